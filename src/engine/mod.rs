@@ -1,0 +1,16 @@
+//! The generic hybrid-systems engine: models declare flows, guards and
+//! resets ([`model`]); the simulation owns the event queue, event location
+//! and the loop ([`simulation`]).
+
+pub mod dopri5;
+pub mod locate;
+pub mod model;
+pub mod observer;
+pub mod queue;
+pub mod simulation;
+pub mod zeno;
+
+pub use dopri5::Tolerances;
+pub use model::{Affects, Direction, Flow, Guard, HybridModel, Jump, Mode};
+pub use observer::{EventRecord, Observer, RecordedEvent, Recorder};
+pub use simulation::{Options, Outcome, Status, simulate};

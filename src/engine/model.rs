@@ -1,0 +1,187 @@
+//! What a hybrid model tells the engine: its state, its modes, the flow in
+//! each mode, its guards and its resets.
+//!
+//! A model is data plus a few pure functions; the [`Simulation`] owns the
+//! event queue, event location, the loop and the log. The required methods
+//! are the minimum for a model with an ODE flow; everything else has a
+//! default.
+//!
+//! [`Simulation`]: crate::engine::Simulation
+
+/// Index of a discrete mode. Models name their modes with [`HybridModel::mode_name`].
+pub type Mode = usize;
+
+/// Which way a guard function must cross zero for its event to fire.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Direction {
+    /// From positive to negative (a gap closing).
+    Falling,
+    /// From negative to positive.
+    Rising,
+    /// Either way.
+    Either,
+}
+
+impl Direction {
+    /// Whether a change of the guard from `before` to `after` is a crossing
+    /// this direction accepts. Landing exactly on zero counts.
+    pub fn accepts(self, before: f64, after: f64) -> bool {
+        match self {
+            Direction::Falling => before > 0.0 && after <= 0.0,
+            Direction::Rising => before < 0.0 && after >= 0.0,
+            Direction::Either => (before > 0.0 && after <= 0.0) || (before < 0.0 && after >= 0.0),
+        }
+    }
+}
+
+/// A guard: a function of the state whose zero crossing fires an event.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Guard {
+    /// Name used in the event log and the summary (`impact`, `bounce`...).
+    pub name: &'static str,
+    pub direction: Direction,
+    /// The guard is an affine function of the state. Along a polynomial
+    /// interpolant it is then a polynomial of the same degree, whose roots
+    /// the engine isolates exactly: no crossing inside a step can be missed.
+    pub affine: bool,
+    /// An internal switch (a change of chart) rather than a physical event:
+    /// it is neither logged nor counted as an event.
+    pub internal: bool,
+}
+
+impl Guard {
+    /// A physical, affine guard: the common case.
+    pub const fn affine(name: &'static str, direction: Direction) -> Self {
+        Guard {
+            name,
+            direction,
+            affine: true,
+            internal: false,
+        }
+    }
+
+    /// Mark this guard as an internal switch (see [`Guard::internal`]).
+    pub const fn as_internal(self) -> Self {
+        Guard {
+            internal: true,
+            ..self
+        }
+    }
+}
+
+/// How the state evolves in a mode.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Flow {
+    /// The model supplies the exact flow map ([`HybridModel::advance`]) and
+    /// the exact next crossing of each guard ([`HybridModel::next_crossing`]).
+    Exact,
+    /// An ODE `x' = f(x)` ([`HybridModel::rhs`]) integrated numerically.
+    Ode,
+    /// The state does not change (resting contact, a stuck mode).
+    Frozen,
+}
+
+/// Which guards a reset can change the predicted crossing of.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Affects {
+    /// Every guard of the new mode is re-predicted.
+    All,
+    /// Only guards `first..first + count` are re-predicted; the others keep
+    /// their queued times (only meaningful for [`Flow::Exact`] modes).
+    Range { first: usize, count: usize },
+}
+
+/// What a reset did: the mode after it, and which predictions it spoiled.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Jump {
+    pub mode: Mode,
+    pub affects: Affects,
+}
+
+impl Jump {
+    /// Stay in `mode` and re-predict every guard.
+    pub fn to(mode: Mode) -> Self {
+        Jump {
+            mode,
+            affects: Affects::All,
+        }
+    }
+}
+
+/// A hybrid automaton: modes with flows, guards and resets.
+///
+/// States are `&[f64]` of length [`dimension`](HybridModel::dimension); the
+/// meaning of each component may differ from mode to mode (a chart switch
+/// changes coordinates). Time is autonomous: flows depend on the elapsed
+/// time `tau` since the last event, never on the absolute clock.
+pub trait HybridModel {
+    /// Length of the continuous state.
+    fn dimension(&self) -> usize;
+
+    /// Names of the state components in `mode`, for logs and summaries.
+    fn state_names(&self, mode: Mode) -> &[&'static str];
+
+    /// Name of a mode, for logs and summaries.
+    fn mode_name(&self, mode: Mode) -> &'static str;
+
+    /// The guards active in `mode`; guard indices are positions in this slice.
+    fn guards(&self, mode: Mode) -> &[Guard];
+
+    /// The value of guard `guard` at state `x`.
+    fn guard(&self, mode: Mode, guard: usize, x: &[f64]) -> f64;
+
+    /// How the state moves in `mode`.
+    fn flow(&self, mode: Mode) -> Flow;
+
+    /// The right-hand side `dx = f(x)` of an [`Flow::Ode`] mode.
+    fn rhs(&self, mode: Mode, x: &[f64], dx: &mut [f64]) {
+        let _ = (x, dx);
+        unreachable!("mode {} declares no ODE", self.mode_name(mode))
+    }
+
+    /// The exact flow map of a [`Flow::Exact`] mode: `x` is the state
+    /// `tau >= 0` after `x0`.
+    fn advance(&self, mode: Mode, x0: &[f64], tau: f64, x: &mut [f64]) {
+        let _ = (x0, tau, x);
+        unreachable!("mode {} declares no exact flow", self.mode_name(mode))
+    }
+
+    /// The exact elapsed time from `x0` to the next crossing of `guard` in
+    /// its direction, for [`Flow::Exact`] modes; `None` if it never crosses.
+    /// `Some(0.0)` means `x0` is on the guard and moving through it now.
+    fn next_crossing(&self, mode: Mode, guard: usize, x0: &[f64]) -> Option<f64> {
+        let _ = (guard, x0);
+        unreachable!("mode {} declares no exact crossings", self.mode_name(mode))
+    }
+
+    /// Apply the reset of `guard`, which has just fired at state `x`.
+    fn reset(&self, mode: Mode, guard: usize, x: &mut [f64]) -> Jump;
+
+    /// The conserved (or monitored) energy at `x`, if the model has one.
+    fn energy(&self, mode: Mode, x: &[f64]) -> Option<f64> {
+        let _ = (mode, x);
+        None
+    }
+
+    /// The scale that relative energy errors are measured against, given
+    /// the initial energy.
+    fn energy_scale(&self, initial_energy: f64) -> f64 {
+        initial_energy.abs()
+    }
+
+    /// Called when events of `guard` accumulate faster than the run can
+    /// resolve (a Zeno point). A model that knows the limit (resting contact)
+    /// writes its state into `x` and returns the mode to go on in; `None`
+    /// ends the run there.
+    fn settle(&self, mode: Mode, guard: usize, x: &mut [f64]) -> Option<Mode> {
+        let _ = (mode, guard, x);
+        None
+    }
+
+    /// A sentence explaining why a numerical flow may fail at `x`, added to
+    /// the engine's own message (e.g. a coordinate singularity).
+    fn diagnose(&self, mode: Mode, x: &[f64]) -> Option<String> {
+        let _ = (mode, x);
+        None
+    }
+}

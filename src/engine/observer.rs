@@ -1,0 +1,64 @@
+//! Events as the engine reports them, and the observers that receive them.
+//!
+//! The engine pushes one [`EventRecord`] per fired (non-internal) guard to an
+//! [`Observer`]. `()` ignores them, [`Recorder`] keeps them in memory, and the
+//! JSON Lines writer in [`crate::log`] streams them to disk.
+
+/// One event, borrowed from the engine for the duration of the call.
+#[derive(Debug, Clone, Copy)]
+pub struct EventRecord<'a> {
+    /// 1-based position in the log.
+    pub seq: u64,
+    pub t: f64,
+    pub guard: &'static str,
+    pub mode_before: &'static str,
+    pub mode_after: &'static str,
+    pub energy_before: Option<f64>,
+    pub energy_after: Option<f64>,
+    pub names_before: &'a [&'static str],
+    pub before: &'a [f64],
+    pub names_after: &'a [&'static str],
+    pub after: &'a [f64],
+}
+
+/// Receives events as they happen. An error stops the run (status `failed`).
+pub trait Observer {
+    fn on_event(&mut self, event: &EventRecord) -> std::io::Result<()>;
+}
+
+impl Observer for () {
+    fn on_event(&mut self, _: &EventRecord) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
+/// An event copied out of the engine.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RecordedEvent {
+    pub t: f64,
+    pub guard: &'static str,
+    pub energy_before: Option<f64>,
+    pub energy_after: Option<f64>,
+    pub before: Vec<f64>,
+    pub after: Vec<f64>,
+}
+
+/// Keeps every event in memory.
+#[derive(Debug, Clone, Default)]
+pub struct Recorder {
+    pub events: Vec<RecordedEvent>,
+}
+
+impl Observer for Recorder {
+    fn on_event(&mut self, e: &EventRecord) -> std::io::Result<()> {
+        self.events.push(RecordedEvent {
+            t: e.t,
+            guard: e.guard,
+            energy_before: e.energy_before,
+            energy_after: e.energy_after,
+            before: e.before.to_vec(),
+            after: e.after.to_vec(),
+        });
+        Ok(())
+    }
+}

@@ -1,0 +1,84 @@
+//! The queue of predicted events: one slot per guard (plus the end of the
+//! current integration step), earliest first.
+//!
+//! Priorities are `(time, slot)` so that events at the same `f64` time pop in
+//! slot order and the log is the same on every run. Times are checked with
+//! `NotNan` when they are scheduled: a NaN time would otherwise sort last and
+//! silently never fire. The exact double-double time of each prediction is
+//! kept beside the queue, so firing an event moves the clock without
+//! rounding.
+
+use std::cmp::Reverse;
+
+use ordered_float::NotNan;
+use priority_queue::PriorityQueue;
+
+use crate::time::Time;
+
+type Priority = Reverse<(NotNan<f64>, usize)>;
+
+#[derive(Debug, Default)]
+pub struct EventQueue {
+    queue: PriorityQueue<usize, Priority>,
+    exact: Vec<Time>,
+}
+
+impl EventQueue {
+    /// Schedule `slot` at `time`, replacing its previous prediction.
+    /// Returns `false` (and schedules nothing) if the time is NaN.
+    pub fn schedule(&mut self, slot: usize, time: Time) -> bool {
+        let Ok(t) = NotNan::new(time.value()) else {
+            return false;
+        };
+        if self.exact.len() <= slot {
+            self.exact.resize(slot + 1, Time::default());
+        }
+        self.exact[slot] = time;
+        self.queue.push(slot, Reverse((t, slot)));
+        true
+    }
+
+    /// Forget the prediction for `slot`, if any.
+    pub fn cancel(&mut self, slot: usize) {
+        self.queue.remove(&slot);
+    }
+
+    /// The earliest slot and its exact time, without removing it.
+    pub fn peek(&self) -> Option<(usize, Time)> {
+        self.queue
+            .peek()
+            .map(|(slot, _)| (*slot, self.exact[*slot]))
+    }
+
+    /// Remove and return the earliest slot and its exact time.
+    pub fn pop(&mut self) -> Option<(usize, Time)> {
+        self.queue.pop().map(|(slot, _)| (slot, self.exact[slot]))
+    }
+
+    pub fn clear(&mut self) {
+        self.queue.clear();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pops_in_time_order_then_slot_order() {
+        let mut q = EventQueue::default();
+        q.schedule(3, Time::new(2.0));
+        q.schedule(1, Time::new(1.0));
+        q.schedule(0, Time::new(2.0));
+        q.schedule(1, Time::new(3.0)); // replaces the 1.0 prediction
+        let order: Vec<usize> = std::iter::from_fn(|| q.pop().map(|(s, _)| s)).collect();
+        assert_eq!(order, vec![0, 3, 1]);
+    }
+
+    #[test]
+    fn refuses_nan_times() {
+        let mut q = EventQueue::default();
+        assert!(!q.schedule(0, Time::new(f64::NAN)));
+        assert!(q.pop().is_none());
+    }
+}

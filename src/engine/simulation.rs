@@ -1,0 +1,536 @@
+//! The event-driven loop: predict, pop the earliest event, advance, reset,
+//! re-predict, record.
+//!
+//! The loop never asks which integrator a mode uses. A mode's flow gives a
+//! *segment*: for an exact flow, the whole future (guards predicted by the
+//! model's exact crossing times); for an ODE, one accepted Dormand-Prince
+//! step with dense output (guards located on it, see [`locate`]), whose end
+//! is queued like an event. The queue holds one prediction per guard and the
+//! step end; whatever pops first happens next.
+//!
+//! How a run can end, in [`Status`]: it reaches `t_end`; events of one guard
+//! accumulate faster than the run can resolve (Zeno), and the model either
+//! settles into a resting mode or the run stops there; a method fails (step
+//! size collapse, non-finite state, event budget spent, the log could not be
+//! written); or it is interrupted. The run never spins.
+//!
+//! [`locate`]: crate::engine::locate
+
+use std::collections::BTreeMap;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+use crate::engine::dopri5::{Dopri5, StepFailure, Tolerances};
+use crate::engine::locate::first_crossing;
+use crate::engine::model::{Affects, Flow, HybridModel, Mode};
+use crate::engine::observer::{EventRecord, Observer};
+use crate::engine::queue::EventQueue;
+use crate::engine::zeno::ZenoWatch;
+use crate::time::Time;
+
+/// How to run a model.
+#[derive(Debug, Clone)]
+pub struct Options {
+    /// Simulated time to stop at (the run starts at 0).
+    pub t_end: f64,
+    /// Stop with `failed` after this many events (guards against runs that
+    /// would take forever without being Zeno).
+    pub max_events: u64,
+    /// Tolerances of the ODE integrator, for modes with [`Flow::Ode`].
+    pub tolerances: Tolerances,
+    /// Set from outside (a signal handler) to stop the run cleanly.
+    pub stop: Option<Arc<AtomicBool>>,
+}
+
+impl Options {
+    /// Run to `t_end` with a budget of 10^9 events and default tolerances.
+    pub fn until(t_end: f64) -> Self {
+        Options {
+            t_end,
+            max_events: 1_000_000_000,
+            tolerances: Tolerances::default(),
+            stop: None,
+        }
+    }
+}
+
+/// How a run ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Status {
+    /// Reached `t_end`.
+    Completed,
+    /// A Zeno accumulation was recognised (see [`Outcome::reason`]); the run
+    /// either settled into resting contact and went on, or stopped there.
+    Zeno,
+    /// A method failed; the result cannot be trusted past `t_reached`.
+    Failed,
+    /// Stopped from outside.
+    Interrupted,
+}
+
+impl Status {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Status::Completed => "completed",
+            Status::Zeno => "zeno",
+            Status::Failed => "failed",
+            Status::Interrupted => "interrupted",
+        }
+    }
+}
+
+/// What a run did.
+#[derive(Debug, Clone)]
+pub struct Outcome {
+    pub status: Status,
+    /// Why the run is not plainly `completed`.
+    pub reason: Option<String>,
+    pub t_end: f64,
+    pub t_reached: f64,
+    /// Non-internal events (impacts and other resets).
+    pub events: u64,
+    pub events_by_guard: BTreeMap<&'static str, u64>,
+    pub zeno: bool,
+    pub energy_initial: Option<f64>,
+    pub energy_final: Option<f64>,
+    /// Largest `|E - E(0)| / scale` seen at any event and at the end.
+    pub max_energy_error: Option<f64>,
+    pub final_mode: &'static str,
+    pub final_state_names: Vec<&'static str>,
+    pub final_state: Vec<f64>,
+    /// Right-hand-side evaluations of numerical flows.
+    pub rhs_evaluations: u64,
+    pub wall_seconds: f64,
+}
+
+/// Run `model` from state `x0` in `mode` at `t = 0`, reporting events to
+/// `observer`.
+pub fn simulate<M: HybridModel + ?Sized, O: Observer + ?Sized>(
+    model: &M,
+    mode: Mode,
+    x0: &[f64],
+    options: &Options,
+    observer: &mut O,
+) -> Outcome {
+    let mut run = Run::new(model, mode, x0, options);
+    let end = run.event_loop(observer);
+    run.outcome(end)
+}
+
+/// Why the loop stopped, with a reason for anything but completion.
+struct End {
+    status: Status,
+    reason: Option<String>,
+}
+
+impl End {
+    fn failed(reason: String) -> Self {
+        End {
+            status: Status::Failed,
+            reason: Some(reason),
+        }
+    }
+}
+
+struct Run<'m, M: HybridModel + ?Sized> {
+    model: &'m M,
+    options: &'m Options,
+    started: Instant,
+    mode: Mode,
+    /// Time of the last event (or step end); `state` is the state then.
+    origin: Time,
+    state: Vec<f64>,
+    queue: EventQueue,
+    stepper: Dopri5,
+    /// Whether the stepper's dense output belongs to the current origin.
+    stepped: bool,
+    /// After `t = 0`, a mode change or a reset that moved the state, guards
+    /// sitting on zero are checked for firing at once: every guard that is
+    /// exactly on zero, and the one that just fired (`Some(slot)`).
+    fresh: Option<Option<usize>>,
+    zeno: ZenoWatch,
+    /// Set once the run has settled a Zeno accumulation and gone on.
+    zeno_reason: Option<String>,
+    settles: u64,
+    before: Vec<f64>,
+    after: Vec<f64>,
+    events: u64,
+    /// Event counts per mode and guard slot.
+    counts: Vec<Vec<u64>>,
+    energy_initial: Option<f64>,
+    energy_scale: f64,
+    max_energy_error: Option<f64>,
+}
+
+impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
+    fn new(model: &'m M, mode: Mode, x0: &[f64], options: &'m Options) -> Self {
+        let n = model.dimension();
+        let energy_initial = model.energy(mode, x0);
+        Run {
+            model,
+            options,
+            started: Instant::now(),
+            mode,
+            origin: Time::new(0.0),
+            state: x0.to_vec(),
+            queue: EventQueue::default(),
+            stepper: Dopri5::new(n, options.tolerances),
+            stepped: false,
+            fresh: Some(None),
+            zeno: ZenoWatch::new(options.t_end),
+            zeno_reason: None,
+            settles: 0,
+            before: vec![0.0; n],
+            after: vec![0.0; n],
+            events: 0,
+            counts: Vec::new(),
+            energy_initial,
+            energy_scale: energy_initial.map_or(1.0, |e| model.energy_scale(e)),
+            max_energy_error: energy_initial.map(|_| 0.0),
+        }
+    }
+
+    fn event_loop<O: Observer + ?Sized>(&mut self, observer: &mut O) -> End {
+        let t_end = self.options.t_end;
+        if self.state.len() != self.model.dimension() || !all_finite(&self.state) {
+            return End::failed(format!(
+                "initial state {:?} is not a finite state",
+                self.state
+            ));
+        }
+        if let Err(end) = self.start_segment() {
+            return end;
+        }
+        loop {
+            if self
+                .options
+                .stop
+                .as_ref()
+                .is_some_and(|s| s.load(Ordering::Relaxed))
+            {
+                return End {
+                    status: Status::Interrupted,
+                    reason: Some("stopped by a signal".into()),
+                };
+            }
+            let next = self.queue.peek().filter(|(_, t)| t.value() <= t_end);
+            let Some((slot, t)) = next else {
+                return self.finish_at(Time::new(t_end));
+            };
+            self.queue.pop();
+            let model = self.model;
+            let result = if slot == model.guards(self.mode).len() {
+                self.stepper.dense().end(&mut self.state);
+                self.origin = t;
+                self.start_segment()
+            } else {
+                self.fire(slot, t, observer)
+            };
+            if let Err(end) = result {
+                return end;
+            }
+            if self.events >= self.options.max_events {
+                return End::failed(format!(
+                    "event budget spent: {} events by t = {}; raise max_events if the run is meant to be this long",
+                    self.events,
+                    t.value()
+                ));
+            }
+        }
+    }
+
+    /// Fire guard `slot` at time `t`: reset, record, watch for Zeno, re-predict.
+    fn fire<O: Observer + ?Sized>(
+        &mut self,
+        slot: usize,
+        t: Time,
+        observer: &mut O,
+    ) -> Result<(), End> {
+        let (model, mode) = (self.model, self.mode);
+        let guard = model.guards(mode)[slot];
+        let mut before = std::mem::take(&mut self.before);
+        self.state_at(t.since(self.origin), &mut before);
+        self.after.copy_from_slice(&before);
+        let jump = model.reset(mode, slot, &mut self.after);
+        let moved = jump.mode != mode || self.after != before;
+        let recorded = if !all_finite(&before) || !all_finite(&self.after) {
+            Err(End::failed(format!(
+                "non-finite state at the `{}` event at t = {}: before {:?}, after {:?}",
+                guard.name,
+                t.value(),
+                before,
+                self.after
+            )))
+        } else if guard.internal {
+            Ok(())
+        } else {
+            self.count(mode, slot);
+            self.record(guard.name, t, jump.mode, &before, observer)
+        };
+        self.before = before;
+        recorded?;
+        std::mem::swap(&mut self.state, &mut self.after);
+        self.origin = t;
+        self.mode = jump.mode;
+        if !guard.internal && self.zeno.observe(mode, slot, t) {
+            return self.settle(slot, guard.name, t, observer);
+        }
+        match (model.flow(jump.mode), jump.affects) {
+            (Flow::Exact, Affects::Range { first, count }) if jump.mode == mode => {
+                (first..first + count).try_for_each(|g| self.predict_exact(g))
+            }
+            _ => {
+                self.stepper.restart();
+                self.fresh = moved.then_some(Some(slot));
+                self.start_segment()
+            }
+        }
+    }
+
+    fn count(&mut self, mode: Mode, slot: usize) {
+        if self.counts.len() <= mode {
+            self.counts.resize(mode + 1, Vec::new());
+        }
+        let counts = &mut self.counts[mode];
+        if counts.len() <= slot {
+            counts.resize(slot + 1, 0);
+        }
+        counts[slot] += 1;
+    }
+
+    /// Send one event (from `before` in the current mode to `self.after` in
+    /// `mode_after`) to the observer and keep the energy audit.
+    fn record<O: Observer + ?Sized>(
+        &mut self,
+        name: &'static str,
+        t: Time,
+        mode_after: Mode,
+        before: &[f64],
+        observer: &mut O,
+    ) -> Result<(), End> {
+        let (model, mode) = (self.model, self.mode);
+        self.events += 1;
+        let energy_before = model.energy(mode, before);
+        let energy_after = model.energy(mode_after, &self.after);
+        self.audit_energy(energy_before);
+        self.audit_energy(energy_after);
+        let event = EventRecord {
+            seq: self.events,
+            t: t.value(),
+            guard: name,
+            mode_before: model.mode_name(mode),
+            mode_after: model.mode_name(mode_after),
+            energy_before,
+            energy_after,
+            names_before: model.state_names(mode),
+            before,
+            names_after: model.state_names(mode_after),
+            after: &self.after,
+        };
+        observer
+            .on_event(&event)
+            .map_err(|e| End::failed(format!("could not write the event log: {e}")))
+    }
+
+    /// Events of guard `slot` of `mode` came faster than the run can
+    /// resolve: let the model settle into resting contact, or stop.
+    fn settle<O: Observer + ?Sized>(
+        &mut self,
+        slot: usize,
+        name: &str,
+        t: Time,
+        observer: &mut O,
+    ) -> Result<(), End> {
+        let what = format!(
+            "events of guard `{name}` accumulate at t = {} faster than the run can resolve ({})",
+            t.value(),
+            self.zeno.describe()
+        );
+        self.after.copy_from_slice(&self.state);
+        let Some(rest) = self.model.settle(self.mode, slot, &mut self.after) else {
+            return Err(End {
+                status: Status::Zeno,
+                reason: Some(format!(
+                    "{what}; the model has no resting mode, so the run stops here"
+                )),
+            });
+        };
+        let before = std::mem::take(&mut self.state);
+        self.settles += 1;
+        let recorded = self.record(SETTLE, t, rest, &before, observer);
+        self.state = before;
+        recorded?;
+        std::mem::swap(&mut self.state, &mut self.after);
+        self.mode = rest;
+        self.zeno_reason = Some(format!(
+            "{what}; settled into `{}`",
+            self.model.mode_name(rest)
+        ));
+        self.stepper.restart();
+        self.fresh = Some(None);
+        self.start_segment()
+    }
+
+    /// Predict every guard of the current mode from `(origin, state)`; for an
+    /// ODE mode this takes the next integration step.
+    fn start_segment(&mut self) -> Result<(), End> {
+        self.queue.clear();
+        let (model, mode) = (self.model, self.mode);
+        let guards = model.guards(mode);
+        match model.flow(mode) {
+            Flow::Frozen => Ok(()),
+            Flow::Exact => (0..guards.len()).try_for_each(|g| self.predict_exact(g)),
+            Flow::Ode => {
+                let t_end = self.options.t_end;
+                let remaining = self.origin.until(t_end);
+                let h_min = 64.0 * f64::EPSILON * self.origin.value().abs().max(t_end);
+                let fresh = self.fresh.take();
+                // What is left of the run is below what a step can resolve.
+                self.stepped = remaining > h_min;
+                if !self.stepped {
+                    return Ok(());
+                }
+                if let Err(failure) = self
+                    .stepper
+                    .step(model, mode, &self.state, remaining, h_min)
+                {
+                    return Err(self.step_failed(failure));
+                }
+                let step = self.stepper.dense();
+                let h = step.h;
+                let x = &mut self.before;
+                for (g, guard) in guards.iter().enumerate() {
+                    let check_start = fresh.is_some_and(|fired| {
+                        fired == Some(g) || model.guard(mode, g, &self.state) == 0.0
+                    });
+                    let crossing = first_crossing(guard, check_start, |s| {
+                        step.eval(s * h, x);
+                        model.guard(mode, g, x)
+                    });
+                    if let Some(s) = crossing {
+                        self.queue.schedule(g, self.origin.after(s * h));
+                    }
+                }
+                self.queue.schedule(guards.len(), self.origin.after(h));
+                Ok(())
+            }
+        }
+    }
+
+    fn predict_exact(&mut self, g: usize) -> Result<(), End> {
+        match self.model.next_crossing(self.mode, g, &self.state) {
+            None => {
+                self.queue.cancel(g);
+                Ok(())
+            }
+            Some(tau) if tau >= 0.0 && self.queue.schedule(g, self.origin.after(tau)) => Ok(()),
+            Some(tau) => Err(End::failed(format!(
+                "the model predicted guard `{}` at an invalid elapsed time {tau} from state {:?} at t = {}",
+                self.model.guards(self.mode)[g].name,
+                self.state,
+                self.origin.value()
+            ))),
+        }
+    }
+
+    fn step_failed(&self, failure: StepFailure) -> End {
+        let t = self.origin.value();
+        let what = match failure {
+            StepFailure::Collapsed { h } => format!(
+                "the Dormand-Prince step size collapsed to {h:.3e} at t = {t} (state {:?})",
+                self.state
+            ),
+            StepFailure::NonFinite => {
+                format!(
+                    "the right-hand side is not finite at t = {t} (state {:?})",
+                    self.state
+                )
+            }
+        };
+        match self.model.diagnose(self.mode, &self.state) {
+            Some(why) => End::failed(format!("{what}: {why}")),
+            None => End::failed(what),
+        }
+    }
+
+    /// The state `tau` after `origin`, by the current segment's flow.
+    fn state_at(&self, tau: f64, x: &mut [f64]) {
+        match self.model.flow(self.mode) {
+            Flow::Exact => self.model.advance(self.mode, &self.state, tau, x),
+            Flow::Frozen => x.copy_from_slice(&self.state),
+            Flow::Ode if self.stepped => self.stepper.dense().eval(tau, x),
+            Flow::Ode => x.copy_from_slice(&self.state),
+        }
+    }
+
+    fn audit_energy(&mut self, energy: Option<f64>) {
+        if let (Some(e), Some(e0), Some(max)) =
+            (energy, self.energy_initial, self.max_energy_error.as_mut())
+        {
+            *max = max.max((e - e0).abs() / self.energy_scale);
+        }
+    }
+
+    fn finish_at(&mut self, t: Time) -> End {
+        let mut x = std::mem::take(&mut self.before);
+        self.state_at(t.since(self.origin), &mut x);
+        self.state.copy_from_slice(&x);
+        self.before = x;
+        self.origin = t;
+        match self.zeno_reason.clone() {
+            Some(reason) => End {
+                status: Status::Zeno,
+                reason: Some(reason),
+            },
+            None => End {
+                status: Status::Completed,
+                reason: None,
+            },
+        }
+    }
+
+    fn outcome(self, end: End) -> Outcome {
+        let model = self.model;
+        let energy_final = model.energy(self.mode, &self.state);
+        let mut run = self;
+        run.audit_energy(energy_final);
+        let mut events_by_guard = BTreeMap::new();
+        for (mode, counts) in run.counts.iter().enumerate() {
+            for (slot, &n) in counts.iter().enumerate() {
+                if n > 0 {
+                    *events_by_guard
+                        .entry(model.guards(mode)[slot].name)
+                        .or_insert(0) += n;
+                }
+            }
+        }
+        if run.settles > 0 {
+            events_by_guard.insert(SETTLE, run.settles);
+        }
+        Outcome {
+            zeno: end.status == Status::Zeno || run.zeno_reason.is_some(),
+            status: end.status,
+            reason: end.reason,
+            t_end: run.options.t_end,
+            t_reached: run.origin.value(),
+            events: run.events,
+            events_by_guard,
+            energy_initial: run.energy_initial,
+            energy_final,
+            max_energy_error: run.max_energy_error,
+            final_mode: model.mode_name(run.mode),
+            final_state_names: model.state_names(run.mode).to_vec(),
+            final_state: run.state,
+            rhs_evaluations: run.stepper.evaluations,
+            wall_seconds: run.started.elapsed().as_secs_f64(),
+        }
+    }
+}
+
+/// The name under which a Zeno settling appears in the log.
+pub const SETTLE: &str = "settle";
+
+fn all_finite(x: &[f64]) -> bool {
+    x.iter().all(|v| v.is_finite())
+}

@@ -1,0 +1,4 @@
+//! flicker: an event-driven engine for hybrid automata.
+pub mod engine;
+pub mod models;
+pub mod time;

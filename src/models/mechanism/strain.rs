@@ -1,0 +1,86 @@
+//! The mechanism in the strain formulation: a hybrid automaton with the exact
+//! flow of the linear oscillator, the guard `eps = 0` while closing, and the
+//! elastic reset `eps' -> -eps'` (PHYSICS.md s.2).
+//!
+//! Below the critical load (`eta < 1`) the trivial state is stable and sits
+//! on the constraint: orbits with small energy chatter against it, and the
+//! engine's Zeno watch hands them to the `resting` mode, where the strain
+//! stays at zero (the load keeps the unit shut, so it never leaves).
+
+use crate::engine::{Direction, Flow, Guard, HybridModel, Jump, Mode};
+use crate::models::mechanism::closed_form::Mechanism;
+
+/// Mode indices.
+pub const FLIGHT: Mode = 0;
+pub const RESTING: Mode = 1;
+
+const STATE: [&str; 2] = ["strain", "strain_rate"];
+const FLIGHT_GUARDS: [Guard; 1] = [Guard::affine("impact", Direction::Falling)];
+
+/// State `[eps, eps']`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StrainMechanism {
+    pub mechanism: Mechanism,
+}
+
+impl HybridModel for StrainMechanism {
+    fn dimension(&self) -> usize {
+        2
+    }
+
+    fn state_names(&self, _: Mode) -> &[&'static str] {
+        &STATE
+    }
+
+    fn mode_name(&self, mode: Mode) -> &'static str {
+        if mode == RESTING { "resting" } else { "flight" }
+    }
+
+    fn guards(&self, mode: Mode) -> &[Guard] {
+        if mode == RESTING { &[] } else { &FLIGHT_GUARDS }
+    }
+
+    fn guard(&self, _: Mode, _: usize, x: &[f64]) -> f64 {
+        x[0]
+    }
+
+    fn flow(&self, mode: Mode) -> Flow {
+        if mode == RESTING {
+            Flow::Frozen
+        } else {
+            Flow::Exact
+        }
+    }
+
+    fn advance(&self, _: Mode, x0: &[f64], tau: f64, x: &mut [f64]) {
+        (x[0], x[1]) = self.mechanism.flow(x0[0], x0[1], tau);
+    }
+
+    fn next_crossing(&self, _: Mode, _: usize, x0: &[f64]) -> Option<f64> {
+        self.mechanism.time_to_closing(x0[0], x0[1])
+    }
+
+    fn reset(&self, mode: Mode, _: usize, x: &mut [f64]) -> Jump {
+        // The crossing is exact up to rounding: put the state on the
+        // constraint so the next flight starts from eps = 0 exactly.
+        x[0] = 0.0;
+        x[1] = -x[1];
+        Jump::to(mode)
+    }
+
+    fn energy(&self, _: Mode, x: &[f64]) -> Option<f64> {
+        Some(self.mechanism.energy(x[0], x[1]))
+    }
+
+    fn energy_scale(&self, initial_energy: f64) -> f64 {
+        self.mechanism.energy_scale(initial_energy)
+    }
+
+    fn settle(&self, _: Mode, _: usize, x: &mut [f64]) -> Option<Mode> {
+        // Only below the critical load does the load hold the unit shut.
+        (self.mechanism.eta < 1.0).then(|| {
+            x.copy_from_slice(&[0.0, 0.0]);
+            RESTING
+        })
+    }
+}

@@ -1,0 +1,5 @@
+//! flicker's integration tests: one binary, one module per behaviour.
+
+mod event_location;
+mod mechanism_angle;
+mod mechanism_strain;

@@ -1,0 +1,79 @@
+//! The angle formulation: plain integration through theta = 0 fails loudly;
+//! with chart switching it agrees with the exact strain formulation.
+
+use flicker::engine::{Options, Recorder, Status, simulate};
+use flicker::models::mechanism::angle::PLAIN;
+use flicker::models::mechanism::strain::FLIGHT;
+use flicker::models::mechanism::{AngleMechanism, Charts, ExactOrbit, Mechanism, StrainMechanism};
+
+#[test]
+fn plain_integration_through_theta_zero_fails_with_a_reason() {
+    let m = Mechanism {
+        eta: 1.2,
+        omega: 1.0,
+    };
+    let model = AngleMechanism {
+        mechanism: m,
+        charts: Charts::Plain,
+    };
+    let (mode, x0) = model.start_from_strain(0.5, 0.0).unwrap();
+    assert_eq!(mode, PLAIN);
+    let outcome = simulate(&model, mode, &x0, &Options::until(100.0), &mut ());
+    assert_eq!(outcome.status, Status::Failed);
+    let reason = outcome.reason.unwrap();
+    assert!(reason.contains("singular at theta = 0"), "{reason}");
+    // It fails at the first passage, not before and not much after.
+    let first = m.time_to_closing(0.5, 0.0).unwrap();
+    assert!(
+        (outcome.t_reached - first).abs() < 1e-3,
+        "stopped at {} not {first}",
+        outcome.t_reached
+    );
+}
+
+#[test]
+fn chart_switching_agrees_with_the_strain_formulation_over_100_impacts() {
+    let m = Mechanism {
+        eta: 1.2,
+        omega: 1.0,
+    };
+    let (eps0, rate0) = (0.5, 0.0);
+    let model = AngleMechanism {
+        mechanism: m,
+        charts: Charts::Switch,
+    };
+    let (mode, x0) = model.start_from_strain(eps0, rate0).unwrap();
+    let exact = ExactOrbit::new(m, eps0, rate0);
+    let period = m.impact_period(m.energy(eps0, rate0));
+    let t_end = m.time_to_closing(eps0, rate0).unwrap() + 99.5 * period;
+    let mut angle_log = Recorder::default();
+    let outcome = simulate(&model, mode, &x0, &Options::until(t_end), &mut angle_log);
+    assert_eq!(outcome.status, Status::Completed, "{:?}", outcome.reason);
+    assert_eq!(outcome.events, 100);
+    let mut strain_log = Recorder::default();
+    simulate(
+        &StrainMechanism { mechanism: m },
+        FLIGHT,
+        &[eps0, rate0],
+        &Options::until(t_end),
+        &mut strain_log,
+    );
+    for (a, s) in angle_log.events.iter().zip(&strain_log.events) {
+        assert!((a.t - s.t).abs() < 1e-7, "impact times {} vs {}", a.t, s.t);
+    }
+    let final_mode = [0, 1, 2, 3]
+        .into_iter()
+        .find(|&m| model_mode_name(&model, m) == outcome.final_mode)
+        .unwrap();
+    let (eps, rate) = model.strain(final_mode, &outcome.final_state);
+    let (eps_exact, rate_exact) = exact.state_at(t_end);
+    assert!((eps - eps_exact).abs() < 1e-7, "eps {eps} vs {eps_exact}");
+    assert!((rate - rate_exact).abs() < 1e-7);
+    // eps(t) along the way: compare at every chart switch too, via energy.
+    assert!(outcome.max_energy_error.unwrap() < 1e-8);
+}
+
+fn model_mode_name(model: &AngleMechanism, mode: usize) -> &'static str {
+    use flicker::engine::HybridModel;
+    model.mode_name(mode)
+}
