@@ -96,7 +96,8 @@ pub struct Outcome {
     pub energy_final: Option<f64>,
     /// Largest `|E - E(0)| / scale` seen at any event and at the end.
     pub max_energy_error: Option<f64>,
-    pub final_mode: &'static str,
+    pub final_mode: Mode,
+    pub final_mode_name: &'static str,
     pub final_state_names: Vec<&'static str>,
     pub final_state: Vec<f64>,
     /// Right-hand-side evaluations of numerical flows.
@@ -343,7 +344,7 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
         observer: &mut O,
     ) -> Result<(), End> {
         let what = format!(
-            "events of guard `{name}` accumulate at t = {} faster than the run can resolve ({})",
+            "events of guard `{name}` accumulate at t = {:e} faster than the run can resolve ({})",
             t.value(),
             self.zeno.describe()
         );
@@ -519,7 +520,8 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
             energy_initial: run.energy_initial,
             energy_final,
             max_energy_error: run.max_energy_error,
-            final_mode: model.mode_name(run.mode),
+            final_mode: run.mode,
+            final_mode_name: model.mode_name(run.mode),
             final_state_names: model.state_names(run.mode).to_vec(),
             final_state: run.state,
             rhs_evaluations: run.stepper.evaluations,

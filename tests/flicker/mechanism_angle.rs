@@ -72,8 +72,3 @@ fn chart_switching_agrees_with_the_strain_formulation_over_100_impacts() {
     // eps(t) along the way: compare at every chart switch too, via energy.
     assert!(outcome.max_energy_error.unwrap() < 1e-8);
 }
-
-fn model_mode_name(model: &AngleMechanism, mode: usize) -> &'static str {
-    use flicker::engine::HybridModel;
-    model.mode_name(mode)
-}

@@ -170,7 +170,7 @@ fn chattering_below_critical_load_settles_into_resting_contact() {
         "{:?}",
         outcome.reason
     );
-    assert_eq!(outcome.final_mode, "resting");
+    assert_eq!(outcome.final_mode, RESTING);
     assert_eq!(outcome.t_reached, 100.0);
     assert_eq!(outcome.final_state, vec![0.0, 0.0]);
     assert!(outcome.events < 100);
@@ -184,7 +184,7 @@ fn resting_contact_at_zero_energy_is_recognised_at_once() {
     };
     let outcome = run(m, (0.0, 0.0), 10.0);
     assert_eq!(outcome.status, Status::Zeno);
-    assert_eq!(outcome.final_mode, "resting");
+    assert_eq!(outcome.final_mode, RESTING);
     assert_eq!(outcome.t_reached, 10.0);
     assert!(outcome.max_energy_error.unwrap() == 0.0);
 }
@@ -204,5 +204,4 @@ fn resolvable_chattering_is_run_out_exactly() {
         ExactOrbit::new(m, x0.0, x0.1).impacts_until(10.0)
     );
     assert!(outcome.events > 500_000);
-    let _ = RESTING;
 }

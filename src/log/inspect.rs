@@ -1,0 +1,162 @@
+//! Filtering and summarising an event log: counts per guard, first and last
+//! times, intervals between events, and the largest energy jump across a
+//! reset (where a perfectly elastic model should show round-off only).
+
+use std::collections::BTreeMap;
+
+use serde::Serialize;
+
+use crate::log::reader::LoggedEvent;
+
+/// Which events to keep.
+#[derive(Debug, Clone, Default)]
+pub struct Filter {
+    pub guard: Option<String>,
+    pub from: Option<f64>,
+    pub to: Option<f64>,
+}
+
+impl Filter {
+    pub fn keeps(&self, e: &LoggedEvent) -> bool {
+        self.guard.as_ref().is_none_or(|g| *g == e.guard)
+            && self.from.is_none_or(|t| e.t >= t)
+            && self.to.is_none_or(|t| e.t <= t)
+    }
+}
+
+/// Smallest, mean and largest of a stream of values.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct Spread {
+    pub count: u64,
+    pub min: Option<f64>,
+    pub mean: Option<f64>,
+    pub max: Option<f64>,
+    #[serde(skip)]
+    sum: f64,
+}
+
+impl Spread {
+    fn add(&mut self, x: f64) {
+        self.count += 1;
+        self.sum += x;
+        self.min = Some(self.min.map_or(x, |m| m.min(x)));
+        self.max = Some(self.max.map_or(x, |m| m.max(x)));
+        self.mean = Some(self.sum / self.count as f64);
+    }
+}
+
+/// What one guard did.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct GuardSummary {
+    pub count: u64,
+    pub first_t: Option<f64>,
+    pub last_t: Option<f64>,
+    /// Between consecutive events of this guard.
+    pub intervals: Spread,
+}
+
+/// The event with the largest `|energy_after - energy_before|`.
+#[derive(Debug, Clone, Serialize)]
+pub struct EnergyJump {
+    pub jump: f64,
+    pub seq: u64,
+    pub t: f64,
+    pub guard: String,
+}
+
+/// A summary of the events a filter kept.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct Summary {
+    pub events: u64,
+    pub first_t: Option<f64>,
+    pub last_t: Option<f64>,
+    pub by_guard: BTreeMap<String, GuardSummary>,
+    /// Between consecutive kept events, whatever their guard.
+    pub intervals: Spread,
+    pub largest_energy_jump: Option<EnergyJump>,
+    /// Events whose time is earlier than the one before (should be none).
+    pub out_of_order: u64,
+}
+
+impl Summary {
+    pub fn add(&mut self, e: &LoggedEvent) {
+        if let Some(last) = self.last_t {
+            if e.t < last {
+                self.out_of_order += 1;
+            }
+            self.intervals.add(e.t - last);
+        }
+        self.events += 1;
+        self.first_t.get_or_insert(e.t);
+        self.last_t = Some(e.t);
+        let guard = self.by_guard.entry(e.guard.clone()).or_default();
+        if let Some(last) = guard.last_t {
+            guard.intervals.add(e.t - last);
+        }
+        guard.count += 1;
+        guard.first_t.get_or_insert(e.t);
+        guard.last_t = Some(e.t);
+        if let (Some(before), Some(after)) = (e.energy_before, e.energy_after) {
+            let jump = (after - before).abs();
+            if self
+                .largest_energy_jump
+                .as_ref()
+                .is_none_or(|j| jump > j.jump)
+            {
+                self.largest_energy_jump = Some(EnergyJump {
+                    jump,
+                    seq: e.seq,
+                    t: e.t,
+                    guard: e.guard.clone(),
+                });
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn event(seq: u64, t: f64, guard: &str, jump: f64) -> LoggedEvent {
+        LoggedEvent {
+            seq,
+            t,
+            guard: guard.into(),
+            energy_before: Some(1.0),
+            energy_after: Some(1.0 + jump),
+        }
+    }
+
+    #[test]
+    fn summarises_counts_intervals_and_the_largest_jump() {
+        let mut s = Summary::default();
+        for e in [
+            event(1, 1.0, "a", 0.0),
+            event(2, 2.0, "b", -3e-16),
+            event(3, 4.0, "a", 1e-16),
+        ] {
+            s.add(&e);
+        }
+        assert_eq!(s.events, 3);
+        assert_eq!(s.by_guard["a"].count, 2);
+        assert_eq!(s.by_guard["a"].intervals.mean, Some(3.0));
+        assert_eq!(s.intervals.min, Some(1.0));
+        assert_eq!(s.intervals.max, Some(2.0));
+        let jump = s.largest_energy_jump.unwrap();
+        assert_eq!((jump.seq, jump.guard.as_str()), (2, "b"));
+        assert_eq!(s.out_of_order, 0);
+    }
+
+    #[test]
+    fn filters_by_guard_and_window() {
+        let f = Filter {
+            guard: Some("a".into()),
+            from: Some(1.5),
+            to: Some(5.0),
+        };
+        assert!(!f.keeps(&event(1, 1.0, "a", 0.0)));
+        assert!(!f.keeps(&event(2, 2.0, "b", 0.0)));
+        assert!(f.keeps(&event(3, 4.0, "a", 0.0)));
+    }
+}

@@ -1,0 +1,57 @@
+//! `summary.json`: what a run did, in one object.
+//!
+//! Keys: `status` (`completed`, `zeno`, `failed`, `interrupted`), `reason`
+//! (null when completed), `model`, `method`, `method_description`,
+//! `scene`, `events`, `events_by_guard`, `t_end`, `t_reached`,
+//! `energy_initial`, `energy_final`, `max_energy_error` (relative, against
+//! the model's energy scale), `final_state` (named components), `final_mode`,
+//! `zeno`, `rhs_evaluations`, `wall_seconds`, `log` (path of the event log or
+//! null).
+
+use std::io;
+use std::path::Path;
+
+use serde_json::{Value, json};
+
+use crate::runner::Report;
+
+/// The summary of `report`, run from the scene file `scene`.
+pub fn summary(report: &Report, model: &str, scene: &Path, log: Option<&Path>) -> Value {
+    let o = &report.outcome;
+    let final_state: serde_json::Map<String, Value> = report
+        .final_state
+        .iter()
+        .map(|(name, x)| (name.to_string(), json!(x)))
+        .collect();
+    json!({
+        "status": o.status.as_str(),
+        "reason": o.reason,
+        "model": model,
+        "method": report.method,
+        "method_description": report.description,
+        "scene": scene.display().to_string(),
+        "events": o.events,
+        "events_by_guard": o.events_by_guard,
+        "t_end": o.t_end,
+        "t_reached": o.t_reached,
+        "energy_initial": o.energy_initial,
+        "energy_final": o.energy_final,
+        "max_energy_error": o.max_energy_error,
+        "final_state": final_state,
+        "final_mode": o.final_mode_name,
+        "zeno": o.zeno,
+        "rhs_evaluations": o.rhs_evaluations,
+        "wall_seconds": o.wall_seconds,
+        "log": log.map(|p| p.display().to_string()),
+    })
+}
+
+/// Write `value` to `path` through a temporary file and a rename, so a
+/// reader never sees half a summary.
+pub fn write_atomically(path: &Path, value: &Value) -> io::Result<()> {
+    let tmp = path.with_extension("json.tmp");
+    let mut text = serde_json::to_string_pretty(value).map_err(io::Error::other)?;
+    text.push('\n');
+    std::fs::write(&tmp, text)?;
+    std::fs::rename(&tmp, path)
+}

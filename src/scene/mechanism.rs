@@ -1,0 +1,209 @@
+//! The keys of a mechanism scene.
+//!
+//! ```json
+//! {"model": "mechanism", "formulation": "strain", "eta": 1.2, "omega": 1.0,
+//!  "initial": {"strain": 0.05, "strain_rate": 0.0}, "t_end": 1000.0}
+//! ```
+//!
+//! - `formulation`: `"strain"` (hybrid, exact flow) or `"angle"` (smooth
+//!   equation (8), integrated with Dormand-Prince).
+//! - `eta`: load ratio `F / F_cr`, any finite number; `omega > 0` (default 1).
+//! - `initial`: one of `{"strain", "strain_rate"}` (`strain >= 0`),
+//!   `{"energy", "phase"}` with phase `"impact"` (at `eps = 0`, opening) or
+//!   `"apex"` (largest strain, at rest), or, for the angle formulation,
+//!   `{"angle", "angle_rate"}` with `|angle| < pi/2`. A strain given to the
+//!   angle formulation means `theta >= 0`.
+//! - `t_end > 0`: simulated time.
+//! - optional: `chart` (angle only: `"switch"`, the default, crosses
+//!   `theta = 0` in the strain chart; `"none"` integrates (8) as it is and
+//!   fails there), `solver` (angle only: `{"rtol", "atol"}`), `max_events`
+//!   (event budget, default 10^9), `description` (free text).
+
+use std::f64::consts::FRAC_PI_2;
+
+use crate::engine::Tolerances;
+use crate::models::mechanism::{Charts, Mechanism, Phase};
+use crate::scene::SceneError;
+use crate::scene::fields::{Fields, kind};
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Formulation {
+    Strain,
+    Angle(Charts),
+}
+
+/// The initial state as the scene gave it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Initial {
+    Strain { strain: f64, rate: f64 },
+    Energy { energy: f64, phase: Phase },
+    Angle { angle: f64, rate: f64 },
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct MechanismScene {
+    pub formulation: Formulation,
+    pub mechanism: Mechanism,
+    pub initial: Initial,
+    /// The initial `(eps, eps')`, resolved from `initial`.
+    pub initial_strain: (f64, f64),
+    pub t_end: f64,
+    pub tolerances: Tolerances,
+    pub max_events: u64,
+    pub description: Option<String>,
+}
+
+pub(crate) fn validate(mut f: Fields) -> Result<MechanismScene, SceneError> {
+    let formulation = f.string("formulation")?;
+    let eta = f.number("eta")?;
+    let omega = f.optional_number("omega")?.unwrap_or(1.0);
+    let omega = f.check("omega", omega, "> 0", |w| w > 0.0)?;
+    let mechanism = Mechanism { eta, omega };
+    let t_end = f.number_where("t_end", "> 0", |t| t > 0.0)?;
+    let max_events = f.optional_count("max_events")?.unwrap_or(1_000_000_000);
+    let description = f.optional_string("description")?.map(str::to_string);
+    let angle = formulation == "angle";
+    let formulation = match formulation {
+        "strain" => Formulation::Strain,
+        "angle" => Formulation::Angle(charts(&mut f)?),
+        other => {
+            return Err(SceneError::field(
+                "formulation",
+                format!("must be \"strain\" or \"angle\" (got {other:?})"),
+            ));
+        }
+    };
+    let tolerances = match f.optional("solver") {
+        Some(_) if !angle => {
+            return Err(SceneError::field(
+                "solver",
+                "applies to the angle formulation only; the strain formulation uses its exact flow"
+                    .into(),
+            ));
+        }
+        Some(solver) => tolerances(solver)?,
+        None => Tolerances::default(),
+    };
+    let initial = initial(f.required("initial")?, mechanism, angle)?;
+    let initial_strain = match initial {
+        Initial::Strain { strain, rate } => (strain, rate),
+        Initial::Energy { energy, phase } => mechanism
+            .state_with_energy(energy, phase)
+            .map_err(|reason| SceneError::field("initial.energy", reason))?,
+        Initial::Angle { angle, rate } => {
+            crate::models::mechanism::angle::strain_of_angle(angle, rate)
+        }
+    };
+    if formulation == Formulation::Angle(Charts::Plain) && initial_strain.0 == 0.0 {
+        return Err(SceneError::field(
+            "initial",
+            "puts theta = 0, where equation (8) is singular (theta' is infinite there); use \"chart\": \"switch\""
+                .into(),
+        ));
+    }
+    f.finish()?;
+    Ok(MechanismScene {
+        formulation,
+        mechanism,
+        initial,
+        initial_strain,
+        t_end,
+        tolerances,
+        max_events,
+        description,
+    })
+}
+
+fn charts(f: &mut Fields) -> Result<Charts, SceneError> {
+    match f.optional_string("chart")? {
+        None | Some("switch") => Ok(Charts::Switch),
+        Some("none") => Ok(Charts::Plain),
+        Some(other) => Err(SceneError::field(
+            "chart",
+            format!("must be \"switch\" or \"none\" (got {other:?})"),
+        )),
+    }
+}
+
+fn tolerances(value: &serde_json::Value) -> Result<Tolerances, SceneError> {
+    let mut f = Fields::open(value, "solver")?;
+    let default = Tolerances::default();
+    let positive = |f: &mut Fields, key, default| -> Result<f64, SceneError> {
+        let x = f.optional_number(key)?.unwrap_or(default);
+        f.check(key, x, "> 0", |x| x > 0.0)
+    };
+    let rtol = positive(&mut f, "rtol", default.rtol)?;
+    let atol = positive(&mut f, "atol", default.atol)?;
+    if let Some(method) = f.optional_string("method")? {
+        if method != "dopri5" {
+            return Err(SceneError::field(
+                "solver.method",
+                format!("must be \"dopri5\" for the angle formulation (got {method:?})"),
+            ));
+        }
+    }
+    f.finish()?;
+    Ok(Tolerances { rtol, atol })
+}
+
+fn initial(
+    value: &serde_json::Value,
+    mechanism: Mechanism,
+    angle: bool,
+) -> Result<Initial, SceneError> {
+    let mut f = Fields::open(value, "initial")?;
+    let initial = if f.has("strain") {
+        let strain = f.number_where(
+            "strain",
+            ">= 0 (the strain is a unilateral constraint)",
+            |e| e >= 0.0,
+        )?;
+        Initial::Strain {
+            strain,
+            rate: f.number("strain_rate")?,
+        }
+    } else if f.has("energy") {
+        let energy = f.number("energy")?;
+        let phase = match f.string("phase")? {
+            "impact" => Phase::Impact,
+            "apex" => Phase::Apex,
+            other => {
+                return Err(SceneError::field(
+                    "initial.phase",
+                    format!("must be \"impact\" or \"apex\" (got {other:?})"),
+                ));
+            }
+        };
+        mechanism
+            .state_with_energy(energy, phase)
+            .map_err(|reason| SceneError::field("initial.energy", reason))?;
+        Initial::Energy { energy, phase }
+    } else if f.has("angle") {
+        if !angle {
+            return Err(SceneError::field(
+                "initial.angle",
+                "is for the angle formulation; give the strain formulation {\"strain\", \"strain_rate\"}".into(),
+            ));
+        }
+        let theta = f.number_where("angle", "inside (-pi/2, pi/2)", |a| a.abs() < FRAC_PI_2)?;
+        Initial::Angle {
+            angle: theta,
+            rate: f.number("angle_rate")?,
+        }
+    } else {
+        return Err(SceneError::field(
+            "initial",
+            format!(
+                "must hold {{\"strain\", \"strain_rate\"}}, {{\"energy\", \"phase\"}}{}; found {}",
+                if angle {
+                    " or {\"angle\", \"angle_rate\"}"
+                } else {
+                    ""
+                },
+                kind(value)
+            ),
+        ));
+    };
+    f.finish()?;
+    Ok(initial)
+}
