@@ -1,5 +1,7 @@
 //! flicker's integration tests: one binary, one module per behaviour.
 
+mod cli;
 mod event_location;
 mod mechanism_angle;
 mod mechanism_strain;
+mod scenes;

@@ -1,0 +1,332 @@
+//! The `flicker` binary: exit codes, the files a run writes, one-line errors
+//! that name the file and the field, and nothing lost on bad input.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use serde_json::Value;
+
+fn flicker(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_flicker"))
+        .args(args)
+        .output()
+        .expect("the binary runs")
+}
+
+fn scene(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+fn models(name: &str) -> String {
+    format!("{}/models/{name}", env!("CARGO_MANIFEST_DIR"))
+}
+
+fn read_json(path: &Path) -> Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+#[test]
+fn a_run_writes_a_summary_and_a_log_that_agree() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("run");
+    let result = flicker(&[
+        "run",
+        &models("mechanism_impacting.json"),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(
+        result.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&result.stderr)
+    );
+    let summary = read_json(&out.join("summary.json"));
+    for key in [
+        "status",
+        "reason",
+        "events",
+        "events_by_guard",
+        "t_end",
+        "t_reached",
+        "energy_initial",
+        "energy_final",
+        "max_energy_error",
+        "final_state",
+        "zeno",
+        "method",
+        "wall_seconds",
+    ] {
+        assert!(summary.get(key).is_some(), "summary lacks {key}");
+    }
+    assert_eq!(summary["status"], "completed");
+    assert_eq!(summary["method"], "exact");
+    assert_eq!(summary["zeno"], false);
+    assert!(summary["max_energy_error"].as_f64().unwrap() < 1e-14);
+    let log = std::fs::read_to_string(out.join("events.jsonl")).unwrap();
+    let lines: Vec<Value> = log
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(lines.len() as u64, summary["events"].as_u64().unwrap());
+    assert_eq!(summary["events_by_guard"]["impact"], summary["events"]);
+    let mut last = 0.0;
+    for line in &lines {
+        let t = line["t"].as_f64().unwrap();
+        assert!(t >= last);
+        last = t;
+        assert_eq!(line["guard"], "impact");
+        assert_eq!(
+            line["before"]["strain_rate"].as_f64().unwrap(),
+            -line["after"]["strain_rate"].as_f64().unwrap()
+        );
+        let jump = line["energy_after"].as_f64().unwrap() - line["energy_before"].as_f64().unwrap();
+        assert!(jump.abs() < 1e-15);
+    }
+    // The final state is the closed form's (eta 1.2, H0 0.05 from the apex).
+    let m = flicker::models::mechanism::Mechanism {
+        eta: 1.2,
+        omega: 1.0,
+    };
+    let (e0, r0) = m
+        .state_with_energy(0.05, flicker::models::mechanism::Phase::Apex)
+        .unwrap();
+    let (eps, rate) = flicker::models::mechanism::ExactOrbit::new(m, e0, r0).state_at(1000.0);
+    assert!((summary["final_state"]["strain"].as_f64().unwrap() - eps).abs() < 1e-12);
+    assert!((summary["final_state"]["strain_rate"].as_f64().unwrap() - rate).abs() < 1e-12);
+}
+
+#[test]
+fn no_events_and_t_end_flags_are_honoured() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("run");
+    let o = out.to_str().unwrap();
+    let result = flicker(&[
+        "run",
+        &models("mechanism_subcritical.json"),
+        "--out",
+        o,
+        "--no-events",
+        "--t-end",
+        "50",
+    ]);
+    assert_eq!(result.status.code(), Some(0));
+    assert!(!out.join("events.jsonl").exists());
+    let summary = read_json(&out.join("summary.json"));
+    assert_eq!(summary["t_end"], 50.0);
+    assert_eq!(summary["t_reached"], 50.0);
+    assert!(summary["log"].is_null());
+}
+
+#[test]
+fn a_failing_method_exits_3_with_its_reason() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("run");
+    let result = flicker(&[
+        "run",
+        &models("mechanism_angle_plain.json"),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(result.status.code(), Some(3));
+    let summary = read_json(&out.join("summary.json"));
+    assert_eq!(summary["status"], "failed");
+    assert!(
+        summary["reason"]
+            .as_str()
+            .unwrap()
+            .contains("singular at theta = 0")
+    );
+    assert!(summary["t_reached"].as_f64().unwrap() < 100.0);
+}
+
+#[test]
+fn zeno_handled_by_resting_contact_exits_0() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("run");
+    let result = flicker(&[
+        "run",
+        &models("mechanism_chattering.json"),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(result.status.code(), Some(0));
+    let summary = read_json(&out.join("summary.json"));
+    assert_eq!(summary["status"], "zeno");
+    assert_eq!(summary["zeno"], true);
+    assert_eq!(summary["final_mode"], "resting");
+    assert!(summary["reason"].as_str().unwrap().contains("resting"));
+}
+
+#[test]
+fn bad_scenes_exit_2_naming_file_field_and_reason() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = r#""model": "mechanism", "formulation": "strain", "eta": 1.2, "omega": 1.0"#;
+    let good_initial = r#""initial": {"strain": 0.05, "strain_rate": 0.0}"#;
+    let cases: Vec<(&str, String, &str)> = vec![
+        ("malformed", "{\"model\": ".into(), "not valid JSON"),
+        ("unknown_model", r#"{"model": "pendulum"}"#.into(), "field model: unknown model"),
+        ("unknown_key", format!("{{{base}, {good_initial}, \"t_end\": 1, \"colour\": 3}}"), "field colour"),
+        ("missing_t_end", format!("{{{base}, {good_initial}}}"), "field t_end: is missing"),
+        ("nan", format!("{{{base}, {good_initial}, \"t_end\": NaN}}"), "not valid JSON"),
+        ("nan_string", format!("{{{base}, {good_initial}, \"t_end\": \"NaN\"}}"), "field t_end: must be a finite number"),
+        (
+            "omega",
+            format!(r#"{{"model": "mechanism", "formulation": "strain", "eta": 1.2, "omega": 0, {good_initial}, "t_end": 1}}"#),
+            "field omega: must be > 0",
+        ),
+        ("t_end", format!("{{{base}, {good_initial}, \"t_end\": -1}}"), "field t_end: must be > 0"),
+        (
+            "strain",
+            format!("{{{base}, \"initial\": {{\"strain\": -0.1, \"strain_rate\": 0}}, \"t_end\": 1}}"),
+            "field initial.strain: must be >= 0",
+        ),
+        (
+            "energy",
+            format!("{{{base}, \"initial\": {{\"energy\": -1, \"phase\": \"apex\"}}, \"t_end\": 1}}"),
+            "field initial.energy",
+        ),
+        (
+            "formulation",
+            r#"{"model": "mechanism", "formulation": "polar", "eta": 1, "initial": {"strain": 0, "strain_rate": 0}, "t_end": 1}"#.into(),
+            "field formulation",
+        ),
+        ("not_object", "[1, 2]".into(), "must be a JSON object"),
+        ("huge", format!("{{{base}, {good_initial}, \"t_end\": 1e999}}"), "not valid JSON"),
+    ];
+    for (name, text, expected) in cases {
+        let path = scene(dir.path(), &format!("{name}.json"), &text);
+        let out = dir.path().join(format!("out_{name}"));
+        let result = flicker(&[
+            "run",
+            path.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        let stderr = String::from_utf8_lossy(&result.stderr);
+        assert_eq!(result.status.code(), Some(2), "{name}: {stderr}");
+        assert_eq!(stderr.lines().count(), 1, "{name}: one line, got {stderr}");
+        assert!(
+            stderr.contains(&format!("{name}.json")),
+            "{name}: names the file: {stderr}"
+        );
+        assert!(
+            stderr.contains(expected),
+            "{name}: expected {expected:?} in {stderr}"
+        );
+        assert!(!out.exists(), "{name}: bad input must not create outputs");
+    }
+}
+
+#[test]
+fn bad_input_leaves_an_earlier_run_untouched() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("run");
+    let o = out.to_str().unwrap();
+    assert_eq!(
+        flicker(&["run", &models("mechanism_impacting.json"), "--out", o])
+            .status
+            .code(),
+        Some(0)
+    );
+    let before = std::fs::read(out.join("events.jsonl")).unwrap();
+    let bad = scene(dir.path(), "bad.json", r#"{"model": "mechanism"}"#);
+    assert_eq!(
+        flicker(&["run", bad.to_str().unwrap(), "--out", o])
+            .status
+            .code(),
+        Some(2)
+    );
+    assert_eq!(
+        flicker(&[
+            "run",
+            &models("mechanism_impacting.json"),
+            "--out",
+            o,
+            "--t-end",
+            "0"
+        ])
+        .status
+        .code(),
+        Some(2)
+    );
+    assert_eq!(std::fs::read(out.join("events.jsonl")).unwrap(), before);
+}
+
+#[test]
+fn a_missing_scene_file_is_bad_input() {
+    let result = flicker(&["run", "/nonexistent/scene.json"]);
+    assert_eq!(result.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&result.stderr).contains("/nonexistent/scene.json"));
+}
+
+#[test]
+fn events_filters_and_summarises_a_log() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("run");
+    let o = out.to_str().unwrap();
+    flicker(&[
+        "run",
+        &models("mechanism_impacting.json"),
+        "--out",
+        o,
+        "--t-end",
+        "100",
+    ]);
+    let log = out.join("events.jsonl");
+    let l = log.to_str().unwrap();
+    let all = flicker(&["events", l]);
+    assert_eq!(all.status.code(), Some(0));
+    let total = String::from_utf8_lossy(&all.stdout).lines().count();
+    let window = flicker(&[
+        "events", l, "--guard", "impact", "--from", "10", "--to", "50",
+    ]);
+    let kept: Vec<Value> = String::from_utf8_lossy(&window.stdout)
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert!(!kept.is_empty() && kept.len() < total);
+    assert!(
+        kept.iter()
+            .all(|e| (10.0..=50.0).contains(&e["t"].as_f64().unwrap()))
+    );
+    let summary = flicker(&["events", l, "--summary"]);
+    let s: Value = serde_json::from_slice(&summary.stdout).unwrap();
+    assert_eq!(s["events"].as_u64().unwrap() as usize, total);
+    assert_eq!(
+        s["by_guard"]["impact"]["count"].as_u64().unwrap() as usize,
+        total
+    );
+    // Impacts are periodic: every interval equals the closed-form period.
+    let m = flicker::models::mechanism::Mechanism {
+        eta: 1.2,
+        omega: 1.0,
+    };
+    let period = m.impact_period(0.05);
+    for key in ["min", "max"] {
+        assert!((s["intervals"][key].as_f64().unwrap() - period).abs() < 1e-12);
+    }
+    assert!(s["largest_energy_jump"]["jump"].as_f64().unwrap() < 1e-15);
+    assert_eq!(s["out_of_order"], 0);
+    let none = flicker(&["events", l, "--guard", "nothing", "--summary"]);
+    let s: Value = serde_json::from_slice(&none.stdout).unwrap();
+    assert_eq!(s["events"], 0);
+}
+
+#[test]
+fn events_refuses_a_broken_log_naming_the_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = scene(
+        dir.path(),
+        "events.jsonl",
+        "{\"seq\":1,\"t\":1.0,\"guard\":\"impact\",\"energy_before\":1,\"energy_after\":1}\nnot json\n",
+    );
+    let result = flicker(&["events", log.to_str().unwrap()]);
+    assert_eq!(result.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&result.stderr);
+    assert!(stderr.contains("line 2"), "{stderr}");
+    let window = flicker(&["events", log.to_str().unwrap(), "--from", "5", "--to", "1"]);
+    assert_eq!(window.status.code(), Some(2));
+}

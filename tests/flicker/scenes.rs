@@ -1,0 +1,104 @@
+//! Every scene shipped in `models/` loads and runs to the outcome its
+//! description promises, checked against the closed form where one exists.
+
+use std::path::Path;
+
+use flicker::engine::Status;
+use flicker::models::mechanism::{ExactOrbit, Mechanism};
+use flicker::runner::{Report, run};
+use flicker::scene::{self, Formulation, Scene};
+
+/// What each shipped scene must do.
+const EXPECTED: &[(&str, Status)] = &[
+    ("mechanism_angle.json", Status::Completed),
+    ("mechanism_angle_plain.json", Status::Failed),
+    ("mechanism_chattering.json", Status::Zeno),
+    ("mechanism_critical.json", Status::Completed),
+    ("mechanism_impacting.json", Status::Completed),
+    ("mechanism_loose.json", Status::Completed),
+    ("mechanism_near_grazing.json", Status::Completed),
+    ("mechanism_resting.json", Status::Zeno),
+    ("mechanism_separatrix.json", Status::Completed),
+    ("mechanism_subcritical.json", Status::Completed),
+];
+
+fn run_file(path: &Path) -> (Scene, Report) {
+    let scene = scene::load(path).unwrap_or_else(|e| panic!("{e}"));
+    let report = run(&scene, None, &mut ()).unwrap();
+    (scene, report)
+}
+
+#[test]
+fn every_shipped_scene_runs_to_its_expected_outcome() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("models");
+    let mut files: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".json"))
+        .collect();
+    files.sort();
+    let listed: Vec<&str> = EXPECTED.iter().map(|(n, _)| *n).collect();
+    assert_eq!(
+        files, listed,
+        "every scene in models/ needs an expected outcome here"
+    );
+    for (name, status) in EXPECTED {
+        let (scene, report) = run_file(&dir.join(name));
+        let o = &report.outcome;
+        assert_eq!(o.status, *status, "{name}: {:?}", o.reason);
+        let Scene::Mechanism(m) = scene;
+        if o.status == Status::Failed {
+            continue;
+        }
+        assert_eq!(o.t_reached, m.t_end, "{name}");
+        // Exact impact counts and states against the closed form; the
+        // numerical angle formulation to its integration tolerance.
+        let exact = ExactOrbit::new(m.mechanism, m.initial_strain.0, m.initial_strain.1);
+        if o.status == Status::Completed {
+            assert_eq!(o.events, exact.impacts_until(m.t_end), "{name}");
+            let (eps, rate) = exact.state_at(m.t_end);
+            let tol = if m.formulation == Formulation::Strain {
+                1e-11
+            } else {
+                1e-7
+            };
+            let final_state = &report.final_state;
+            assert!(
+                (final_state[0].1 - eps).abs() < tol,
+                "{name}: strain {} vs {eps}",
+                final_state[0].1
+            );
+            assert!(
+                (final_state[1].1 - rate).abs() < tol,
+                "{name}: rate {} vs {rate}",
+                final_state[1].1
+            );
+        }
+        let max_error = o.max_energy_error.unwrap();
+        assert!(
+            max_error
+                < if m.formulation == Formulation::Strain {
+                    1e-14
+                } else {
+                    1e-8
+                },
+            "{name}: {max_error}"
+        );
+    }
+}
+
+#[test]
+fn the_issue_example_scene_parses_as_written() {
+    let text = r#"{"model": "mechanism", "formulation": "strain", "eta": 1.2, "omega": 1.0,
+        "initial": {"strain": 0.05, "strain_rate": 0.0}, "t_end": 1000.0}"#;
+    let Scene::Mechanism(m) = scene::parse(text).unwrap();
+    assert_eq!(
+        m.mechanism,
+        Mechanism {
+            eta: 1.2,
+            omega: 1.0
+        }
+    );
+    assert_eq!(m.initial_strain, (0.05, 0.0));
+}
