@@ -1,5 +1,6 @@
 //! flicker's integration tests: one binary, one module per behaviour.
 
+mod bouncing_ball;
 mod cli;
 mod event_location;
 mod mechanism_angle;

@@ -17,10 +17,10 @@ fn run(m: Mechanism, x0: (f64, f64), t_end: f64) -> flicker::engine::Outcome {
     )
 }
 
-/// A `t_end` half a period after the `n`-th impact, away from any event.
+/// A `t_end` a generic fraction (0.37) of a period after the `n`-th impact.
 fn t_end_after_impacts(m: Mechanism, x0: (f64, f64), n: u64) -> f64 {
     let first = m.time_to_closing(x0.0, x0.1).unwrap();
-    first + (n as f64 - 0.5) * m.impact_period(m.energy(x0.0, x0.1))
+    first + (n as f64 - 0.63) * m.impact_period(m.energy(x0.0, x0.1))
 }
 
 fn check_against_closed_form(m: Mechanism, x0: (f64, f64), impacts: u64, state_tol: f64) {
