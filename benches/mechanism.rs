@@ -56,7 +56,12 @@ fn bare_loop(m: Mechanism, mut eps: f64, mut rate: f64, t_end: f64) -> u64 {
 }
 
 /// Errors of a run of `impacts` impacts against the closed form.
-fn accuracy(model: &dyn Fn(f64) -> (f64, f64, f64, u64), m: Mechanism, x0: [f64; 2], impacts: u64) -> String {
+fn accuracy(
+    model: &dyn Fn(f64) -> (f64, f64, f64, u64),
+    m: Mechanism,
+    x0: [f64; 2],
+    impacts: u64,
+) -> String {
     let exact = ExactOrbit::new(m, x0[0], x0[1]);
     let period = m.impact_period(m.energy(x0[0], x0[1]));
     let t_end = m.time_to_closing(x0[0], x0[1]).unwrap() + (impacts as f64 - 0.63) * period;
@@ -76,18 +81,38 @@ fn accuracy(model: &dyn Fn(f64) -> (f64, f64, f64, u64), m: Mechanism, x0: [f64;
 }
 
 fn main() {
-    let m = Mechanism { eta: 1.2, omega: 1.0 };
+    let m = Mechanism {
+        eta: 1.2,
+        omega: 1.0,
+    };
     let start = [0.5, 0.0];
     let strain_run = |t_end: f64| {
-        let o = simulate(&StrainMechanism { mechanism: m }, FLIGHT, &start, &Options::until(t_end), &mut ());
-        (o.final_state[0], o.final_state[1], o.max_energy_error.unwrap(), o.events)
+        let o = simulate(
+            &StrainMechanism { mechanism: m },
+            FLIGHT,
+            &start,
+            &Options::until(t_end),
+            &mut (),
+        );
+        (
+            o.final_state[0],
+            o.final_state[1],
+            o.max_energy_error.unwrap(),
+            o.events,
+        )
     };
     println!("accuracy against the closed form (eta 1.2, from strain 0.5 at rest)");
     for impacts in [10_000, 1_000_000, 10_000_000] {
-        println!("  strain, exact  {}", accuracy(&strain_run, m, start, impacts));
+        println!(
+            "  strain, exact  {}",
+            accuracy(&strain_run, m, start, impacts)
+        );
     }
     let angle_run = |t_end: f64| {
-        let model = AngleMechanism { mechanism: m, charts: Charts::Switch };
+        let model = AngleMechanism {
+            mechanism: m,
+            charts: Charts::Switch,
+        };
         let (mode, x0) = model.start_from_strain(start[0], start[1]).unwrap();
         let o = simulate(&model, mode, &x0, &Options::until(t_end), &mut ());
         let (eps, rate) = model.strain(o.final_mode, &o.final_state);
@@ -103,8 +128,12 @@ fn main() {
     let strain = StrainMechanism { mechanism: m };
 
     let (bare, n_bare) = median_seconds(|| bare_loop(m, x0[0], x0[1], t_end));
-    let (engine, n_engine) = median_seconds(|| simulate(&strain, FLIGHT, &x0, &Options::until(t_end), &mut ()).events);
-    assert_eq!(n_bare, n_engine, "the bare loop and the engine must make the same impacts");
+    let (engine, n_engine) =
+        median_seconds(|| simulate(&strain, FLIGHT, &x0, &Options::until(t_end), &mut ()).events);
+    assert_eq!(
+        n_bare, n_engine,
+        "the bare loop and the engine must make the same impacts"
+    );
     let log_path = std::env::temp_dir().join("flicker-bench-events.jsonl");
     let (logged, n_logged) = median_seconds(|| {
         let mut writer = JsonlWriter::new(BufWriter::new(File::create(&log_path).unwrap()));
@@ -115,15 +144,36 @@ fn main() {
     let log_bytes = std::fs::metadata(&log_path).map_or(0, |m| m.len());
     let _ = std::fs::remove_file(&log_path);
 
-    let angle = AngleMechanism { mechanism: m, charts: Charts::Switch };
+    let angle = AngleMechanism {
+        mechanism: m,
+        charts: Charts::Switch,
+    };
     let angle_t_end = 1_999.5 * period;
-    let (angle_time, n_angle) =
-        median_seconds(|| simulate(&angle, STRAIN_POSITIVE, &x0, &Options::until(angle_t_end), &mut ()).events);
+    let (angle_time, n_angle) = median_seconds(|| {
+        simulate(
+            &angle,
+            STRAIN_POSITIVE,
+            &x0,
+            &Options::until(angle_t_end),
+            &mut (),
+        )
+        .events
+    });
 
     let rate = |n: u64, s: f64| n as f64 / s;
-    println!("flicker throughput, medians of {REPEATS} runs (eta 1.2, H0 {:.3})", m.energy(x0[0], x0[1]));
-    println!("  bare closed-form loop      {:>12.0} impacts/s", rate(n_bare, bare));
-    println!("  engine, no log             {:>12.0} impacts/s   ({:.2}x the bare loop's time)", rate(n_engine, engine), engine / bare);
+    println!(
+        "flicker throughput, medians of {REPEATS} runs (eta 1.2, H0 {:.3})",
+        m.energy(x0[0], x0[1])
+    );
+    println!(
+        "  bare closed-form loop      {:>12.0} impacts/s",
+        rate(n_bare, bare)
+    );
+    println!(
+        "  engine, no log             {:>12.0} impacts/s   ({:.2}x the bare loop's time)",
+        rate(n_engine, engine),
+        engine / bare
+    );
     println!(
         "  engine, log to disk        {:>12.0} impacts/s   ({:.0} MB/s of JSON Lines)",
         rate(n_logged, logged),

@@ -330,3 +330,45 @@ fn events_refuses_a_broken_log_naming_the_line() {
     let window = flicker(&["events", log.to_str().unwrap(), "--from", "5", "--to", "1"]);
     assert_eq!(window.status.code(), Some(2));
 }
+
+#[test]
+fn an_interrupted_run_keeps_its_log_and_says_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("run");
+    let child = Command::new(env!("CARGO_BIN_EXE_flicker"))
+        .args([
+            "run",
+            &models("mechanism_impacting.json"),
+            "--t-end",
+            "1e12",
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .stdout(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    // Wait until the run is writing, then interrupt it.
+    let log = out.join("events.jsonl");
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(30);
+    while std::fs::metadata(&log).map_or(0, |m| m.len()) == 0
+        && std::time::Instant::now() < deadline
+    {
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let killed = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    let result = child.wait_with_output().unwrap();
+    assert_eq!(result.status.code(), Some(130));
+    let summary = read_json(&out.join("summary.json"));
+    assert_eq!(summary["status"], "interrupted");
+    assert!(summary["t_reached"].as_f64().unwrap() < 1e12);
+    let text = std::fs::read_to_string(&log).unwrap();
+    assert!(text.ends_with('\n'));
+    let lines = text.lines().count() as u64;
+    assert_eq!(lines, summary["events"].as_u64().unwrap());
+    let last: Value = serde_json::from_str(text.lines().last().unwrap()).unwrap();
+    assert_eq!(last["t"], summary["t_reached"]);
+}
