@@ -34,14 +34,19 @@ use crate::engine::model::{Direction, Guard};
 
 /// The earliest `s in [0, 1]` at which `guard` crosses zero in its
 /// direction, where `g(s)` is the guard along the step.
-/// With `check_start`, a guard on or past zero at `s = 0` and moving further
-/// its way fires at `s = 0` (see the module docs).
+///
+/// With `check_start` (a guard that sits on zero at `s = 0` after a reset),
+/// the guard fires at `s = 0` if it moves further its way, and otherwise
+/// counts as being just before zero: a return to zero that comes sooner
+/// than rounding lets the guard rise visibly above it (a reset that barely
+/// turned the motion round) is still a crossing. See the module docs.
 pub fn first_crossing(
     guard: &Guard,
     check_start: bool,
     mut g: impl FnMut(f64) -> f64,
 ) -> Option<f64> {
     let g0 = g(0.0);
+    let start = if check_start { just_before_zero(guard.direction, g0) } else { g0 };
     if guard.affine {
         let samples: [f64; 5] = [g0, g(0.25), g(0.5), g(0.75), g(1.0)];
         let poly = quartic_through(&samples);
@@ -50,10 +55,19 @@ pub fn first_crossing(
         }
         let mut cuts = critical_points(&poly);
         cuts.push(1.0);
-        scan(guard.direction, &cuts, g0, &mut g, &|s| horner(&poly, s))
+        scan(guard.direction, &cuts, start, &mut g, &|s| horner(&poly, s))
     } else {
         let cuts: Vec<f64> = (1..=16).map(|k| k as f64 / 16.0).collect();
-        scan(guard.direction, &cuts, g0, &mut g, &|_| f64::NAN)
+        scan(guard.direction, &cuts, start, &mut g, &|_| f64::NAN)
+    }
+}
+
+/// A value of the guard strictly on the side it crosses from.
+fn just_before_zero(direction: Direction, g0: f64) -> f64 {
+    match direction {
+        Direction::Falling => f64::MIN_POSITIVE,
+        Direction::Rising => -f64::MIN_POSITIVE,
+        Direction::Either => g0,
     }
 }
 
@@ -259,6 +273,17 @@ mod tests {
         assert_eq!(first_crossing(&FALLING, true, |s| -s * s), Some(0.0));
         // Without the start check it has not crossed (it never was before zero).
         assert_eq!(first_crossing(&FALLING, false, |s| -s), None);
+    }
+
+    #[test]
+    fn a_return_to_zero_within_rounding_after_a_reset_still_fires() {
+        // Rate 1e-30 after the reset: the guard's excursion above zero is far
+        // below rounding of the step's samples, yet it must fire near 0.
+        let g = |s: f64| 1e-30 * s - 0.25 * s * s;
+        let root = first_crossing(&FALLING, true, g).unwrap();
+        assert!(root < 1e-10, "root {root}");
+        // Without the start check, a guard never seen above zero has not crossed.
+        assert_eq!(first_crossing(&FALLING, false, |s: f64| -0.25 * s * s), None);
     }
 
     #[test]

@@ -94,6 +94,12 @@ pub(crate) fn validate(mut f: Fields) -> Result<MechanismScene, SceneError> {
             crate::models::mechanism::angle::strain_of_angle(angle, rate)
         }
     };
+    if !(initial_strain.0.is_finite() && initial_strain.1.is_finite()) {
+        return Err(SceneError::field(
+            "initial",
+            format!("gives a strain and rate {initial_strain:?} that overflow; scale the problem down"),
+        ));
+    }
     if formulation == Formulation::Angle(Charts::Plain) && initial_strain.0 == 0.0 {
         return Err(SceneError::field(
             "initial",

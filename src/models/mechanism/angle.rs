@@ -13,6 +13,8 @@
 //! passing `theta = 0` is the crossing `eps = 0` with `eps'` changing sign
 //! and `theta` changing side; above `SWITCH_OUT` it returns to the angle.
 //! The gap between the two thresholds keeps the chart from flickering.
+//! Below the critical load, chattering at `theta = 0` settles into the
+//! `resting` mode, as in the strain formulation.
 
 use crate::engine::{Direction, Flow, Guard, HybridModel, Jump, Mode};
 use crate::models::mechanism::closed_form::Mechanism;
@@ -24,6 +26,8 @@ pub const ANGLE_NEGATIVE: Mode = 1;
 pub const STRAIN_POSITIVE: Mode = 2;
 pub const STRAIN_NEGATIVE: Mode = 3;
 pub const PLAIN: Mode = 4;
+/// Resting contact at `theta = 0` below the critical load, after chattering.
+pub const RESTING: Mode = 5;
 
 /// Strain below which the angle chart hands over to the strain chart.
 pub const SWITCH_IN: f64 = 0.01;
@@ -64,7 +68,7 @@ fn side(mode: Mode) -> f64 {
 }
 
 fn is_strain_chart(mode: Mode) -> bool {
-    mode == STRAIN_POSITIVE || mode == STRAIN_NEGATIVE
+    mode == STRAIN_POSITIVE || mode == STRAIN_NEGATIVE || mode == RESTING
 }
 
 /// `(eps, eps')` from `(theta, theta')`: `eps = sec theta - 1`,
@@ -155,6 +159,7 @@ impl HybridModel for AngleMechanism {
             ANGLE_NEGATIVE => "angle_chart_negative",
             STRAIN_POSITIVE => "strain_chart_positive",
             STRAIN_NEGATIVE => "strain_chart_negative",
+            RESTING => "resting",
             _ => "angle",
         }
     }
@@ -175,8 +180,8 @@ impl HybridModel for AngleMechanism {
         }
     }
 
-    fn flow(&self, _: Mode) -> Flow {
-        Flow::Ode
+    fn flow(&self, mode: Mode) -> Flow {
+        if mode == RESTING { Flow::Frozen } else { Flow::Ode }
     }
 
     fn rhs(&self, mode: Mode, x: &[f64], dx: &mut [f64]) {
@@ -231,6 +236,13 @@ impl HybridModel for AngleMechanism {
 
     fn energy_scale(&self, initial_energy: f64) -> f64 {
         self.mechanism.energy_scale(initial_energy)
+    }
+
+    fn settle(&self, mode: Mode, _: usize, x: &mut [f64]) -> Option<Mode> {
+        (self.mechanism.eta < 1.0 && is_strain_chart(mode)).then(|| {
+            x.copy_from_slice(&[0.0, 0.0]);
+            RESTING
+        })
     }
 
     fn diagnose(&self, mode: Mode, x: &[f64]) -> Option<String> {
