@@ -46,7 +46,11 @@ pub fn first_crossing(
     mut g: impl FnMut(f64) -> f64,
 ) -> Option<f64> {
     let g0 = g(0.0);
-    let start = if check_start { just_before_zero(guard.direction, g0) } else { g0 };
+    let start = if check_start {
+        just_before_zero(guard.direction, g0)
+    } else {
+        g0
+    };
     if guard.affine {
         let samples: [f64; 5] = [g0, g(0.25), g(0.5), g(0.75), g(1.0)];
         let poly = quartic_through(&samples);
@@ -283,7 +287,10 @@ mod tests {
         let root = first_crossing(&FALLING, true, g).unwrap();
         assert!(root < 1e-10, "root {root}");
         // Without the start check, a guard never seen above zero has not crossed.
-        assert_eq!(first_crossing(&FALLING, false, |s: f64| -0.25 * s * s), None);
+        assert_eq!(
+            first_crossing(&FALLING, false, |s: f64| -0.25 * s * s),
+            None
+        );
     }
 
     #[test]

@@ -154,6 +154,9 @@ struct Run<'m, M: HybridModel + ?Sized> {
     /// Set once the run has settled a Zeno accumulation and gone on.
     zeno_reason: Option<String>,
     settles: u64,
+    /// The event count at which to check the budget next, and the count
+    /// and time at the previous check.
+    budget_check: (u64, u64, Time),
     before: Vec<f64>,
     after: Vec<f64>,
     events: u64,
@@ -182,6 +185,7 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
             zeno: ZenoWatch::new(options.t_end),
             zeno_reason: None,
             settles: 0,
+            budget_check: (BUDGET_CHECK.min(options.max_events), 0, Time::new(0.0)),
             before: vec![0.0; n],
             after: vec![0.0; n],
             events: 0,
@@ -231,14 +235,34 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
             if let Err(end) = result {
                 return end;
             }
-            if self.events >= self.options.max_events {
-                return End::failed(format!(
-                    "event budget spent: {} events by t = {}; raise max_events if the run is meant to be this long",
-                    self.events,
-                    t.value()
-                ));
+            if self.events >= self.budget_check.0 {
+                if let Err(end) = self.check_budget(t) {
+                    return end;
+                }
             }
         }
+    }
+
+    /// Every [`BUDGET_CHECK`] events, project the events still needed to
+    /// reach `t_end` at the recent rate, so that a run that cannot finish
+    /// within `max_events` says so early instead of grinding to the limit.
+    fn check_budget(&mut self, t: Time) -> Result<(), End> {
+        let (_, events_then, t_then) = self.budget_check;
+        let max = self.options.max_events;
+        let rate = (self.events - events_then) as f64 / t.since(t_then);
+        let needed = self.events as f64 + rate * Time::new(self.options.t_end).since(t);
+        if self.events >= max || needed > max as f64 {
+            return Err(End::failed(format!(
+                "event budget: {} events by t = {:e}, and at the recent rate ({rate:.3e} events per unit time) \
+                 reaching t_end = {} needs about {needed:.3e}, more than max_events = {max}; \
+                 raise max_events or shorten t_end",
+                self.events,
+                t.value(),
+                self.options.t_end
+            )));
+        }
+        self.budget_check = ((self.events + BUDGET_CHECK).min(max), self.events, t);
+        Ok(())
     }
 
     /// Fire guard `slot` at time `t`: reset, record, watch for Zeno, re-predict.
@@ -529,6 +553,9 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
         }
     }
 }
+
+/// Events between two projections of the event budget.
+const BUDGET_CHECK: u64 = 1 << 20;
 
 /// The name under which a Zeno settling appears in the log.
 pub const SETTLE: &str = "settle";

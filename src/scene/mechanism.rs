@@ -97,7 +97,9 @@ pub(crate) fn validate(mut f: Fields) -> Result<MechanismScene, SceneError> {
     if !(initial_strain.0.is_finite() && initial_strain.1.is_finite()) {
         return Err(SceneError::field(
             "initial",
-            format!("gives a strain and rate {initial_strain:?} that overflow; scale the problem down"),
+            format!(
+                "gives a strain and rate {initial_strain:?} that overflow; scale the problem down"
+            ),
         ));
     }
     if formulation == Formulation::Angle(Charts::Plain) && initial_strain.0 == 0.0 {

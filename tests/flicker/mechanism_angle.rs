@@ -89,17 +89,33 @@ fn chattering_in_the_angle_formulation_settles_instead_of_sinking() {
     // H0 = 1e-40 below critical load: impacts ~1e-20 apart, far below what
     // the integrator's steps resolve. The run must recognise it, never let
     // the strain go negative, and rest at theta = 0.
-    let m = Mechanism { eta: 0.5, omega: 1.0 };
-    let model = AngleMechanism { mechanism: m, charts: Charts::Switch };
+    let m = Mechanism {
+        eta: 0.5,
+        omega: 1.0,
+    };
+    let model = AngleMechanism {
+        mechanism: m,
+        charts: Charts::Switch,
+    };
     for energy in [1e-40, 0.0] {
-        let (eps, rate) = m.state_with_energy(energy, flicker::models::mechanism::Phase::Impact).unwrap();
+        let (eps, rate) = m
+            .state_with_energy(energy, flicker::models::mechanism::Phase::Impact)
+            .unwrap();
         let (mode, x0) = model.start_from_strain(eps, rate).unwrap();
         let mut log = Recorder::default();
         let outcome = simulate(&model, mode, &x0, &Options::until(10.0), &mut log);
-        assert_eq!(outcome.status, Status::Zeno, "H0 = {energy}: {:?}", outcome.reason);
+        assert_eq!(
+            outcome.status,
+            Status::Zeno,
+            "H0 = {energy}: {:?}",
+            outcome.reason
+        );
         assert_eq!(outcome.final_mode_name, "resting");
         assert_eq!(outcome.final_state, vec![0.0, 0.0]);
         assert_eq!(outcome.t_reached, 10.0);
-        assert!(log.events.iter().all(|e| e.before[0] > -1e-15), "the strain went below zero");
+        assert!(
+            log.events.iter().all(|e| e.before[0] > -1e-15),
+            "the strain went below zero"
+        );
     }
 }

@@ -205,3 +205,44 @@ fn resolvable_chattering_is_run_out_exactly() {
     );
     assert!(outcome.events > 500_000);
 }
+
+#[test]
+fn a_run_that_cannot_finish_within_its_event_budget_says_so_early() {
+    // Chattering just below critical load: resolvable impacts ~3e-6 apart,
+    // ~3e11 of them to t_end. The projection must stop it long before.
+    let m = Mechanism {
+        eta: 0.999_999_999,
+        omega: 1.0,
+    };
+    let x0 = m.state_with_energy(1e-30, Phase::Apex).unwrap();
+    let mut options = Options::until(1e6);
+    options.max_events = 100_000_000;
+    let outcome = simulate(
+        &StrainMechanism { mechanism: m },
+        FLIGHT,
+        &[x0.0, x0.1],
+        &options,
+        &mut (),
+    );
+    assert_eq!(outcome.status, Status::Failed);
+    assert!(
+        outcome.reason.as_deref().unwrap().contains("max_events"),
+        "{:?}",
+        outcome.reason
+    );
+    assert!(
+        outcome.events <= 1 << 21,
+        "stopped only after {} events",
+        outcome.events
+    );
+    // A small budget is a hard limit too.
+    options.max_events = 1000;
+    let outcome = simulate(
+        &StrainMechanism { mechanism: m },
+        FLIGHT,
+        &[x0.0, x0.1],
+        &options,
+        &mut (),
+    );
+    assert_eq!((outcome.status, outcome.events), (Status::Failed, 1000));
+}

@@ -181,7 +181,11 @@ impl HybridModel for AngleMechanism {
     }
 
     fn flow(&self, mode: Mode) -> Flow {
-        if mode == RESTING { Flow::Frozen } else { Flow::Ode }
+        if mode == RESTING {
+            Flow::Frozen
+        } else {
+            Flow::Ode
+        }
     }
 
     fn rhs(&self, mode: Mode, x: &[f64], dx: &mut [f64]) {
