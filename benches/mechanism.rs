@@ -46,9 +46,8 @@ fn bare_loop(m: Mechanism, mut eps: f64, mut rate: f64, t_end: f64) -> u64 {
             break;
         }
         t += tau;
-        (eps, rate) = m.flow(eps, rate, tau);
+        rate = -m.flow(eps, rate, tau).1;
         eps = 0.0;
-        rate = -rate;
         impacts += 1;
     }
     black_box((eps, rate));

@@ -72,7 +72,7 @@ impl HybridModel for BouncingBall {
 
     fn reset(&self, mode: Mode, _: usize, x: &mut [f64]) -> Jump {
         x[0] = 0.0;
-        x[1] = -self.restitution * x[1];
+        x[1] *= -self.restitution;
         Jump::to(mode)
     }
 

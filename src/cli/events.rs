@@ -15,12 +15,12 @@ pub fn events(log: &Path, filter: Filter, summarise: bool) -> Result<Code, Failu
             return Err(Failure::bad_input(format!("{flag}: must be a finite time")));
         }
     }
-    if let (Some(from), Some(to)) = (filter.from, filter.to) {
-        if from > to {
-            return Err(Failure::bad_input(format!(
-                "--from {from} is after --to {to}"
-            )));
-        }
+    if let (Some(from), Some(to)) = (filter.from, filter.to)
+        && from > to
+    {
+        return Err(Failure::bad_input(format!(
+            "--from {from} is after --to {to}"
+        )));
     }
     let mut summary = Summary::default();
     let stdout = io::stdout();

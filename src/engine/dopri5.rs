@@ -8,6 +8,9 @@
 //! the tableau are not needed. Coefficients from Hairer, Norsett and Wanner,
 //! "Solving Ordinary Differential Equations I", and their code DOPRI5.
 
+// Stage sums read several arrays at one index: an index loop says it plainly.
+#![allow(clippy::needless_range_loop)]
+
 use crate::engine::model::{HybridModel, Mode};
 
 const A21: f64 = 1.0 / 5.0;

@@ -235,10 +235,10 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
             if let Err(end) = result {
                 return end;
             }
-            if self.events >= self.budget_check.0 {
-                if let Err(end) = self.check_budget(t) {
-                    return end;
-                }
+            if self.events >= self.budget_check.0
+                && let Err(end) = self.check_budget(t)
+            {
+                return end;
             }
         }
     }
@@ -307,7 +307,9 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
             }
             _ => {
                 self.stepper.restart();
-                self.fresh = moved.then_some(Some(slot));
+                // A guard index names the same guard only within one mode.
+                let fired = (jump.mode == mode).then_some(slot);
+                self.fresh = moved.then_some(fired);
                 self.start_segment()
             }
         }

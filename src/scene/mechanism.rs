@@ -142,13 +142,13 @@ fn tolerances(value: &serde_json::Value) -> Result<Tolerances, SceneError> {
     };
     let rtol = positive(&mut f, "rtol", default.rtol)?;
     let atol = positive(&mut f, "atol", default.atol)?;
-    if let Some(method) = f.optional_string("method")? {
-        if method != "dopri5" {
-            return Err(SceneError::field(
-                "solver.method",
-                format!("must be \"dopri5\" for the angle formulation (got {method:?})"),
-            ));
-        }
+    if let Some(method) = f.optional_string("method")?
+        && method != "dopri5"
+    {
+        return Err(SceneError::field(
+            "solver.method",
+            format!("must be \"dopri5\" for the angle formulation (got {method:?})"),
+        ));
     }
     f.finish()?;
     Ok(Tolerances { rtol, atol })
