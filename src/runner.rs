@@ -4,7 +4,7 @@
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
-use crate::engine::{Observer, Options, Outcome, simulate};
+use crate::engine::{Method, Observer, Options, Outcome, simulate};
 use crate::models::mechanism::strain::FLIGHT;
 use crate::models::mechanism::{AngleMechanism, Charts, StrainMechanism};
 use crate::scene::{Formulation, Initial, MechanismScene, Scene, SceneError};
@@ -40,6 +40,7 @@ fn run_mechanism(
     let options = Options {
         t_end: scene.t_end,
         max_events: scene.max_events,
+        method: scene.method,
         tolerances: scene.tolerances,
         stop,
     };
@@ -55,11 +56,25 @@ fn run_mechanism(
                 .into_iter()
                 .zip(outcome.final_state.iter().copied())
                 .collect();
+            let (method, description) = match scene.method {
+                Method::Auto | Method::Exact => (
+                    "exact",
+                    "strain formulation: closed-form flow (46) between impacts, impact times in closed form".to_string(),
+                ),
+                Method::Linear => (
+                    "linear",
+                    "strain formulation: exact linear propagator (matrix exponential), impacts located on it".into(),
+                ),
+                Method::Dopri5(tol) => (
+                    "dopri5",
+                    format!("strain formulation: Dormand-Prince 5(4), rtol {:e}, atol {:e}", tol.rtol, tol.atol),
+                ),
+                Method::Verlet { step } => ("verlet", format!("strain formulation: Stormer-Verlet, step {step:e}")),
+            };
             Ok(Report {
                 outcome,
-                method: "exact",
-                description: "strain formulation: closed-form flow (46) between impacts, impact times in closed form"
-                    .into(),
+                method,
+                description,
                 final_state,
             })
         }

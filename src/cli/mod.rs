@@ -8,6 +8,8 @@ use std::path::PathBuf;
 
 use clap::{Parser, Subcommand};
 
+use flicker::scene::solver::SolverSpec;
+
 use crate::cli::exit::{Code, Failure};
 
 #[derive(Debug, Parser)]
@@ -36,6 +38,8 @@ enum Command {
         /// Do not write the event log.
         #[arg(long = "no-events")]
         no_events: bool,
+        #[command(flatten)]
+        solver: SolverFlags,
     },
     /// Filter or summarise an event log.
     Events {
@@ -56,6 +60,35 @@ enum Command {
     },
 }
 
+/// Flags that override a scene's `solver`.
+#[derive(Debug, clap::Args)]
+pub struct SolverFlags {
+    /// Method: exact, linear, dopri5 or verlet (default: the scene's, else
+    /// the cheapest exact description of the model).
+    #[arg(long, value_name = "M")]
+    method: Option<String>,
+    /// Relative tolerance (dopri5).
+    #[arg(long, value_name = "R", allow_negative_numbers = true)]
+    rtol: Option<f64>,
+    /// Absolute tolerance (dopri5).
+    #[arg(long, value_name = "A", allow_negative_numbers = true)]
+    atol: Option<f64>,
+    /// Fixed step (verlet).
+    #[arg(long, value_name = "H", allow_negative_numbers = true)]
+    step: Option<f64>,
+}
+
+impl SolverFlags {
+    fn spec(self) -> SolverSpec {
+        SolverSpec {
+            method: self.method,
+            rtol: self.rtol,
+            atol: self.atol,
+            step: self.step,
+        }
+    }
+}
+
 pub fn dispatch(cli: Cli) -> Result<Code, Failure> {
     match cli.command {
         Command::Run {
@@ -63,7 +96,8 @@ pub fn dispatch(cli: Cli) -> Result<Code, Failure> {
             out,
             t_end,
             no_events,
-        } => run::run(&scene, out, t_end, !no_events),
+            solver,
+        } => run::run(&scene, out, t_end, solver.spec(), !no_events),
         Command::Events {
             log,
             guard,

@@ -11,6 +11,7 @@ use flicker::engine::Status;
 use flicker::log::JsonlWriter;
 use flicker::log::summary::{summary, write_atomically};
 use flicker::runner::{Report, run as run_scene};
+use flicker::scene::solver::SolverSpec;
 use flicker::scene::{self, Scene};
 
 use crate::cli::exit::{Code, Failure};
@@ -19,6 +20,7 @@ pub fn run(
     scene_path: &Path,
     out: Option<PathBuf>,
     t_end: Option<f64>,
+    solver: SolverSpec,
     log_events: bool,
 ) -> Result<Code, Failure> {
     // Everything is checked before any file is touched: bad input loses nothing.
@@ -27,6 +29,14 @@ pub fn run(
         scene
             .set_t_end(t)
             .map_err(|e| Failure::bad_input(format!("--t-end: {}", e.reason)))?;
+    }
+    if solver != SolverSpec::default() {
+        scene.override_solver(&solver).map_err(|e| {
+            Failure::bad_input(format!(
+                "--method/--rtol/--atol/--step: {}",
+                e.in_path(scene_path)
+            ))
+        })?;
     }
     let out = out.unwrap_or_else(|| default_out(scene_path));
     std::fs::create_dir_all(&out).map_err(|e| {

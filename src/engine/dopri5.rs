@@ -72,6 +72,8 @@ pub enum StepFailure {
     Collapsed { h: f64 },
     /// The right-hand side returned a non-finite value.
     NonFinite,
+    /// The method cannot integrate this mode (said why).
+    NotApplicable(String),
 }
 
 /// The dense output of one accepted step, as a function of `tau in [0, h]`.

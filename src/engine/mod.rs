@@ -3,14 +3,18 @@
 //! and the loop ([`simulation`]).
 
 pub mod dopri5;
+pub mod integrator;
+pub mod linear;
 pub mod locate;
 pub mod model;
 pub mod observer;
 pub mod queue;
 pub mod simulation;
+pub mod verlet;
 pub mod zeno;
 
 pub use dopri5::Tolerances;
+pub use integrator::Method;
 pub use model::{Affects, Direction, Flow, Guard, HybridModel, Jump, Mode};
 pub use observer::{EventRecord, Observer, RecordedEvent, Recorder};
 pub use simulation::{Options, Outcome, Status, simulate};

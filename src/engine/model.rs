@@ -8,6 +8,8 @@
 //!
 //! [`Simulation`]: crate::engine::Simulation
 
+use nalgebra::{DMatrix, DVector};
+
 /// Index of a discrete mode. Models name their modes with [`HybridModel::mode_name`].
 pub type Mode = usize;
 
@@ -137,6 +139,27 @@ pub trait HybridModel {
     fn rhs(&self, mode: Mode, x: &[f64], dx: &mut [f64]) {
         let _ = (x, dx);
         unreachable!("mode {} declares no ODE", self.mode_name(mode))
+    }
+
+    /// Whether [`rhs`](HybridModel::rhs) is implemented for `mode`, so that
+    /// a numerical method can integrate it (also when its natural flow is
+    /// exact, to compare methods).
+    fn has_rhs(&self, mode: Mode) -> bool {
+        self.flow(mode) == Flow::Ode
+    }
+
+    /// Whether the state in `mode` is `[q; v]` with `q' = v` and `v' = a(q)`
+    /// independent of `v`: what Stormer-Verlet needs.
+    fn second_order(&self, mode: Mode) -> bool {
+        let _ = mode;
+        false
+    }
+
+    /// `(A, b)` if the flow in `mode` is linear, `x' = A x + b`: what the
+    /// exact linear propagator needs.
+    fn linear(&self, mode: Mode) -> Option<(DMatrix<f64>, DVector<f64>)> {
+        let _ = mode;
+        None
     }
 
     /// The exact flow map of a [`Flow::Exact`] mode: `x` is the state

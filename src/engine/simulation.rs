@@ -21,9 +21,10 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
-use crate::engine::dopri5::{Dopri5, StepFailure, Tolerances};
+use crate::engine::dopri5::{StepFailure, Tolerances};
+use crate::engine::integrator::{Integrator, Method, Motion, motion};
 use crate::engine::locate::first_crossing;
-use crate::engine::model::{Affects, Flow, HybridModel, Mode};
+use crate::engine::model::{Affects, HybridModel, Mode};
 use crate::engine::observer::{EventRecord, Observer};
 use crate::engine::queue::EventQueue;
 use crate::engine::zeno::ZenoWatch;
@@ -37,7 +38,11 @@ pub struct Options {
     /// Stop with `failed` after this many events (guards against runs that
     /// would take forever without being Zeno).
     pub max_events: u64,
-    /// Tolerances of the ODE integrator, for modes with [`Flow::Ode`].
+    /// How to advance the flows ([`Method::Auto`]: each mode's cheapest
+    /// exact description).
+    pub method: Method,
+    /// Tolerances of Dormand-Prince where [`Method::Auto`] needs it (modes
+    /// whose only flow is an ODE).
     pub tolerances: Tolerances,
     /// Set from outside (a signal handler) to stop the run cleanly.
     pub stop: Option<Arc<AtomicBool>>,
@@ -49,6 +54,7 @@ impl Options {
         Options {
             t_end,
             max_events: 1_000_000_000,
+            method: Method::Auto,
             tolerances: Tolerances::default(),
             stop: None,
         }
@@ -101,7 +107,9 @@ pub struct Outcome {
     pub final_state_names: Vec<&'static str>,
     pub final_state: Vec<f64>,
     /// Right-hand-side evaluations of numerical flows.
-    pub rhs_evaluations: u64,
+    /// Evaluations of the flow: right-hand sides and propagators of
+    /// numerical methods, flow maps and crossing times of exact ones.
+    pub flow_evaluations: u64,
     pub wall_seconds: f64,
 }
 
@@ -143,8 +151,12 @@ struct Run<'m, M: HybridModel + ?Sized> {
     origin: Time,
     state: Vec<f64>,
     queue: EventQueue,
-    stepper: Dopri5,
-    /// Whether the stepper's dense output belongs to the current origin.
+    integrator: Integrator,
+    /// How the current mode moves under the run's method.
+    motion: Motion,
+    /// Flow maps and crossing times asked of exact flows.
+    exact_evaluations: u64,
+    /// Whether the integrator's last step starts at the current origin.
     stepped: bool,
     /// After `t = 0`, a mode change or a reset that moved the state, guards
     /// sitting on zero are checked for firing at once: every guard that is
@@ -179,7 +191,9 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
             origin: Time::new(0.0),
             state: x0.to_vec(),
             queue: EventQueue::default(),
-            stepper: Dopri5::new(n, options.tolerances),
+            integrator: Integrator::for_method(options.method, n, options.tolerances),
+            motion: Motion::Frozen,
+            exact_evaluations: 0,
             stepped: false,
             fresh: Some(None),
             zeno: ZenoWatch::new(options.t_end),
@@ -226,7 +240,7 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
             self.queue.pop();
             let model = self.model;
             let result = if slot == model.guards(self.mode).len() {
-                self.stepper.dense().end(&mut self.state);
+                self.integrator.end(&mut self.state);
                 self.origin = t;
                 self.start_segment()
             } else {
@@ -301,12 +315,12 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
         if !guard.internal && self.zeno.observe(mode, slot, t) {
             return self.settle(slot, guard.name, t, observer);
         }
-        match (model.flow(jump.mode), jump.affects) {
-            (Flow::Exact, Affects::Range { first, count }) if jump.mode == mode => {
+        match (self.motion, jump.affects) {
+            (Motion::Exact, Affects::Range { first, count }) if jump.mode == mode => {
                 (first..first + count).try_for_each(|g| self.predict_exact(g))
             }
             _ => {
-                self.stepper.restart();
+                self.integrator.restart();
                 // A guard index names the same guard only within one mode.
                 let fired = (jump.mode == mode).then_some(slot);
                 self.fresh = moved.then_some(fired);
@@ -394,7 +408,7 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
             "{what}; settled into `{}`",
             self.model.mode_name(rest)
         ));
-        self.stepper.restart();
+        self.integrator.restart();
         self.fresh = Some(None);
         self.start_segment()
     }
@@ -405,10 +419,16 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
         self.queue.clear();
         let (model, mode) = (self.model, self.mode);
         let guards = model.guards(mode);
-        match model.flow(mode) {
-            Flow::Frozen => Ok(()),
-            Flow::Exact => (0..guards.len()).try_for_each(|g| self.predict_exact(g)),
-            Flow::Ode => {
+        self.motion = motion(model, mode, self.options.method).map_err(|why| {
+            End::failed(format!(
+                "method `{}` cannot run this model: {why}",
+                self.options.method.name()
+            ))
+        })?;
+        match self.motion {
+            Motion::Frozen => Ok(()),
+            Motion::Exact => (0..guards.len()).try_for_each(|g| self.predict_exact(g)),
+            Motion::Stepped => {
                 let t_end = self.options.t_end;
                 let remaining = self.origin.until(t_end);
                 let h_min = 64.0 * f64::EPSILON * self.origin.value().abs().max(t_end);
@@ -418,14 +438,14 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
                 if !self.stepped {
                     return Ok(());
                 }
-                if let Err(failure) = self
-                    .stepper
-                    .step(model, mode, &self.state, remaining, h_min)
+                if let Err(failure) =
+                    self.integrator
+                        .step(model, mode, &self.state, remaining, h_min)
                 {
                     return Err(self.step_failed(failure));
                 }
-                let step = self.stepper.dense();
-                let h = step.h;
+                let step = &self.integrator;
+                let h = step.h();
                 let x = &mut self.before;
                 for (g, guard) in guards.iter().enumerate() {
                     let check_start = fresh.is_some_and(|fired| {
@@ -446,6 +466,7 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
     }
 
     fn predict_exact(&mut self, g: usize) -> Result<(), End> {
+        self.exact_evaluations += 1;
         match self.model.next_crossing(self.mode, g, &self.state) {
             None => {
                 self.queue.cancel(g);
@@ -465,9 +486,16 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
         let t = self.origin.value();
         let what = match failure {
             StepFailure::Collapsed { h } => format!(
-                "the Dormand-Prince step size collapsed to {h:.3e} at t = {t} (state {:?})",
+                "the {} step size collapsed to {h:.3e} at t = {t} (state {:?})",
+                self.integrator.name(),
                 self.state
             ),
+            StepFailure::NotApplicable(why) => {
+                format!(
+                    "method `{}` cannot run this model: {why}",
+                    self.options.method.name()
+                )
+            }
             StepFailure::NonFinite => {
                 format!(
                     "the right-hand side is not finite at t = {t} (state {:?})",
@@ -482,12 +510,14 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
     }
 
     /// The state `tau` after `origin`, by the current segment's flow.
-    fn state_at(&self, tau: f64, x: &mut [f64]) {
-        match self.model.flow(self.mode) {
-            Flow::Exact => self.model.advance(self.mode, &self.state, tau, x),
-            Flow::Frozen => x.copy_from_slice(&self.state),
-            Flow::Ode if self.stepped => self.stepper.dense().eval(tau, x),
-            Flow::Ode => x.copy_from_slice(&self.state),
+    fn state_at(&mut self, tau: f64, x: &mut [f64]) {
+        match self.motion {
+            Motion::Exact => {
+                self.exact_evaluations += 1;
+                self.model.advance(self.mode, &self.state, tau, x)
+            }
+            Motion::Stepped if self.stepped => self.integrator.eval(tau, x),
+            Motion::Stepped | Motion::Frozen => x.copy_from_slice(&self.state),
         }
     }
 
@@ -550,7 +580,7 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
             final_mode_name: model.mode_name(run.mode),
             final_state_names: model.state_names(run.mode).to_vec(),
             final_state: run.state,
-            rhs_evaluations: run.stepper.evaluations,
+            flow_evaluations: run.integrator.evaluations() + run.exact_evaluations,
             wall_seconds: run.started.elapsed().as_secs_f64(),
         }
     }

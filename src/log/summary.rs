@@ -5,7 +5,7 @@
 //! `scene`, `events`, `events_by_guard`, `t_end`, `t_reached`,
 //! `energy_initial`, `energy_final`, `max_energy_error` (relative, against
 //! the model's energy scale), `final_state` (named components), `final_mode`,
-//! `zeno`, `rhs_evaluations`, `wall_seconds`, `log` (path of the event log or
+//! `zeno`, `flow_evaluations`, `wall_seconds`, `log` (path of the event log or
 //! null).
 
 use std::io;
@@ -40,7 +40,7 @@ pub fn summary(report: &Report, model: &str, scene: &Path, log: Option<&Path>) -
         "final_state": final_state,
         "final_mode": o.final_mode_name,
         "zeno": o.zeno,
-        "rhs_evaluations": o.rhs_evaluations,
+        "flow_evaluations": o.flow_evaluations,
         "wall_seconds": o.wall_seconds,
         "log": log.map(|p| p.display().to_string()),
     })

@@ -16,15 +16,19 @@
 //! - `t_end > 0`: simulated time.
 //! - optional: `chart` (angle only: `"switch"`, the default, crosses
 //!   `theta = 0` in the strain chart; `"none"` integrates (8) as it is and
-//!   fails there), `solver` (angle only: `{"rtol", "atol"}`), `max_events`
-//!   (event budget, default 10^9), `description` (free text).
+//!   fails there), `solver` (see [`solver`](crate::scene::solver): the
+//!   strain formulation takes `exact` (default), `linear`, `dopri5` and
+//!   `verlet`; the angle formulation `dopri5`, the default, with `rtol` and
+//!   `atol` 1e-12 unless given), `max_events` (event budget, default 10^9),
+//!   `description` (free text).
 
 use std::f64::consts::FRAC_PI_2;
 
-use crate::engine::Tolerances;
+use crate::engine::{Method, Tolerances};
 use crate::models::mechanism::{Charts, Mechanism, Phase};
 use crate::scene::SceneError;
 use crate::scene::fields::{Fields, kind};
+use crate::scene::solver::SolverSpec;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Formulation {
@@ -48,6 +52,9 @@ pub struct MechanismScene {
     /// The initial `(eps, eps')`, resolved from `initial`.
     pub initial_strain: (f64, f64),
     pub t_end: f64,
+    /// The solver as written (the command line may override parts of it).
+    pub solver: SolverSpec,
+    pub method: Method,
     pub tolerances: Tolerances,
     pub max_events: u64,
     pub description: Option<String>,
@@ -73,17 +80,12 @@ pub(crate) fn validate(mut f: Fields) -> Result<MechanismScene, SceneError> {
             ));
         }
     };
-    let tolerances = match f.optional("solver") {
-        Some(_) if !angle => {
-            return Err(SceneError::field(
-                "solver",
-                "applies to the angle formulation only; the strain formulation uses its exact flow"
-                    .into(),
-            ));
-        }
-        Some(solver) => tolerances(solver)?,
-        None => Tolerances::default(),
-    };
+    let solver = f
+        .optional("solver")
+        .map(SolverSpec::from_json)
+        .transpose()?
+        .unwrap_or_default();
+    let (method, tolerances) = resolve_solver(&solver, formulation)?;
     let initial = initial(f.required("initial")?, mechanism, angle)?;
     let initial_strain = match initial {
         Initial::Strain { strain, rate } => (strain, rate),
@@ -116,6 +118,8 @@ pub(crate) fn validate(mut f: Fields) -> Result<MechanismScene, SceneError> {
         initial,
         initial_strain,
         t_end,
+        solver,
+        method,
         tolerances,
         max_events,
         description,
@@ -133,25 +137,25 @@ fn charts(f: &mut Fields) -> Result<Charts, SceneError> {
     }
 }
 
-fn tolerances(value: &serde_json::Value) -> Result<Tolerances, SceneError> {
-    let mut f = Fields::open(value, "solver")?;
-    let default = Tolerances::default();
-    let positive = |f: &mut Fields, key, default| -> Result<f64, SceneError> {
-        let x = f.optional_number(key)?.unwrap_or(default);
-        f.check(key, x, "> 0", |x| x > 0.0)
+/// The method and tolerances of `spec`, checked against the formulation.
+pub fn resolve_solver(
+    spec: &SolverSpec,
+    formulation: Formulation,
+) -> Result<(Method, Tolerances), SceneError> {
+    let (method, tolerances) = spec.resolve()?;
+    let refused = match (formulation, method) {
+        (Formulation::Angle(_), Method::Exact | Method::Linear) => {
+            Some("the angle formulation (8) has no closed form and is not linear; use \"dopri5\"")
+        }
+        (Formulation::Angle(_), Method::Verlet { .. }) => Some(
+            "the angle formulation's acceleration depends on the angle rate, which Stormer-Verlet cannot take; use \"dopri5\"",
+        ),
+        _ => None,
     };
-    let rtol = positive(&mut f, "rtol", default.rtol)?;
-    let atol = positive(&mut f, "atol", default.atol)?;
-    if let Some(method) = f.optional_string("method")?
-        && method != "dopri5"
-    {
-        return Err(SceneError::field(
-            "solver.method",
-            format!("must be \"dopri5\" for the angle formulation (got {method:?})"),
-        ));
+    match refused {
+        Some(why) => Err(SceneError::field("solver.method", why.into())),
+        None => Ok((method, tolerances)),
     }
-    f.finish()?;
-    Ok(Tolerances { rtol, atol })
 }
 
 fn initial(

@@ -8,6 +8,7 @@
 
 pub mod fields;
 pub mod mechanism;
+pub mod solver;
 
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -29,6 +30,18 @@ impl Scene {
         match self {
             Scene::Mechanism(m) => m.t_end,
         }
+    }
+
+    /// Override the solver with what the command line gave, checking it.
+    pub fn override_solver(&mut self, flags: &solver::SolverSpec) -> Result<(), SceneError> {
+        match self {
+            Scene::Mechanism(m) => {
+                let spec = m.solver.overridden_by(flags);
+                (m.method, m.tolerances) = mechanism::resolve_solver(&spec, m.formulation)?;
+                m.solver = spec;
+            }
+        }
+        Ok(())
     }
 
     /// Replace `t_end` (from the command line), checking it.

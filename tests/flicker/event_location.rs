@@ -77,7 +77,7 @@ fn a_crossing_in_and_out_within_one_step_is_found() {
     // The test is only meaningful if steps really straddle the crests: the
     // time above the level, 2 acos(0.999) = 0.09 per period, must be far
     // shorter than a typical step.
-    let steps_per_period = outcome.rhs_evaluations as f64 / 6.0 / 20.0;
+    let steps_per_period = outcome.flow_evaluations as f64 / 6.0 / 20.0;
     assert!(
         steps_per_period < 20.0,
         "{steps_per_period} steps per period"

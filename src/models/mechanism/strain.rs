@@ -6,6 +6,11 @@
 //! on the constraint: orbits with small energy chatter against it, and the
 //! engine's Zeno watch hands them to the `resting` mode, where the strain
 //! stays at zero (the load keeps the unit shut, so it never leaves).
+//!
+//! The flight is also offered as an ODE (second order, and linear), so that
+//! every method can run it and be measured against the closed form.
+
+use nalgebra::{DMatrix, DVector};
 
 use crate::engine::{Direction, Flow, Guard, HybridModel, Jump, Mode};
 use crate::models::mechanism::closed_form::Mechanism;
@@ -50,6 +55,31 @@ impl HybridModel for StrainMechanism {
         } else {
             Flow::Exact
         }
+    }
+
+    fn has_rhs(&self, mode: Mode) -> bool {
+        mode == FLIGHT
+    }
+
+    /// The linear oscillator (45), for numerical methods.
+    fn rhs(&self, _: Mode, x: &[f64], dx: &mut [f64]) {
+        let omega = self.mechanism.omega;
+        dx[0] = x[1];
+        dx[1] = -omega * omega * (x[0] - self.mechanism.centre());
+    }
+
+    fn second_order(&self, mode: Mode) -> bool {
+        mode == FLIGHT
+    }
+
+    fn linear(&self, mode: Mode) -> Option<(DMatrix<f64>, DVector<f64>)> {
+        let w2 = self.mechanism.omega.powi(2);
+        (mode == FLIGHT).then(|| {
+            (
+                DMatrix::from_row_slice(2, 2, &[0.0, 1.0, -w2, 0.0]),
+                DVector::from_vec(vec![0.0, w2 * self.mechanism.centre()]),
+            )
+        })
     }
 
     fn advance(&self, _: Mode, x0: &[f64], tau: f64, x: &mut [f64]) {

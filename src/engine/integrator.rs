@@ -1,0 +1,166 @@
+//! The numerical methods behind one interface, and which one a mode gets.
+//!
+//! The event loop asks an [`Integrator`] for one step and for states inside
+//! it; it never asks which method is inside. [`Method`] is the user's choice;
+//! [`Motion`] is what it means for one mode: the model's exact flow, a
+//! frozen state, or steps of the chosen integrator.
+
+use crate::engine::dopri5::{Dopri5, StepFailure, Tolerances};
+use crate::engine::linear::Linear;
+use crate::engine::model::{Flow, HybridModel, Mode};
+use crate::engine::verlet::Verlet;
+
+/// How to advance the flows.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Method {
+    /// The cheapest exact description each mode offers: its closed form
+    /// where it has one, Dormand-Prince otherwise.
+    Auto,
+    /// The model's closed forms only; a mode without one fails.
+    Exact,
+    /// The exact propagator of linear flows.
+    Linear,
+    /// Dormand-Prince 5(4) with these tolerances.
+    Dopri5(Tolerances),
+    /// Stormer-Verlet with this fixed step.
+    Verlet { step: f64 },
+}
+
+impl Method {
+    /// The name used in summaries and `compare.csv`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Method::Auto => "auto",
+            Method::Exact => "exact",
+            Method::Linear => "linear",
+            Method::Dopri5(_) => "dopri5",
+            Method::Verlet { .. } => "verlet",
+        }
+    }
+}
+
+/// How one mode moves under a method.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Motion {
+    Exact,
+    Frozen,
+    Stepped,
+}
+
+/// Decide how `mode` moves under `method`, or say why it cannot.
+pub fn motion<M: HybridModel + ?Sized>(
+    model: &M,
+    mode: Mode,
+    method: Method,
+) -> Result<Motion, String> {
+    let name = model.mode_name(mode);
+    match (model.flow(mode), method) {
+        (Flow::Frozen, _) => Ok(Motion::Frozen),
+        (Flow::Exact, Method::Auto | Method::Exact) => Ok(Motion::Exact),
+        (Flow::Ode, Method::Auto) => Ok(Motion::Stepped),
+        (Flow::Ode, Method::Exact) => Err(format!(
+            "mode `{name}` has no exact flow; choose a numerical method"
+        )),
+        (_, Method::Linear) if model.linear(mode).is_none() => Err(format!(
+            "mode `{name}` is not a linear flow x' = A x + b, so the linear propagator cannot run it"
+        )),
+        (_, Method::Dopri5(_) | Method::Verlet { .. }) if !model.has_rhs(mode) => Err(format!(
+            "mode `{name}` gives no right-hand side to integrate"
+        )),
+        (_, Method::Verlet { .. }) if !model.second_order(mode) => Err(format!(
+            "mode `{name}` is not of the form q'' = a(q) (its acceleration depends on the velocity), which Stormer-Verlet needs"
+        )),
+        _ => Ok(Motion::Stepped),
+    }
+}
+
+/// One numerical method's working state.
+#[derive(Debug, Clone)]
+pub enum Integrator {
+    Dopri5(Dopri5),
+    Verlet(Verlet),
+    Linear(Linear),
+}
+
+impl Integrator {
+    /// The integrator `method` steps with (Dormand-Prince for `Auto` and
+    /// `Exact`, whose non-exact modes need one).
+    pub fn for_method(method: Method, dimension: usize, tolerances: Tolerances) -> Self {
+        match method {
+            Method::Verlet { step } => Integrator::Verlet(Verlet::new(dimension, step)),
+            Method::Linear => Integrator::Linear(Linear::new(dimension)),
+            Method::Dopri5(tol) => Integrator::Dopri5(Dopri5::new(dimension, tol)),
+            Method::Auto | Method::Exact => Integrator::Dopri5(Dopri5::new(dimension, tolerances)),
+        }
+    }
+
+    /// The method's name, for messages.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Integrator::Dopri5(_) => "Dormand-Prince",
+            Integrator::Verlet(_) => "Stormer-Verlet",
+            Integrator::Linear(_) => "linear propagator",
+        }
+    }
+
+    /// Forget the last step (the next starts from a reset state).
+    pub fn restart(&mut self) {
+        match self {
+            Integrator::Dopri5(m) => m.restart(),
+            Integrator::Verlet(m) => m.restart(),
+            Integrator::Linear(m) => m.restart(),
+        }
+    }
+
+    /// Take one step from `y0`, at most `h_max` long.
+    pub fn step<M: HybridModel + ?Sized>(
+        &mut self,
+        model: &M,
+        mode: Mode,
+        y0: &[f64],
+        h_max: f64,
+        h_min: f64,
+    ) -> Result<(), StepFailure> {
+        match self {
+            Integrator::Dopri5(m) => m.step(model, mode, y0, h_max, h_min),
+            Integrator::Verlet(m) => m.step(model, mode, y0, h_max, h_min),
+            Integrator::Linear(m) => m.step(model, mode, y0, h_max, h_min),
+        }
+    }
+
+    /// Length of the last step.
+    pub fn h(&self) -> f64 {
+        match self {
+            Integrator::Dopri5(m) => m.dense().h,
+            Integrator::Verlet(m) => m.h(),
+            Integrator::Linear(m) => m.h(),
+        }
+    }
+
+    /// The state `tau` into the last step.
+    pub fn eval(&self, tau: f64, x: &mut [f64]) {
+        match self {
+            Integrator::Dopri5(m) => m.dense().eval(tau, x),
+            Integrator::Verlet(m) => m.eval(tau, x),
+            Integrator::Linear(m) => m.eval(tau, x),
+        }
+    }
+
+    /// The state at the end of the last step.
+    pub fn end(&self, x: &mut [f64]) {
+        match self {
+            Integrator::Dopri5(m) => m.dense().end(x),
+            Integrator::Verlet(m) => m.end(x),
+            Integrator::Linear(m) => m.end(x),
+        }
+    }
+
+    /// Right-hand-side or propagator evaluations so far.
+    pub fn evaluations(&self) -> u64 {
+        match self {
+            Integrator::Dopri5(m) => m.evaluations,
+            Integrator::Verlet(m) => m.evaluations,
+            Integrator::Linear(m) => m.evaluations(),
+        }
+    }
+}

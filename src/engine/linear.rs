@@ -1,0 +1,111 @@
+//! The exact propagator of a linear flow `x' = A x + b`.
+//!
+//! With the augmented matrix `M = [[A, b], [0, 0]]`, `exp(M tau)` holds both
+//! `exp(A tau)` and `(integral of exp(A s) ds) b`, so one matrix exponential
+//! (nalgebra's scaled Pade) gives the state at any `tau` to round-off.
+//! Steps are bounded so that `|M| h <= 1/2`: within a step the guard is
+//! smooth enough for the polynomial root isolation of
+//! [`locate`](crate::engine::locate) to bracket every crossing, and each
+//! bracket is refined on the exact propagator itself.
+
+use std::cell::Cell;
+
+use nalgebra::{DMatrix, DVector};
+
+use crate::engine::dopri5::StepFailure;
+use crate::engine::model::{HybridModel, Mode};
+
+#[derive(Debug, Clone)]
+pub struct Linear {
+    /// The mode whose `M` is cached.
+    mode: Option<Mode>,
+    augmented: DMatrix<f64>,
+    h_bound: f64,
+    h: f64,
+    y0: DVector<f64>,
+    y1: Vec<f64>,
+    /// Propagator evaluations; a `Cell` because evaluation reads `&self`.
+    evaluations: Cell<u64>,
+}
+
+impl Linear {
+    pub fn new(dimension: usize) -> Self {
+        Linear {
+            mode: None,
+            augmented: DMatrix::zeros(dimension + 1, dimension + 1),
+            h_bound: f64::INFINITY,
+            h: 0.0,
+            y0: DVector::zeros(dimension + 1),
+            y1: vec![0.0; dimension],
+            evaluations: Cell::new(0),
+        }
+    }
+
+    pub fn restart(&mut self) {}
+
+    pub fn h(&self) -> f64 {
+        self.h
+    }
+
+    pub fn step<M: HybridModel + ?Sized>(
+        &mut self,
+        model: &M,
+        mode: Mode,
+        y0: &[f64],
+        h_max: f64,
+        _h_min: f64,
+    ) -> Result<(), StepFailure> {
+        if self.mode != Some(mode) {
+            let Some((a, b)) = model.linear(mode) else {
+                return Err(StepFailure::NotApplicable(format!(
+                    "mode `{}` is not a linear flow x' = A x + b",
+                    model.mode_name(mode)
+                )));
+            };
+            let n = y0.len();
+            self.augmented.fill(0.0);
+            self.augmented.view_mut((0, 0), (n, n)).copy_from(&a);
+            self.augmented.view_mut((0, n), (n, 1)).copy_from(&b);
+            if !self.augmented.iter().all(|x| x.is_finite()) {
+                return Err(StepFailure::NonFinite);
+            }
+            let norm = self
+                .augmented
+                .column_iter()
+                .map(|c| c.lp_norm(1))
+                .fold(0.0, f64::max);
+            self.h_bound = if norm > 0.0 {
+                0.5 / norm
+            } else {
+                f64::INFINITY
+            };
+            self.mode = Some(mode);
+        }
+        self.y0.rows_mut(0, y0.len()).copy_from_slice(y0);
+        self.y0[y0.len()] = 1.0;
+        self.h = self.h_bound.min(h_max);
+        let mut y1 = std::mem::take(&mut self.y1);
+        self.eval(self.h, &mut y1);
+        self.y1 = y1;
+        if self.y1.iter().any(|x| !x.is_finite()) {
+            return Err(StepFailure::NonFinite);
+        }
+        Ok(())
+    }
+
+    /// The exact state `tau` after the step's start.
+    pub fn eval(&self, tau: f64, x: &mut [f64]) {
+        let propagator = (&self.augmented * tau).exp();
+        let y = propagator * &self.y0;
+        x.copy_from_slice(&y.as_slice()[..x.len()]);
+        self.evaluations.set(self.evaluations.get() + 1);
+    }
+
+    pub fn evaluations(&self) -> u64 {
+        self.evaluations.get()
+    }
+
+    pub fn end(&self, x: &mut [f64]) {
+        x.copy_from_slice(&self.y1);
+    }
+}

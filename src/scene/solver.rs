@@ -1,0 +1,163 @@
+//! The `solver` key of a scene, and the command-line flags that override it.
+//!
+//! ```json
+//! "solver": {"method": "dopri5", "rtol": 1e-9, "atol": 1e-9}
+//! "solver": {"method": "verlet", "step": 0.01}
+//! "solver": {"method": "linear"}
+//! "solver": {"method": "exact"}
+//! ```
+//!
+//! Without `method` (or without `solver`) a scene runs the cheapest exact
+//! description its model offers; `rtol` and `atol` then set Dormand-Prince's
+//! tolerances where a model has only an ODE. Each key belongs to its
+//! methods: `step` to `verlet`, `rtol`/`atol` to `dopri5`.
+
+use serde_json::Value;
+
+use crate::engine::{Method, Tolerances};
+use crate::scene::SceneError;
+use crate::scene::fields::Fields;
+
+/// The method names a scene or `--method` may give.
+pub const METHODS: [&str; 4] = ["exact", "linear", "dopri5", "verlet"];
+
+/// The solver as written, before it is checked against the model.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SolverSpec {
+    pub method: Option<String>,
+    pub rtol: Option<f64>,
+    pub atol: Option<f64>,
+    pub step: Option<f64>,
+}
+
+impl SolverSpec {
+    /// Read the `solver` object of a scene.
+    pub fn from_json(value: &Value) -> Result<Self, SceneError> {
+        let mut f = Fields::open(value, "solver")?;
+        let spec = SolverSpec {
+            method: f.optional_string("method")?.map(str::to_string),
+            rtol: f.optional_number("rtol")?,
+            atol: f.optional_number("atol")?,
+            step: f.optional_number("step")?,
+        };
+        f.finish()?;
+        Ok(spec)
+    }
+
+    /// This spec with the fields of `other` that are set taking precedence.
+    pub fn overridden_by(&self, other: &SolverSpec) -> SolverSpec {
+        SolverSpec {
+            method: other.method.clone().or_else(|| self.method.clone()),
+            rtol: other.rtol.or(self.rtol),
+            atol: other.atol.or(self.atol),
+            step: other.step.or(self.step),
+        }
+    }
+
+    /// The method and tolerances this spec asks for.
+    pub fn resolve(&self) -> Result<(Method, Tolerances), SceneError> {
+        let default = Tolerances::default();
+        let positive = |key: &str, x: Option<f64>| match x {
+            Some(x) if !(x.is_finite() && x > 0.0) => Err(SceneError::field(
+                &format!("solver.{key}"),
+                format!("must be a finite number > 0 (got {x})"),
+            )),
+            _ => Ok(x),
+        };
+        let rtol = positive("rtol", self.rtol)?;
+        let atol = positive("atol", self.atol)?;
+        let step = positive("step", self.step)?;
+        let tolerances = Tolerances {
+            rtol: rtol.unwrap_or(default.rtol),
+            atol: atol.unwrap_or(default.atol),
+        };
+        let not_for = |key: &str, method: &str| {
+            SceneError::field(
+                &format!("solver.{key}"),
+                format!("does not apply to method {method:?}"),
+            )
+        };
+        let method = match self.method.as_deref() {
+            None | Some("dopri5") if step.is_some() => {
+                return Err(not_for("step", self.method.as_deref().unwrap_or("auto")));
+            }
+            None => Method::Auto,
+            Some("dopri5") => Method::Dopri5(tolerances),
+            Some(other @ ("verlet" | "linear" | "exact")) if rtol.is_some() || atol.is_some() => {
+                return Err(not_for(if rtol.is_some() { "rtol" } else { "atol" }, other));
+            }
+            Some("verlet") => Method::Verlet {
+                step: step.ok_or_else(|| {
+                    SceneError::field("solver.step", "is required by method \"verlet\"".into())
+                })?,
+            },
+            Some(other @ ("linear" | "exact")) if step.is_some() => {
+                return Err(not_for("step", other));
+            }
+            Some("linear") => Method::Linear,
+            Some("exact") => Method::Exact,
+            Some(other) => {
+                return Err(SceneError::field(
+                    "solver.method",
+                    format!("unknown method {other:?} (known: {})", METHODS.join(", ")),
+                ));
+            }
+        };
+        Ok((method, tolerances))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn spec(method: Option<&str>, rtol: Option<f64>, step: Option<f64>) -> SolverSpec {
+        SolverSpec {
+            method: method.map(str::to_string),
+            rtol,
+            atol: None,
+            step,
+        }
+    }
+
+    #[test]
+    fn resolves_each_method_with_its_own_keys() {
+        assert_eq!(spec(None, None, None).resolve().unwrap().0, Method::Auto);
+        let (m, _) = spec(Some("dopri5"), Some(1e-6), None).resolve().unwrap();
+        assert_eq!(
+            m,
+            Method::Dopri5(Tolerances {
+                rtol: 1e-6,
+                atol: Tolerances::default().atol
+            })
+        );
+        assert_eq!(
+            spec(Some("verlet"), None, Some(0.1)).resolve().unwrap().0,
+            Method::Verlet { step: 0.1 }
+        );
+        assert_eq!(
+            spec(Some("linear"), None, None).resolve().unwrap().0,
+            Method::Linear
+        );
+    }
+
+    #[test]
+    fn refuses_keys_that_belong_to_other_methods() {
+        let message = |s: SolverSpec| s.resolve().unwrap_err().to_string();
+        assert!(message(spec(Some("verlet"), Some(1e-6), Some(0.1))).contains("solver.rtol"));
+        assert!(message(spec(Some("dopri5"), None, Some(0.1))).contains("solver.step"));
+        assert!(message(spec(Some("verlet"), None, None)).contains("is required"));
+        assert!(message(spec(Some("rk4"), None, None)).contains("unknown method"));
+        assert!(message(spec(Some("dopri5"), Some(-1.0), None)).contains("> 0"));
+    }
+
+    #[test]
+    fn later_fields_override_earlier_ones() {
+        let scene = spec(Some("dopri5"), Some(1e-6), None);
+        let flags = spec(None, Some(1e-9), None);
+        assert_eq!(
+            scene.overridden_by(&flags),
+            spec(Some("dopri5"), Some(1e-9), None)
+        );
+    }
+}
