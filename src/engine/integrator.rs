@@ -74,8 +74,10 @@ pub fn motion<M: HybridModel + ?Sized>(
     }
 }
 
-/// One numerical method's working state.
+/// One numerical method's working state. One lives per run, so the size of
+/// the largest variant does not matter.
 #[derive(Debug, Clone)]
+#[allow(clippy::large_enum_variant)]
 pub enum Integrator {
     Dopri5(Dopri5),
     Verlet(Verlet),

@@ -15,8 +15,10 @@ use crate::engine::model::{HybridModel, Mode};
 
 #[derive(Debug, Clone)]
 pub struct Verlet {
+    /// The fixed step; the last step before an event or the end is shorter.
+    step: f64,
+    /// The length of the last step taken.
     h: f64,
-    h_taken: f64,
     y0: Vec<f64>,
     y1: Vec<f64>,
     /// `f` at the start and end of the step (`[v; a]`).
@@ -47,7 +49,7 @@ impl Verlet {
     }
 
     pub fn h(&self) -> f64 {
-        self.h_taken
+        self.h
     }
 
     pub fn step<M: HybridModel + ?Sized>(
@@ -65,7 +67,7 @@ impl Verlet {
             model.rhs(mode, y0, &mut self.f0);
             self.evaluations += 1;
         }
-        let h = self.h.min(h_max);
+        let h = self.step.min(h_max);
         self.y0.copy_from_slice(y0);
         for i in 0..m {
             let v_half = y0[m + i] + 0.5 * h * self.f0[m + i];
@@ -81,7 +83,7 @@ impl Verlet {
         if self.y1.iter().chain(&self.f1).any(|x| !x.is_finite()) {
             return Err(StepFailure::NonFinite);
         }
-        self.h_taken = h;
+        self.h = h;
         self.fsal = true;
         Ok(())
     }
@@ -89,7 +91,7 @@ impl Verlet {
     /// Cubic Hermite interpolation of each component from its values and
     /// rates at the step's ends.
     pub fn eval(&self, tau: f64, x: &mut [f64]) {
-        let h = self.h_taken;
+        let h = self.h;
         let s = tau / h;
         let (h00, h10, h01, h11) = (
             (1.0 + 2.0 * s) * (1.0 - s).powi(2),
