@@ -33,8 +33,8 @@ impl Verlet {
     pub fn new(dimension: usize, h: f64) -> Self {
         let v = || vec![0.0; dimension];
         Verlet {
-            h,
-            h_taken: 0.0,
+            step: h,
+            h: 0.0,
             y0: v(),
             y1: v(),
             f0: v(),
