@@ -99,9 +99,8 @@ impl Verlet {
             s * s * (3.0 - 2.0 * s),
             s * s * (s - 1.0),
         );
-        for i in 0..x.len() {
-            x[i] =
-                h00 * self.y0[i] + h10 * h * self.f0[i] + h01 * self.y1[i] + h11 * h * self.f1[i];
+        for (i, xi) in x.iter_mut().enumerate() {
+            *xi = h00 * self.y0[i] + h10 * h * self.f0[i] + h01 * self.y1[i] + h11 * h * self.f1[i];
         }
     }
 
