@@ -57,6 +57,7 @@
 //! assert!((outcome.final_state[0] - eps).abs() < 1e-12);
 //! ```
 
+pub mod compare;
 pub mod engine;
 pub mod log;
 pub mod models;

@@ -1,5 +1,6 @@
 //! Command-line arguments and their dispatch to subcommands.
 
+pub mod compare;
 pub mod events;
 pub mod exit;
 pub mod run;
@@ -40,6 +41,24 @@ enum Command {
         no_events: bool,
         #[command(flatten)]
         solver: SolverFlags,
+    },
+    /// Run a scene with every method over a range of tolerances or steps and
+    /// measure each against the exact answer: DIR/compare.csv, compare.svg, compare.png.
+    Compare {
+        /// The scene file (JSON).
+        scene: PathBuf,
+        /// Methods, comma-separated (default: every method the model offers).
+        #[arg(long, value_delimiter = ',', value_name = "M,M,..")]
+        methods: Option<Vec<String>>,
+        /// Dormand-Prince tolerances (rtol = atol), comma-separated.
+        #[arg(long, value_delimiter = ',', value_name = "TOL,..")]
+        tolerances: Option<Vec<f64>>,
+        /// Stormer-Verlet steps, comma-separated (default: fractions of the period).
+        #[arg(long, value_delimiter = ',', value_name = "H,..")]
+        steps: Option<Vec<f64>>,
+        /// Output directory (default: out/<scene name>-compare).
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
     },
     /// Filter or summarise an event log.
     Events {
@@ -98,6 +117,13 @@ pub fn dispatch(cli: Cli) -> Result<Code, Failure> {
             no_events,
             solver,
         } => run::run(&scene, out, t_end, solver.spec(), !no_events),
+        Command::Compare {
+            scene,
+            methods,
+            tolerances,
+            steps,
+            out,
+        } => compare::compare(&scene, methods, tolerances, steps, out),
         Command::Events {
             log,
             guard,

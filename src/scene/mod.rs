@@ -32,11 +32,19 @@ impl Scene {
         }
     }
 
-    /// Override the solver with what the command line gave, checking it.
+    /// Override the solver with what the command line gave (the fields it
+    /// sets replace the scene's), checking it.
     pub fn override_solver(&mut self, flags: &solver::SolverSpec) -> Result<(), SceneError> {
+        let spec = match self {
+            Scene::Mechanism(m) => m.solver.overridden_by(flags),
+        };
+        self.set_solver(spec)
+    }
+
+    /// Replace the solver, checking it against the model.
+    pub fn set_solver(&mut self, spec: solver::SolverSpec) -> Result<(), SceneError> {
         match self {
             Scene::Mechanism(m) => {
-                let spec = m.solver.overridden_by(flags);
                 (m.method, m.tolerances) = mechanism::resolve_solver(&spec, m.formulation)?;
                 m.solver = spec;
             }

@@ -2,6 +2,7 @@
 
 mod bouncing_ball;
 mod cli;
+mod compare;
 mod convergence;
 mod engine_generic;
 mod event_location;

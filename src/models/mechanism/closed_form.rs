@@ -156,6 +156,15 @@ impl ExactOrbit {
         }
     }
 
+    /// The impact times in `(0, t]`, each computed from the first impact
+    /// and the period (no accumulated rounding).
+    pub fn impact_times_until(&self, t: f64) -> Vec<f64> {
+        let first = self.first_impact.unwrap_or(f64::INFINITY);
+        (0..self.impacts_until(t))
+            .map(|k| first + k as f64 * self.period)
+            .collect()
+    }
+
     /// `(eps, eps')` at time `t`.
     pub fn state_at(&self, t: f64) -> (f64, f64) {
         let (eps, rate) = self.initial;

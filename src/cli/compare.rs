@@ -1,0 +1,104 @@
+//! `flicker compare`: every method on one scene, measured against the exact
+//! answer; writes `compare.csv`, `compare.svg` and `compare.png`.
+
+use std::path::{Path, PathBuf};
+
+use flicker::compare::{Plan, Row, TOLERANCES, chart, compare as run_compare, write_csv};
+use flicker::scene::solver::METHODS;
+use flicker::scene::{self, Formulation, Scene};
+
+use crate::cli::exit::{Code, Failure};
+
+pub fn compare(
+    scene_path: &Path,
+    methods: Option<Vec<String>>,
+    tolerances: Option<Vec<f64>>,
+    steps: Option<Vec<f64>>,
+    out: Option<PathBuf>,
+) -> Result<Code, Failure> {
+    let scene = scene::load(scene_path).map_err(Failure::bad_input)?;
+    let methods = methods.unwrap_or_else(|| applicable(&scene));
+    if let Some(bad) = methods.iter().find(|m| !METHODS.contains(&m.as_str())) {
+        return Err(Failure::bad_input(format!(
+            "--methods: unknown method {bad:?} (known: {})",
+            METHODS.join(", ")
+        )));
+    }
+    for (flag, values) in [("--tolerances", &tolerances), ("--steps", &steps)] {
+        if values
+            .iter()
+            .flatten()
+            .any(|x| !(x.is_finite() && *x > 0.0))
+        {
+            return Err(Failure::bad_input(format!(
+                "{flag}: every value must be a finite number > 0"
+            )));
+        }
+    }
+    let out = out.unwrap_or_else(|| {
+        let stem = scene_path
+            .file_stem()
+            .map_or_else(|| "scene".into(), |s| s.to_string_lossy().into_owned());
+        Path::new("out").join(format!("{stem}-compare"))
+    });
+    let plan = Plan {
+        methods,
+        tolerances: tolerances.unwrap_or_else(|| TOLERANCES.to_vec()),
+        steps,
+    };
+    eprintln!(
+        "{:<8} {:>9} {:>9} {:>10} {:>10} {:>9} {:>10}  status",
+        "method", "tol", "step", "seconds", "evals", "events", "error"
+    );
+    let (reference, rows) = run_compare(&scene, &plan, &mut |row| eprintln!("{}", line(row)))
+        .map_err(|e| Failure::bad_input(e.in_path(scene_path)))?;
+    std::fs::create_dir_all(&out).map_err(|e| {
+        Failure::bad_input(format!(
+            "{}: cannot create the output directory: {e}",
+            out.display()
+        ))
+    })?;
+    let csv = out.join("compare.csv");
+    write_csv(&rows, &csv).map_err(|e| Failure::untrusted(format!("{}: {e}", csv.display())))?;
+    let title = format!(
+        "work-precision: {}",
+        scene_path.file_stem().unwrap_or_default().to_string_lossy()
+    );
+    let mut written = vec![csv];
+    for chart_file in ["compare.svg", "compare.png"] {
+        let path = out.join(chart_file);
+        chart::draw(&rows, &title, &path)
+            .map_err(|e| Failure::untrusted(format!("{}: {e}", path.display())))?;
+        written.push(path);
+    }
+    println!("reference: {}", reference.kind);
+    let names: Vec<String> = written.iter().map(|p| p.display().to_string()).collect();
+    println!("wrote {}", names.join(", "));
+    Ok(Code::Ok)
+}
+
+/// The methods a scene's model can run.
+fn applicable(scene: &Scene) -> Vec<String> {
+    let names: &[&str] = match scene {
+        Scene::Mechanism(m) if m.formulation == Formulation::Strain => {
+            &["exact", "linear", "dopri5", "verlet"]
+        }
+        Scene::Mechanism(_) => &["dopri5"],
+    };
+    names.iter().map(|s| s.to_string()).collect()
+}
+
+fn line(row: &Row) -> String {
+    let opt = |x: Option<f64>| x.map_or("-".to_string(), |x| format!("{x:.0e}"));
+    format!(
+        "{:<8} {:>9} {:>9} {:>10.3e} {:>10} {:>9} {:>10.2e}  {}",
+        row.method,
+        opt(row.tolerance),
+        opt(row.step),
+        row.wall_seconds,
+        row.flow_evals,
+        row.events,
+        row.final_error,
+        row.status
+    )
+}

@@ -1,0 +1,179 @@
+//! `flicker compare`: one scene, every method over a range of tolerances or
+//! steps, each run measured against the exact answer.
+//!
+//! A row per run: its cost (wall time, the median of a few repeats, and flow
+//! evaluations) beside its errors (final state, event times and energy,
+//! against the [`reference`]). [`chart`] draws error against cost.
+
+pub mod chart;
+pub mod reference;
+
+use std::path::Path;
+use std::time::Instant;
+
+use serde::Serialize;
+
+use crate::engine::{EventRecord, Observer, Status};
+use crate::runner;
+use crate::scene::solver::SolverSpec;
+use crate::scene::{Scene, SceneError};
+pub use reference::Reference;
+
+/// Default Dormand-Prince tolerances (`rtol = atol`).
+pub const TOLERANCES: [f64; 9] = [1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12];
+/// Default Stormer-Verlet steps, as fractions of the period `2 pi / omega`.
+pub const STEP_FRACTIONS: [f64; 6] = [1e-1, 3e-2, 1e-2, 3e-3, 1e-3, 3e-4];
+
+/// One run of one method at one setting.
+#[derive(Debug, Clone, Serialize)]
+pub struct Row {
+    pub method: String,
+    pub tolerance: Option<f64>,
+    pub step: Option<f64>,
+    pub wall_seconds: f64,
+    pub flow_evals: u64,
+    pub events: u64,
+    pub final_error: f64,
+    pub max_event_time_error: Option<f64>,
+    pub energy_error: Option<f64>,
+    /// `completed`, `zeno`, `failed: <reason>` or `events differ: ...`.
+    pub status: String,
+}
+
+/// Which settings to try for each method.
+#[derive(Debug, Clone)]
+pub struct Plan {
+    pub methods: Vec<String>,
+    pub tolerances: Vec<f64>,
+    /// Fixed steps; `None` picks fractions of the scene's period.
+    pub steps: Option<Vec<f64>>,
+}
+
+/// Run every method of `plan` on `scene` and measure it against the reference.
+pub fn compare(
+    scene: &Scene,
+    plan: &Plan,
+    progress: &mut dyn FnMut(&Row),
+) -> Result<(Reference, Vec<Row>), SceneError> {
+    let reference = Reference::of(scene);
+    let mut rows = Vec::new();
+    for method in &plan.methods {
+        let settings: Vec<SolverSpec> = match method.as_str() {
+            "dopri5" => plan
+                .tolerances
+                .iter()
+                .map(|&tol| spec(method, Some(tol), None))
+                .collect(),
+            "verlet" => plan
+                .steps
+                .clone()
+                .unwrap_or_else(|| {
+                    STEP_FRACTIONS
+                        .iter()
+                        .map(|f| f * scene_period(scene))
+                        .collect()
+                })
+                .into_iter()
+                .map(|h| spec(method, None, Some(h)))
+                .collect(),
+            _ => vec![spec(method, None, None)],
+        };
+        for setting in settings {
+            let mut run_scene = scene.clone();
+            run_scene.set_solver(setting.clone())?;
+            let row = measure(&run_scene, &setting, &reference)?;
+            progress(&row);
+            rows.push(row);
+        }
+    }
+    Ok((reference, rows))
+}
+
+/// Write `rows` as CSV to `path`.
+pub fn write_csv(rows: &[Row], path: &Path) -> Result<(), csv::Error> {
+    let mut writer = csv::Writer::from_path(path)?;
+    for row in rows {
+        writer.serialize(row)?;
+    }
+    writer.flush()?;
+    Ok(())
+}
+
+fn spec(method: &str, tolerance: Option<f64>, step: Option<f64>) -> SolverSpec {
+    SolverSpec {
+        method: Some(method.to_string()),
+        rtol: tolerance,
+        atol: tolerance,
+        step,
+    }
+}
+
+/// The natural time scale of a scene: one period of its linear flow.
+fn scene_period(scene: &Scene) -> f64 {
+    match scene {
+        Scene::Mechanism(m) => std::f64::consts::TAU / m.mechanism.omega,
+    }
+}
+
+/// Event times as they happen (resting-contact settles excluded).
+#[derive(Default)]
+struct EventTimes(Vec<f64>);
+
+impl Observer for EventTimes {
+    fn on_event(&mut self, e: &EventRecord) -> std::io::Result<()> {
+        if e.guard != crate::engine::simulation::SETTLE {
+            self.0.push(e.t);
+        }
+        Ok(())
+    }
+}
+
+/// Repeats of a run for its timing: at least 3, and until 50 ms have passed.
+fn measure(scene: &Scene, setting: &SolverSpec, reference: &Reference) -> Result<Row, SceneError> {
+    let mut times = EventTimes::default();
+    let start = Instant::now();
+    let report = runner::run(scene, None, &mut times)?;
+    let mut walls = vec![start.elapsed().as_secs_f64()];
+    while walls.len() < 3 || (walls.iter().sum::<f64>() < 0.05 && walls.len() < 1000) {
+        let start = Instant::now();
+        runner::run(scene, None, &mut ())?;
+        walls.push(start.elapsed().as_secs_f64());
+    }
+    walls.sort_by(f64::total_cmp);
+    let o = &report.outcome;
+    let final_state: Vec<f64> = report.final_state.iter().map(|(_, x)| *x).collect();
+    let final_error = final_state
+        .iter()
+        .zip(&reference.final_state)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    let common = times.0.len().min(reference.event_times.len());
+    let max_event_time_error = (common > 0).then(|| {
+        times.0[..common]
+            .iter()
+            .zip(&reference.event_times)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max)
+    });
+    let status = match (o.status, &o.reason) {
+        (Status::Failed, Some(reason)) => format!("failed: {reason}"),
+        _ if times.0.len() != reference.event_times.len() => format!(
+            "events differ: {} against {} in the reference",
+            times.0.len(),
+            reference.event_times.len()
+        ),
+        (status, _) => status.as_str().to_string(),
+    };
+    Ok(Row {
+        method: report.method.to_string(),
+        tolerance: setting.rtol,
+        step: setting.step,
+        wall_seconds: walls[walls.len() / 2],
+        flow_evals: o.flow_evaluations,
+        events: o.events,
+        final_error,
+        max_event_time_error,
+        energy_error: o.max_energy_error,
+        status,
+    })
+}
