@@ -115,6 +115,10 @@ pub struct Dopri5 {
     dense: DenseStep,
     /// Right-hand-side evaluations so far.
     pub evaluations: u64,
+    /// Largest component of the error estimate of the last trial step.
+    trial_error: f64,
+    /// The same, for the last accepted step.
+    local_error: f64,
 }
 
 impl Dopri5 {
@@ -132,6 +136,8 @@ impl Dopri5 {
                 r: [v(), v(), v(), v(), v()],
             },
             evaluations: 0,
+            trial_error: 0.0,
+            local_error: 0.0,
         }
     }
 
@@ -139,6 +145,12 @@ impl Dopri5 {
     /// not this integrator's last output (after a reset).
     pub fn restart(&mut self) {
         self.fsal = false;
+    }
+
+    /// The embedded error estimate of the last accepted step (largest
+    /// component, absolute): a pessimistic bound on its local error.
+    pub fn local_error(&self) -> f64 {
+        self.local_error
     }
 
     /// The dense output of the last accepted step.
@@ -178,6 +190,7 @@ impl Dopri5 {
             if err <= 1.0 {
                 let grow = (0.9 * err.powf(-0.2)).min(5.0);
                 self.h_next = Some(h * grow.max(1.0));
+                self.local_error = self.trial_error;
                 self.finish(y0, h);
                 return Ok(());
             }
@@ -223,6 +236,7 @@ impl Dopri5 {
         }
         let k = &self.k;
         let mut sum = 0.0;
+        self.trial_error = 0.0;
         for i in 0..y0.len() {
             let e = h
                 * (E1 * k[0][i]
@@ -233,6 +247,7 @@ impl Dopri5 {
                     + E7 * k[6][i]);
             let scale = self.tol.atol + self.tol.rtol * y0[i].abs().max(self.y1[i].abs());
             sum += (e / scale).powi(2);
+            self.trial_error = self.trial_error.max(e.abs());
         }
         if self.y1.iter().any(|v| !v.is_finite()) || k[6].iter().any(|v| !v.is_finite()) {
             return f64::NAN;

@@ -157,6 +157,15 @@ impl Integrator {
         }
     }
 
+    /// An estimate of the last step's local error (largest component).
+    pub fn local_error(&self) -> f64 {
+        match self {
+            Integrator::Dopri5(m) => m.local_error(),
+            Integrator::Verlet(m) => m.local_error(),
+            Integrator::Linear(m) => m.local_error(),
+        }
+    }
+
     /// Right-hand-side or propagator evaluations so far.
     pub fn evaluations(&self) -> u64 {
         match self {

@@ -105,6 +105,11 @@ impl Linear {
         self.evaluations.get()
     }
 
+    /// Round-off of one propagation: a few ulps of the state.
+    pub fn local_error(&self) -> f64 {
+        8.0 * f64::EPSILON * self.y1.iter().fold(1.0, |m: f64, x| m.max(x.abs()))
+    }
+
     pub fn end(&self, x: &mut [f64]) {
         x.copy_from_slice(&self.y1);
     }

@@ -32,37 +32,100 @@
 
 use crate::engine::model::{Direction, Guard};
 
-/// The earliest `s in [0, 1]` at which `guard` crosses zero in its
-/// direction, where `g(s)` is the guard along the step.
+/// What one step says about one guard.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepScan {
+    /// The earliest `s in [0, 1]` at which the guard crosses zero in its
+    /// direction.
+    pub crossing: Option<f64>,
+    /// How clearly the step decides: for a crossing that curves back (a
+    /// graze), the depth its dip would reach, `g'^2 / (2 |g''|)`; without a
+    /// crossing, the smallest height of a turning point still short of zero;
+    /// infinite when nothing comes close or the guard is not affine. A margin
+    /// below the integration error means the method cannot tell a graze from
+    /// a near miss.
+    pub margin: f64,
+}
+
+/// Scan one step for `guard`, where `g(s)` is the guard along the step.
 ///
 /// With `check_start` (a guard that sits on zero at `s = 0` after a reset),
 /// the guard fires at `s = 0` if it moves further its way, and otherwise
 /// counts as being just before zero: a return to zero that comes sooner
 /// than rounding lets the guard rise visibly above it (a reset that barely
 /// turned the motion round) is still a crossing. See the module docs.
-pub fn first_crossing(
-    guard: &Guard,
-    check_start: bool,
-    mut g: impl FnMut(f64) -> f64,
-) -> Option<f64> {
+pub fn scan_step(guard: &Guard, check_start: bool, mut g: impl FnMut(f64) -> f64) -> StepScan {
     let g0 = g(0.0);
     let start = if check_start {
         just_before_zero(guard.direction, g0)
     } else {
         g0
     };
-    if guard.affine {
-        let samples: [f64; 5] = [g0, g(0.25), g(0.5), g(0.75), g(1.0)];
-        let poly = quartic_through(&samples);
-        if check_start && fires_at_start(guard.direction, &poly) {
-            return Some(0.0);
-        }
-        let mut cuts = critical_points(&poly);
-        cuts.push(1.0);
-        scan(guard.direction, &cuts, start, &mut g, &|s| horner(&poly, s))
-    } else {
+    if !guard.affine {
         let cuts: Vec<f64> = (1..=16).map(|k| k as f64 / 16.0).collect();
-        scan(guard.direction, &cuts, start, &mut g, &|_| f64::NAN)
+        let crossing = scan(guard.direction, &cuts, start, &mut g, &|_| f64::NAN);
+        return StepScan {
+            crossing,
+            margin: f64::INFINITY,
+        };
+    }
+    let samples: [f64; 5] = [g0, g(0.25), g(0.5), g(0.75), g(1.0)];
+    let poly = quartic_through(&samples);
+    if check_start && fires_at_start(guard.direction, &poly) {
+        return StepScan {
+            crossing: Some(0.0),
+            margin: f64::INFINITY,
+        };
+    }
+    let turning = critical_points(&poly);
+    let mut cuts = turning.clone();
+    cuts.push(1.0);
+    let crossing = scan(guard.direction, &cuts, start, &mut g, &|s| horner(&poly, s));
+    StepScan {
+        crossing,
+        margin: margin(guard.direction, &poly, crossing, &turning),
+    }
+}
+
+/// The earliest crossing of `guard` in a step (see [`scan_step`]).
+pub fn first_crossing(guard: &Guard, check_start: bool, g: impl FnMut(f64) -> f64) -> Option<f64> {
+    scan_step(guard, check_start, g).crossing
+}
+
+/// See [`StepScan::margin`].
+fn margin(direction: Direction, poly: &[f64; 5], crossing: Option<f64>, turning: &[f64]) -> f64 {
+    // `inward` is the sign of the side a crossing goes to.
+    let inward = match direction {
+        Direction::Falling => -1.0,
+        Direction::Rising => 1.0,
+        Direction::Either => return f64::INFINITY,
+    };
+    let d1: Vec<f64> = poly
+        .iter()
+        .enumerate()
+        .skip(1)
+        .map(|(k, c)| k as f64 * c)
+        .collect();
+    let d2: Vec<f64> = d1
+        .iter()
+        .enumerate()
+        .skip(1)
+        .map(|(k, c)| k as f64 * c)
+        .collect();
+    match crossing {
+        Some(s) => {
+            let (slope, curvature) = (horner(&d1, s), horner(&d2, s));
+            if curvature * inward < 0.0 {
+                slope * slope / (2.0 * curvature.abs())
+            } else {
+                f64::INFINITY
+            }
+        }
+        None => turning
+            .iter()
+            .map(|&s| horner(poly, s) * -inward)
+            .filter(|height| *height > 0.0)
+            .fold(f64::INFINITY, f64::min),
     }
 }
 
@@ -305,6 +368,27 @@ mod tests {
     fn returns_the_side_that_has_crossed() {
         let root = first_crossing(&FALLING, false, |s| 0.3 - s).unwrap();
         assert!(0.3 - root <= 0.0 && 0.3 - root > -1e-15);
+    }
+
+    #[test]
+    fn a_graze_has_a_small_margin_and_an_impact_a_large_one() {
+        // Dips to -1e-6 and back: margin = depth = 1e-6.
+        let graze = scan_step(&FALLING, false, |s| (s - 0.5).powi(2) - 1e-6);
+        assert!(graze.crossing.is_some());
+        assert!(
+            (graze.margin - 1e-6).abs() < 1e-12,
+            "margin {}",
+            graze.margin
+        );
+        // Turns back 1e-6 short of zero: a near miss, margin 1e-6.
+        let miss = scan_step(&FALLING, false, |s| (s - 0.5).powi(2) + 1e-6);
+        assert_eq!(miss.crossing, None);
+        assert!((miss.margin - 1e-6).abs() < 1e-12);
+        // Accelerating through zero: nothing to decide.
+        assert_eq!(
+            scan_step(&FALLING, false, |s| 0.1 - s * s).margin,
+            f64::INFINITY
+        );
     }
 
     #[test]

@@ -23,7 +23,7 @@ use std::time::Instant;
 
 use crate::engine::dopri5::{StepFailure, Tolerances};
 use crate::engine::integrator::{Integrator, Method, Motion, motion};
-use crate::engine::locate::first_crossing;
+use crate::engine::locate::scan_step;
 use crate::engine::model::{Affects, HybridModel, Mode};
 use crate::engine::observer::{EventRecord, Observer};
 use crate::engine::queue::EventQueue;
@@ -156,6 +156,8 @@ struct Run<'m, M: HybridModel + ?Sized> {
     motion: Motion,
     /// Flow maps and crossing times asked of exact flows.
     exact_evaluations: u64,
+    /// Sum of squared local error estimates of the numerical steps so far.
+    error_squares: f64,
     /// Whether the integrator's last step starts at the current origin.
     stepped: bool,
     /// After `t = 0`, a mode change or a reset that moved the state, guards
@@ -194,6 +196,7 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
             integrator: Integrator::for_method(options.method, n, options.tolerances),
             motion: Motion::Frozen,
             exact_evaluations: 0,
+            error_squares: 0.0,
             stepped: false,
             fresh: Some(None),
             zeno: ZenoWatch::new(options.t_end),
@@ -444,18 +447,24 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
                 {
                     return Err(self.step_failed(failure));
                 }
-                let step = &self.integrator;
-                let h = step.h();
-                let x = &mut self.before;
+                self.error_squares += self.integrator.local_error().powi(2);
+                let h = self.integrator.h();
                 for (g, guard) in guards.iter().enumerate() {
                     let check_start = fresh.is_some_and(|fired| {
                         fired == Some(g) || model.guard(mode, g, &self.state) == 0.0
                     });
-                    let crossing = first_crossing(guard, check_start, |s| {
+                    let (step, x) = (&self.integrator, &mut self.before);
+                    let scan = scan_step(guard, check_start, |s| {
                         step.eval(s * h, x);
                         model.guard(mode, g, x)
                     });
-                    if let Some(s) = crossing {
+                    if !guard.internal && scan.margin.is_finite() {
+                        let uncertainty = self.guard_uncertainty(g);
+                        if scan.margin <= uncertainty {
+                            return Err(self.undecidable(g, scan.margin, uncertainty));
+                        }
+                    }
+                    if let Some(s) = scan.crossing {
                         self.queue.schedule(g, self.origin.after(s * h));
                     }
                 }
@@ -463,6 +472,36 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
                 Ok(())
             }
         }
+    }
+
+    /// How far guard `g` may be off given the integration error so far: the
+    /// error bound (root-sum-square of the local error estimates, as if they
+    /// were independent) carried through the guard component by component.
+    fn guard_uncertainty(&self, g: usize) -> f64 {
+        let bound = self.error_squares.sqrt();
+        let (model, mode) = (self.model, self.mode);
+        let base = model.guard(mode, g, &self.state);
+        let mut x = self.state.clone();
+        (0..x.len())
+            .map(|i| {
+                x[i] += bound;
+                let change = (model.guard(mode, g, &x) - base).abs();
+                x[i] = self.state[i];
+                change
+            })
+            .sum()
+    }
+
+    /// A graze or near miss closer than the integration error can resolve.
+    fn undecidable(&self, g: usize, margin: f64, uncertainty: f64) -> End {
+        End::failed(format!(
+            "guard `{}` grazes zero near t = {:e}: its dip or near miss is {margin:.2e} deep, within the \
+             integration error so far ({uncertainty:.2e}), so {} cannot tell whether it fires; \
+             tighten the method or use an exact one",
+            self.model.guards(self.mode)[g].name,
+            self.origin.value(),
+            self.integrator.name()
+        ))
     }
 
     fn predict_exact(&mut self, g: usize) -> Result<(), End> {
