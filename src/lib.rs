@@ -63,4 +63,5 @@ pub mod log;
 pub mod models;
 pub mod runner;
 pub mod scene;
+pub mod stress;
 pub mod time;

@@ -21,20 +21,29 @@ pub struct Report {
     pub final_state: Vec<(&'static str, f64)>,
 }
 
-/// Run `scene`; `stop` interrupts it cleanly when set.
+/// What may stop a run from outside the scene.
+#[derive(Debug, Clone, Default)]
+pub struct Control {
+    /// Interrupts the run cleanly when set (a signal handler sets it).
+    pub stop: Option<Arc<AtomicBool>>,
+    /// Fails the run after this much wall time.
+    pub max_wall_seconds: Option<f64>,
+}
+
+/// Run `scene` under `control`.
 pub fn run(
     scene: &Scene,
-    stop: Option<Arc<AtomicBool>>,
+    control: &Control,
     observer: &mut dyn Observer,
 ) -> Result<Report, SceneError> {
     match scene {
-        Scene::Mechanism(m) => run_mechanism(m, stop, observer),
+        Scene::Mechanism(m) => run_mechanism(m, control, observer),
     }
 }
 
 fn run_mechanism(
     scene: &MechanismScene,
-    stop: Option<Arc<AtomicBool>>,
+    control: &Control,
     observer: &mut dyn Observer,
 ) -> Result<Report, SceneError> {
     let options = Options {
@@ -42,7 +51,8 @@ fn run_mechanism(
         max_events: scene.max_events,
         method: scene.method,
         tolerances: scene.tolerances,
-        stop,
+        stop: control.stop.clone(),
+        max_wall_seconds: control.max_wall_seconds,
     };
     let (eps, rate) = scene.initial_strain;
     let strain_names = ["strain", "strain_rate"];

@@ -4,6 +4,7 @@ pub mod compare;
 pub mod events;
 pub mod exit;
 pub mod run;
+pub mod stress;
 
 use std::path::PathBuf;
 
@@ -59,6 +60,20 @@ enum Command {
         /// Output directory (default: out/<scene name>-compare).
         #[arg(long, value_name = "DIR")]
         out: Option<PathBuf>,
+    },
+    /// Run every stress scene in DIR with every method: each verified
+    /// against the exact answer or failed with a reason (exit 3 if any is
+    /// silently wrong).
+    Stress {
+        /// The folder of stress scenes.
+        #[arg(default_value = "models/stress")]
+        dir: PathBuf,
+        /// Wall-time budget per run, in seconds.
+        #[arg(long, default_value_t = 10.0, value_name = "SECONDS")]
+        wall: f64,
+        /// Print the table of outcomes as Markdown.
+        #[arg(long)]
+        markdown: bool,
     },
     /// Filter or summarise an event log.
     Events {
@@ -124,6 +139,11 @@ pub fn dispatch(cli: Cli) -> Result<Code, Failure> {
             steps,
             out,
         } => compare::compare(&scene, methods, tolerances, steps, out),
+        Command::Stress {
+            dir,
+            wall,
+            markdown,
+        } => stress::stress(&dir, wall, markdown),
         Command::Events {
             log,
             guard,

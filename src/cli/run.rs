@@ -10,7 +10,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use flicker::engine::Status;
 use flicker::log::JsonlWriter;
 use flicker::log::summary::{summary, write_atomically};
-use flicker::runner::{Report, run as run_scene};
+use flicker::runner::{Control, Report, run as run_scene};
 use flicker::scene::solver::SolverSpec;
 use flicker::scene::{self, Scene};
 
@@ -50,6 +50,10 @@ pub fn run(
     // A second handler cannot be installed in the same process; a run
     // without one still works, it just cannot be interrupted cleanly.
     let _ = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed));
+    let control = Control {
+        stop: Some(stop),
+        max_wall_seconds: None,
+    };
 
     let log_path = out.join("events.jsonl");
     let report = if log_events {
@@ -57,7 +61,7 @@ pub fn run(
             Failure::bad_input(format!("{}: cannot be created: {e}", log_path.display()))
         })?;
         let mut writer = JsonlWriter::new(BufWriter::new(file));
-        let report = run_scene(&scene, Some(stop), &mut writer)
+        let report = run_scene(&scene, &control, &mut writer)
             .map_err(|e| Failure::bad_input(e.in_path(scene_path)))?;
         writer.flush().map_err(|e| {
             Failure::untrusted(format!(
@@ -67,7 +71,7 @@ pub fn run(
         })?;
         report
     } else {
-        run_scene(&scene, Some(stop), &mut ())
+        run_scene(&scene, &control, &mut ())
             .map_err(|e| Failure::bad_input(e.in_path(scene_path)))?
     };
 

@@ -13,7 +13,7 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use crate::engine::{EventRecord, Observer, Status};
+use crate::engine::{EventTimes, Status};
 use crate::runner;
 use crate::scene::solver::SolverSpec;
 use crate::scene::{Scene, SceneError};
@@ -115,28 +115,15 @@ fn scene_period(scene: &Scene) -> f64 {
     }
 }
 
-/// Event times as they happen (resting-contact settles excluded).
-#[derive(Default)]
-struct EventTimes(Vec<f64>);
-
-impl Observer for EventTimes {
-    fn on_event(&mut self, e: &EventRecord) -> std::io::Result<()> {
-        if e.guard != crate::engine::simulation::SETTLE {
-            self.0.push(e.t);
-        }
-        Ok(())
-    }
-}
-
 /// Repeats of a run for its timing: at least 3, and until 50 ms have passed.
 fn measure(scene: &Scene, setting: &SolverSpec, reference: &Reference) -> Result<Row, SceneError> {
     let mut times = EventTimes::default();
     let start = Instant::now();
-    let report = runner::run(scene, None, &mut times)?;
+    let report = runner::run(scene, &runner::Control::default(), &mut times)?;
     let mut walls = vec![start.elapsed().as_secs_f64()];
     while walls.len() < 3 || (walls.iter().sum::<f64>() < 0.05 && walls.len() < 1000) {
         let start = Instant::now();
-        runner::run(scene, None, &mut ())?;
+        runner::run(scene, &runner::Control::default(), &mut ())?;
         walls.push(start.elapsed().as_secs_f64());
     }
     walls.sort_by(f64::total_cmp);

@@ -16,5 +16,5 @@ pub mod zeno;
 pub use dopri5::Tolerances;
 pub use integrator::Method;
 pub use model::{Affects, Direction, Flow, Guard, HybridModel, Jump, Mode};
-pub use observer::{EventRecord, Observer, RecordedEvent, Recorder};
+pub use observer::{EventRecord, EventTimes, Observer, RecordedEvent, Recorder, SETTLE};
 pub use simulation::{Options, Outcome, Status, simulate};

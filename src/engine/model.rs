@@ -49,16 +49,33 @@ pub struct Guard {
     /// An internal switch (a change of chart) rather than a physical event:
     /// it is neither logged nor counted as an event.
     pub internal: bool,
+    /// The guard bounds the state (an impact, a wall): the state must stay
+    /// on the side the guard crosses from. After its reset, if the state is
+    /// on zero and still moving through (resting contact), it fires again at
+    /// once, which the Zeno watch then recognises. A guard that only marks a
+    /// passage (a Poincare section, a threshold) is not a barrier: its reset
+    /// may leave the state where it was, and it fires once per passage.
+    pub barrier: bool,
 }
 
 impl Guard {
-    /// A physical, affine guard: the common case.
+    /// An affine barrier guard: the common case (an impact).
     pub const fn affine(name: &'static str, direction: Direction) -> Self {
         Guard {
             name,
             direction,
             affine: true,
             internal: false,
+            barrier: true,
+        }
+    }
+
+    /// Mark this guard as a passage marker rather than a barrier (see
+    /// [`Guard::barrier`]).
+    pub const fn as_crossing(self) -> Self {
+        Guard {
+            barrier: false,
+            ..self
         }
     }
 

@@ -32,6 +32,22 @@ impl Observer for () {
     }
 }
 
+/// The name under which a Zeno settling appears in the log.
+pub const SETTLE: &str = "settle";
+
+/// Keeps the times of events, Zeno settles left out.
+#[derive(Debug, Clone, Default)]
+pub struct EventTimes(pub Vec<f64>);
+
+impl Observer for EventTimes {
+    fn on_event(&mut self, e: &EventRecord) -> std::io::Result<()> {
+        if e.guard != SETTLE {
+            self.0.push(e.t);
+        }
+        Ok(())
+    }
+}
+
 /// An event copied out of the engine.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RecordedEvent {

@@ -25,7 +25,7 @@ use crate::engine::dopri5::{StepFailure, Tolerances};
 use crate::engine::integrator::{Integrator, Method, Motion, motion};
 use crate::engine::locate::scan_step;
 use crate::engine::model::{Affects, HybridModel, Mode};
-use crate::engine::observer::{EventRecord, Observer};
+use crate::engine::observer::{EventRecord, Observer, SETTLE};
 use crate::engine::queue::EventQueue;
 use crate::engine::zeno::ZenoWatch;
 use crate::time::Time;
@@ -46,6 +46,8 @@ pub struct Options {
     pub tolerances: Tolerances,
     /// Set from outside (a signal handler) to stop the run cleanly.
     pub stop: Option<Arc<AtomicBool>>,
+    /// Stop with `failed` after this much wall time (seconds), if set.
+    pub max_wall_seconds: Option<f64>,
 }
 
 impl Options {
@@ -57,6 +59,7 @@ impl Options {
             method: Method::Auto,
             tolerances: Tolerances::default(),
             stop: None,
+            max_wall_seconds: None,
         }
     }
 }
@@ -160,9 +163,9 @@ struct Run<'m, M: HybridModel + ?Sized> {
     error_squares: f64,
     /// Whether the integrator's last step starts at the current origin.
     stepped: bool,
-    /// After `t = 0`, a mode change or a reset that moved the state, guards
-    /// sitting on zero are checked for firing at once: every guard that is
-    /// exactly on zero, and the one that just fired (`Some(slot)`).
+    /// Set at `t = 0` and after each reset: guards exactly on zero are
+    /// checked for firing at once, and so is the barrier guard that just
+    /// fired (`Some(slot)`, within the same mode).
     fresh: Option<Option<usize>>,
     zeno: ZenoWatch,
     /// Set once the run has settled a Zeno accumulation and gone on.
@@ -224,7 +227,9 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
         if let Err(end) = self.start_segment() {
             return end;
         }
+        let mut turn: u64 = 0;
         loop {
+            turn = turn.wrapping_add(1);
             if self
                 .options
                 .stop
@@ -235,6 +240,17 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
                     status: Status::Interrupted,
                     reason: Some("stopped by a signal".into()),
                 };
+            }
+            if turn % 1024 == 0 {
+                if let Some(limit) = self.options.max_wall_seconds {
+                    if self.started.elapsed().as_secs_f64() > limit {
+                        return End::failed(format!(
+                            "wall-time budget of {limit} s spent at t = {:e} after {} events",
+                            self.origin.value(),
+                            self.events
+                        ));
+                    }
+                }
             }
             let next = self.queue.peek().filter(|(_, t)| t.value() <= t_end);
             let Some((slot, t)) = next else {
@@ -295,7 +311,6 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
         self.state_at(t.since(self.origin), &mut before);
         self.after.copy_from_slice(&before);
         let jump = model.reset(mode, slot, &mut self.after);
-        let moved = jump.mode != mode || self.after != before;
         let recorded = if !all_finite(&before) || !all_finite(&self.after) {
             Err(End::failed(format!(
                 "non-finite state at the `{}` event at t = {}: before {:?}, after {:?}",
@@ -326,7 +341,7 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
                 self.integrator.restart();
                 // A guard index names the same guard only within one mode.
                 let fired = (jump.mode == mode).then_some(slot);
-                self.fresh = moved.then_some(fired);
+                self.fresh = Some(fired);
                 self.start_segment()
             }
         }
@@ -451,7 +466,11 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
                 let h = self.integrator.h();
                 for (g, guard) in guards.iter().enumerate() {
                     let check_start = fresh.is_some_and(|fired| {
-                        fired == Some(g) || model.guard(mode, g, &self.state) == 0.0
+                        if fired == Some(g) {
+                            guard.barrier
+                        } else {
+                            model.guard(mode, g, &self.state) == 0.0
+                        }
                     });
                     let (step, x) = (&self.integrator, &mut self.before);
                     let scan = scan_step(guard, check_start, |s| {
@@ -627,9 +646,6 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
 
 /// Events between two projections of the event budget.
 const BUDGET_CHECK: u64 = 1 << 20;
-
-/// The name under which a Zeno settling appears in the log.
-pub const SETTLE: &str = "settle";
 
 fn all_finite(x: &[f64]) -> bool {
     x.iter().all(|v| v.is_finite())

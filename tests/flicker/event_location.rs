@@ -14,7 +14,7 @@ struct Crest {
     level: f64,
 }
 
-const CREST_GUARDS: [Guard; 1] = [Guard::affine("crest", Direction::Rising)];
+const CREST_GUARDS: [Guard; 1] = [Guard::affine("crest", Direction::Rising).as_crossing()];
 
 impl HybridModel for Crest {
     fn dimension(&self) -> usize {

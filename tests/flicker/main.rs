@@ -9,3 +9,4 @@ mod event_location;
 mod mechanism_angle;
 mod mechanism_strain;
 mod scenes;
+mod stress;

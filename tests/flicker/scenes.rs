@@ -5,7 +5,7 @@ use std::path::Path;
 
 use flicker::engine::Status;
 use flicker::models::mechanism::{ExactOrbit, Mechanism};
-use flicker::runner::{Report, run};
+use flicker::runner::{Control, Report, run};
 use flicker::scene::{self, Formulation, Scene};
 
 /// What each shipped scene must do.
@@ -24,7 +24,7 @@ const EXPECTED: &[(&str, Status)] = &[
 
 fn run_file(path: &Path) -> (Scene, Report) {
     let scene = scene::load(path).unwrap_or_else(|e| panic!("{e}"));
-    let report = run(&scene, None, &mut ()).unwrap();
+    let report = run(&scene, &Control::default(), &mut ()).unwrap();
     (scene, report)
 }
 

@@ -129,12 +129,15 @@ pub struct ExactOrbit {
     first_impact: Option<f64>,
     period: f64,
     impact_speed: f64,
+    resting: bool,
 }
 
 impl ExactOrbit {
     pub fn new(mechanism: Mechanism, eps: f64, rate: f64) -> Self {
         let h0 = mechanism.energy(eps, rate);
-        let first_impact = mechanism.time_to_closing(eps, rate);
+        // At H0 = 0 below critical load the unit rests shut: no impacts.
+        let resting = h0 == 0.0 && mechanism.centre() < 0.0;
+        let first_impact = mechanism.time_to_closing(eps, rate).filter(|_| !resting);
         ExactOrbit {
             mechanism,
             initial: (eps, rate),
@@ -145,6 +148,7 @@ impl ExactOrbit {
                 f64::INFINITY
             },
             impact_speed: mechanism.omega * (2.0 * h0.max(0.0)).sqrt(),
+            resting,
         }
     }
 
@@ -168,6 +172,9 @@ impl ExactOrbit {
     /// `(eps, eps')` at time `t`.
     pub fn state_at(&self, t: f64) -> (f64, f64) {
         let (eps, rate) = self.initial;
+        if self.resting {
+            return (0.0, 0.0);
+        }
         match self.first_impact {
             Some(t1) if t1 <= t => {
                 let since = (t - t1) % self.period;
@@ -257,6 +264,20 @@ mod tests {
             omega: 1.0,
         };
         assert_eq!(m.time_to_closing(0.0, 0.0), Some(0.0));
+    }
+
+    #[test]
+    fn resting_contact_stays_shut_with_no_impacts() {
+        let orbit = ExactOrbit::new(
+            Mechanism {
+                eta: 0.8,
+                omega: 1.0,
+            },
+            0.0,
+            0.0,
+        );
+        assert_eq!(orbit.impacts_until(100.0), 0);
+        assert_eq!(orbit.state_at(37.0), (0.0, 0.0));
     }
 
     #[test]

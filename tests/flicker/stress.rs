@@ -1,0 +1,126 @@
+//! Where methods fail: every stress scene with every method either passes
+//! (same events as the exact answer) or fails with a reason; none is
+//! silently wrong, and none runs past its wall-time budget.
+
+use std::path::Path;
+
+use flicker::stress::{Row, Verdict, cases, run_case, settings};
+
+/// Per-run budget here; `flicker stress` uses 10 s for docs/stress.md.
+const WALL: f64 = 2.0;
+
+fn rows() -> Vec<Row> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/stress");
+    let mut rows = Vec::new();
+    for (name, scene) in cases(&dir).unwrap() {
+        for setting in settings(&scene) {
+            rows.push(run_case(&name, &scene, &setting, WALL).unwrap());
+        }
+    }
+    rows
+}
+
+fn verdict<'a>(rows: &'a [Row], case: &str, method: &str) -> &'a Verdict {
+    &rows
+        .iter()
+        .find(|r| r.case == case && r.method == method)
+        .unwrap()
+        .verdict
+}
+
+#[test]
+fn no_method_is_silently_wrong_and_each_says_why_it_fails() {
+    let rows = rows();
+    assert_eq!(
+        rows.len(),
+        29,
+        "8 cases: 7 strain cases x 4 methods + the angle case"
+    );
+    for r in &rows {
+        assert!(
+            !matches!(r.verdict, Verdict::Wrong { .. }),
+            "{} with {}: {:?}",
+            r.case,
+            r.method,
+            r.verdict
+        );
+        if let Verdict::Failed { reason } = &r.verdict {
+            assert!(
+                !reason.is_empty(),
+                "{} with {} failed without a reason",
+                r.case,
+                r.method
+            );
+        }
+        assert!(
+            r.wall_seconds < WALL + 1.0,
+            "{} with {} took {} s",
+            r.case,
+            r.method,
+            r.wall_seconds
+        );
+    }
+    // The exact flow passes every strain case.
+    for r in rows.iter().filter(|r| r.method == "exact") {
+        assert!(
+            matches!(r.verdict, Verdict::Passed { .. }),
+            "{}: {:?}",
+            r.case,
+            r.verdict
+        );
+    }
+    // The singular angle formulation fails, saying so.
+    let Verdict::Failed { reason } = verdict(&rows, "angle_singular", "dopri5") else {
+        panic!()
+    };
+    assert!(reason.contains("singular at theta = 0"));
+    // Grazes a numerical method cannot resolve are refused, not guessed.
+    for method in ["dopri5", "verlet"] {
+        let Verdict::Failed { reason } = verdict(&rows, "separatrix", method) else {
+            panic!("{method} on the separatrix must fail loudly")
+        };
+        assert!(reason.contains("grazes zero"), "{reason}");
+    }
+    // A double crossing inside one step is found by the methods that can
+    // resolve it, and Zeno cases settle with every method.
+    assert!(matches!(
+        verdict(&rows, "double_crossing", "linear"),
+        Verdict::Passed { .. }
+    ));
+    for method in ["exact", "linear", "dopri5", "verlet"] {
+        assert!(
+            matches!(verdict(&rows, "chattering", method), Verdict::Passed { .. }),
+            "{method}"
+        );
+        assert!(
+            matches!(verdict(&rows, "resting", method), Verdict::Passed { .. }),
+            "{method}"
+        );
+        assert!(
+            matches!(
+                verdict(&rows, "event_at_zero", method),
+                Verdict::Passed { .. }
+            ),
+            "{method}"
+        );
+    }
+}
+
+#[test]
+fn every_stress_scene_runs_each_offered_method() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/stress");
+    let names: Vec<String> = cases(&dir).unwrap().into_iter().map(|(n, _)| n).collect();
+    assert_eq!(
+        names,
+        [
+            "angle_singular",
+            "chattering",
+            "double_crossing",
+            "event_at_zero",
+            "long_run",
+            "near_grazing",
+            "resting",
+            "separatrix"
+        ]
+    );
+}
