@@ -7,6 +7,7 @@
 
 use crate::engine::dopri5::{Dopri5, StepFailure, Tolerances};
 use crate::engine::linear::Linear;
+use crate::engine::locate::Interpolant;
 use crate::engine::model::{Flow, HybridModel, Mode};
 use crate::engine::verlet::Verlet;
 
@@ -154,6 +155,14 @@ impl Integrator {
             Integrator::Dopri5(m) => m.dense().end(x),
             Integrator::Verlet(m) => m.end(x),
             Integrator::Linear(m) => m.end(x),
+        }
+    }
+
+    /// What kind of function of the step time the dense output is.
+    pub fn interpolant(&self) -> Interpolant {
+        match self {
+            Integrator::Dopri5(_) | Integrator::Verlet(_) => Interpolant::Polynomial,
+            Integrator::Linear(_) => Interpolant::Other,
         }
     }
 

@@ -54,7 +54,13 @@ pub struct StepScan {
 /// counts as being just before zero: a return to zero that comes sooner
 /// than rounding lets the guard rise visibly above it (a reset that barely
 /// turned the motion round) is still a crossing. See the module docs.
-pub fn scan_step(guard: &Guard, check_start: bool, mut g: impl FnMut(f64) -> f64) -> StepScan {
+pub fn scan_step(
+    guard: &Guard,
+    check_start: bool,
+    interpolant: Interpolant,
+    resolution: f64,
+    mut g: impl FnMut(f64) -> f64,
+) -> StepScan {
     let g0 = g(0.0);
     let start = if check_start {
         just_before_zero(guard.direction, g0)
@@ -62,7 +68,7 @@ pub fn scan_step(guard: &Guard, check_start: bool, mut g: impl FnMut(f64) -> f64
         g0
     };
     if !guard.affine {
-        let cuts: Vec<f64> = (1..=16).map(|k| k as f64 / 16.0).collect();
+        let cuts: [f64; 16] = std::array::from_fn(|k| (k + 1) as f64 / 16.0);
         let crossing = scan(guard.direction, &cuts, start, &mut g, &|_| f64::NAN);
         return StepScan {
             crossing,
@@ -76,7 +82,23 @@ pub fn scan_step(guard: &Guard, check_start: bool, mut g: impl FnMut(f64) -> f64
         g_a: g0,
         check_start,
     };
-    scan_piece(guard.direction, piece, &mut g, 0)
+    let depth = if interpolant == Interpolant::Polynomial {
+        MAX_DEPTH
+    } else {
+        0
+    };
+    scan_piece(guard.direction, piece, resolution, &mut g, depth)
+}
+
+/// What the step's dense output is, as far as event location cares.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Interpolant {
+    /// A polynomial of degree four or less in the step time: a quartic
+    /// through five samples of an affine guard is the guard itself.
+    Polynomial,
+    /// Anything else (the exact linear propagator): pieces are halved until
+    /// a quartic fits.
+    Other,
 }
 
 /// A part `[a, b]` of the step, with the guard's value at `a` (`start` is
@@ -103,6 +125,7 @@ const FIT_TOLERANCE: f64 = 1e-13;
 fn scan_piece(
     direction: Direction,
     piece: Piece,
+    resolution: f64,
     g: &mut impl FnMut(f64) -> f64,
     depth: u32,
 ) -> StepScan {
@@ -116,6 +139,23 @@ fn scan_piece(
     let w = b - a;
     let samples: [f64; 5] = [g_a, g(a + 0.25 * w), g(a + 0.5 * w), g(a + 0.75 * w), g(b)];
     let poly = quartic_through(&samples);
+    // Most steps: the guard stays clearly on one side, which a bound on the
+    // quartic's variation shows without finding its turning points.
+    let variation: f64 = poly[1..].iter().map(|c| c.abs()).sum();
+    if depth >= MAX_DEPTH && !check_start && start.signum() == poly[0].signum() {
+        let clearance = poly[0].abs() - variation;
+        let before = match direction {
+            Direction::Falling => poly[0] > 0.0,
+            Direction::Rising => poly[0] < 0.0,
+            Direction::Either => true,
+        };
+        if clearance > resolution && (before || direction == Direction::Either) {
+            return StepScan {
+                crossing: None,
+                margin: f64::INFINITY,
+            };
+        }
+    }
     let turning = critical_points(&poly);
     if depth < MAX_DEPTH {
         let scale = samples
@@ -134,7 +174,13 @@ fn scan_piece(
         if misfit > FIT_TOLERANCE * scale && (crosses || nearest <= 8.0 * misfit) {
             let mid = 0.5 * (a + b);
             let g_mid = g(mid);
-            let left = scan_piece(direction, Piece { b: mid, ..piece }, g, depth + 1);
+            let left = scan_piece(
+                direction,
+                Piece { b: mid, ..piece },
+                resolution,
+                g,
+                depth + 1,
+            );
             if left.crossing.is_some() {
                 return left;
             }
@@ -145,7 +191,7 @@ fn scan_piece(
                 g_a: g_mid,
                 check_start: false,
             };
-            let right = scan_piece(direction, right_piece, g, depth + 1);
+            let right = scan_piece(direction, right_piece, resolution, g, depth + 1);
             return StepScan {
                 crossing: right.crossing,
                 margin: left.margin.min(right.margin),
@@ -159,21 +205,23 @@ fn scan_piece(
             margin: f64::INFINITY,
         };
     }
-    let mut cuts: Vec<f64> = turning.iter().map(|u| a + u * w).collect();
-    cuts.push(b);
-    let crossing = scan_from(direction, a, &cuts, start, g, &|s| {
+    let mut cuts = [b; 4];
+    for (cut, u) in cuts.iter_mut().zip(turning.iter()) {
+        *cut = a + u * w;
+    }
+    let crossing = scan_from(direction, a, &cuts[..=turning.len()], start, g, &|s| {
         horner(&poly, (s - a) / w)
     });
     let local = crossing.map(|s| (s - a) / w);
+    let margin = margin(direction, &poly, local, turning.as_slice());
     StepScan {
         crossing,
-        margin: margin(direction, &poly, local, &turning),
+        margin: if margin > resolution {
+            f64::INFINITY
+        } else {
+            margin
+        },
     }
-}
-
-/// The earliest crossing of `guard` in a step (see [`scan_step`]).
-pub fn first_crossing(guard: &Guard, check_start: bool, g: impl FnMut(f64) -> f64) -> Option<f64> {
-    scan_step(guard, check_start, g).crossing
 }
 
 /// See [`StepScan::margin`].
@@ -364,34 +412,57 @@ fn horner(poly: &[f64], s: f64) -> f64 {
     poly.iter().rev().fold(0.0, |acc, c| acc * s + c)
 }
 
+/// At most four sorted values in `(0, 1)`: the roots or turning points of
+/// a polynomial of degree four or less, kept without allocating.
+#[derive(Debug, Clone, Copy, Default)]
+struct Points {
+    len: usize,
+    values: [f64; 4],
+}
+
+impl Points {
+    fn push(&mut self, x: f64) {
+        self.values[self.len] = x;
+        self.len += 1;
+    }
+
+    fn as_slice(&self) -> &[f64] {
+        &self.values[..self.len]
+    }
+
+    fn len(&self) -> usize {
+        self.len
+    }
+
+    fn iter(&self) -> std::slice::Iter<'_, f64> {
+        self.as_slice().iter()
+    }
+}
+
 /// The real roots of `poly'` in `(0, 1)`, sorted.
-fn critical_points(poly: &[f64]) -> Vec<f64> {
-    let derivative: Vec<f64> = poly
-        .iter()
-        .enumerate()
-        .skip(1)
-        .map(|(k, c)| k as f64 * c)
-        .collect();
-    roots_in_unit_interval(&derivative)
+fn critical_points(poly: &[f64]) -> Points {
+    let mut derivative = [0.0; 4];
+    for k in 1..poly.len().min(5) {
+        derivative[k - 1] = k as f64 * poly[k];
+    }
+    roots_in_unit_interval(&derivative[..poly.len().saturating_sub(1).min(4)])
 }
 
 /// Every real root of `poly` in `(0, 1)`, sorted, by recursion on the
 /// derivative: the critical points split `[0, 1]` into monotone pieces.
-fn roots_in_unit_interval(poly: &[f64]) -> Vec<f64> {
-    let degree = poly.iter().rposition(|c| *c != 0.0).unwrap_or(0);
-    if degree == 0 {
-        return Vec::new();
-    }
+fn roots_in_unit_interval(poly: &[f64]) -> Points {
+    let mut roots = Points::default();
+    let Some(degree) = poly.iter().rposition(|c| *c != 0.0).filter(|d| *d > 0) else {
+        return roots;
+    };
     let p = &poly[..=degree];
-    let mut cuts = if degree == 1 {
-        Vec::new()
+    let turning = if degree == 1 {
+        Points::default()
     } else {
         critical_points(p)
     };
-    cuts.push(1.0);
-    let mut roots = Vec::new();
     let (mut left, mut f_left) = (0.0, p[0]);
-    for right in cuts {
+    for &right in turning.iter().chain(std::iter::once(&1.0)) {
         let f_right = horner(p, right);
         if f_left * f_right < 0.0 {
             roots.push(refine_polynomial(left, right, &|s| horner(p, s)));
@@ -408,6 +479,17 @@ mod tests {
     use super::*;
 
     const FALLING: Guard = Guard::affine("g", Direction::Falling);
+
+    fn first_crossing(guard: &Guard, check_start: bool, g: impl FnMut(f64) -> f64) -> Option<f64> {
+        scan_step(
+            guard,
+            check_start,
+            Interpolant::Polynomial,
+            f64::INFINITY,
+            g,
+        )
+        .crossing
+    }
 
     #[test]
     fn finds_a_dip_that_both_ends_of_the_step_miss() {
@@ -469,7 +551,13 @@ mod tests {
     #[test]
     fn a_graze_has_a_small_margin_and_an_impact_a_large_one() {
         // Dips to -1e-6 and back: margin = depth = 1e-6.
-        let graze = scan_step(&FALLING, false, |s| (s - 0.5).powi(2) - 1e-6);
+        let graze = scan_step(
+            &FALLING,
+            false,
+            Interpolant::Polynomial,
+            f64::INFINITY,
+            |s| (s - 0.5).powi(2) - 1e-6,
+        );
         assert!(graze.crossing.is_some());
         assert!(
             (graze.margin - 1e-6).abs() < 1e-12,
@@ -477,12 +565,25 @@ mod tests {
             graze.margin
         );
         // Turns back 1e-6 short of zero: a near miss, margin 1e-6.
-        let miss = scan_step(&FALLING, false, |s| (s - 0.5).powi(2) + 1e-6);
+        let miss = scan_step(
+            &FALLING,
+            false,
+            Interpolant::Polynomial,
+            f64::INFINITY,
+            |s| (s - 0.5).powi(2) + 1e-6,
+        );
         assert_eq!(miss.crossing, None);
         assert!((miss.margin - 1e-6).abs() < 1e-12);
         // Accelerating through zero: nothing to decide.
         assert_eq!(
-            scan_step(&FALLING, false, |s| 0.1 - s * s).margin,
+            scan_step(
+                &FALLING,
+                false,
+                Interpolant::Polynomial,
+                f64::INFINITY,
+                |s| 0.1 - s * s
+            )
+            .margin,
             f64::INFINITY
         );
     }
@@ -493,7 +594,7 @@ mod tests {
         // through five samples cannot see it; halving until the fit is
         // exact does.
         let g = |s: f64| 1e-3 + (s - 0.3).powi(2) - 1.001e-3 * (-((s - 0.3) / 0.01).powi(2)).exp();
-        let scan = scan_step(&FALLING, false, g);
+        let scan = scan_step(&FALLING, false, Interpolant::Other, f64::INFINITY, g);
         let root = scan.crossing.expect("the dip must be found");
         assert!((root - 0.3).abs() < 0.01, "root {root}");
         assert!(g(root) <= 0.0 && g(root - 1e-9) > 0.0);

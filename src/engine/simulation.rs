@@ -161,6 +161,8 @@ struct Run<'m, M: HybridModel + ?Sized> {
     exact_evaluations: u64,
     /// Sum of squared local error estimates of the numerical steps so far.
     error_squares: f64,
+    /// Guard sensitivities of a mode (see [`Run::measure_sensitivity`]).
+    sensitivity: (Option<Mode>, Vec<f64>),
     /// Whether the integrator's last step starts at the current origin.
     stepped: bool,
     /// Set at `t = 0` and after each reset: guards exactly on zero are
@@ -200,6 +202,7 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
             motion: Motion::Frozen,
             exact_evaluations: 0,
             error_squares: 0.0,
+            sensitivity: (None, Vec::new()),
             stepped: false,
             fresh: Some(None),
             zeno: ZenoWatch::new(options.t_end),
@@ -464,6 +467,10 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
                 }
                 self.error_squares += self.integrator.local_error().powi(2);
                 let h = self.integrator.h();
+                let interpolant = self.integrator.interpolant();
+                let bound = self.error_squares.sqrt();
+                self.measure_sensitivity();
+                let sensitivity = std::mem::take(&mut self.sensitivity.1);
                 for (g, guard) in guards.iter().enumerate() {
                     let check_start = fresh.is_some_and(|fired| {
                         if fired == Some(g) {
@@ -473,42 +480,53 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
                         }
                     });
                     let (step, x) = (&self.integrator, &mut self.before);
-                    let scan = scan_step(guard, check_start, |s| {
+                    let uncertainty = if guard.internal {
+                        0.0
+                    } else {
+                        sensitivity[g] * bound
+                    };
+                    let scan = scan_step(guard, check_start, interpolant, uncertainty, |s| {
                         step.eval(s * h, x);
                         model.guard(mode, g, x)
                     });
-                    if !guard.internal && scan.margin.is_finite() {
-                        let uncertainty = self.guard_uncertainty(g);
-                        if scan.margin <= uncertainty {
-                            return Err(self.undecidable(g, scan.margin, uncertainty));
-                        }
+                    if scan.margin <= uncertainty {
+                        return Err(self.undecidable(g, scan.margin, uncertainty));
                     }
                     if let Some(s) = scan.crossing {
                         self.queue.schedule(g, self.origin.after(s * h));
                     }
                 }
+                self.sensitivity.1 = sensitivity;
                 self.queue.schedule(guards.len(), self.origin.after(h));
                 Ok(())
             }
         }
     }
 
-    /// How far guard `g` may be off given the integration error so far: the
-    /// error bound (root-sum-square of the local error estimates, as if they
-    /// were independent) carried through the guard component by component.
-    fn guard_uncertainty(&self, g: usize) -> f64 {
-        let bound = self.error_squares.sqrt();
+    /// For each guard of the current mode, how much it can change when each
+    /// state component changes by one: `sum |dg/dx_i|`, exact for affine
+    /// guards. Times the integration error bound (root-sum-square of the
+    /// local error estimates, as if independent) it says how far the guard
+    /// may be off. Kept until the mode changes.
+    fn measure_sensitivity(&mut self) {
         let (model, mode) = (self.model, self.mode);
-        let base = model.guard(mode, g, &self.state);
-        let mut x = self.state.clone();
-        (0..x.len())
-            .map(|i| {
-                x[i] += bound;
-                let change = (model.guard(mode, g, &x) - base).abs();
-                x[i] = self.state[i];
-                change
-            })
-            .sum()
+        if self.sensitivity.0 != Some(mode) {
+            let mut x = self.state.clone();
+            let values = (0..model.guards(mode).len())
+                .map(|g| {
+                    let base = model.guard(mode, g, &x);
+                    (0..x.len())
+                        .map(|i| {
+                            x[i] += 1.0;
+                            let change = (model.guard(mode, g, &x) - base).abs();
+                            x[i] = self.state[i];
+                            change
+                        })
+                        .sum()
+                })
+                .collect();
+            self.sensitivity = (Some(mode), values);
+        }
     }
 
     /// A graze or near miss closer than the integration error can resolve.
