@@ -12,14 +12,16 @@ use std::cmp::Reverse;
 
 use ordered_float::NotNan;
 use priority_queue::PriorityQueue;
+use rustc_hash::FxBuildHasher;
 
 use crate::time::Time;
 
 type Priority = Reverse<(NotNan<f64>, usize)>;
 
-#[derive(Debug, Default)]
+#[derive(Default)]
 pub struct EventQueue {
-    queue: PriorityQueue<usize, Priority>,
+    /// Slots are small integers: a fast non-cryptographic hash will do.
+    queue: PriorityQueue<usize, Priority, FxBuildHasher>,
     exact: Vec<Time>,
 }
 

@@ -157,6 +157,8 @@ struct Run<'m, M: HybridModel + ?Sized> {
     integrator: Integrator,
     /// How the current mode moves under the run's method.
     motion: Motion,
+    /// The same for every mode met so far.
+    motions: Vec<Option<Motion>>,
     /// Flow maps and crossing times asked of exact flows.
     exact_evaluations: u64,
     /// Sum of squared local error estimates of the numerical steps so far.
@@ -200,6 +202,7 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
             queue: EventQueue::default(),
             integrator: Integrator::for_method(options.method, n, options.tolerances),
             motion: Motion::Frozen,
+            motions: Vec::new(),
             exact_evaluations: 0,
             error_squares: 0.0,
             sensitivity: (None, Vec::new()),
@@ -440,12 +443,7 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
         self.queue.clear();
         let (model, mode) = (self.model, self.mode);
         let guards = model.guards(mode);
-        self.motion = motion(model, mode, self.options.method).map_err(|why| {
-            End::failed(format!(
-                "method `{}` cannot run this model: {why}",
-                self.options.method.name()
-            ))
-        })?;
+        self.motion = self.motion_of(mode)?;
         match self.motion {
             Motion::Frozen => Ok(()),
             Motion::Exact => (0..guards.len()).try_for_each(|g| self.predict_exact(g)),
@@ -501,6 +499,24 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
                 Ok(())
             }
         }
+    }
+
+    /// How `mode` moves under the run's method, decided once per mode.
+    fn motion_of(&mut self, mode: Mode) -> Result<Motion, End> {
+        if let Some(Some(known)) = self.motions.get(mode) {
+            return Ok(*known);
+        }
+        let decided = motion(self.model, mode, self.options.method).map_err(|why| {
+            End::failed(format!(
+                "method `{}` cannot run this model: {why}",
+                self.options.method.name()
+            ))
+        })?;
+        if self.motions.len() <= mode {
+            self.motions.resize(mode + 1, None);
+        }
+        self.motions[mode] = Some(decided);
+        Ok(decided)
     }
 
     /// For each guard of the current mode, how much it can change when each
