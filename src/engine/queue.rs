@@ -1,5 +1,4 @@
-//! The queue of predicted events: one slot per guard (plus the end of the
-//! current integration step), earliest first.
+//! The queue of predicted events: one slot per guard, earliest first.
 //!
 //! Priorities are `(time, slot)` so that events at the same `f64` time pop in
 //! slot order and the log is the same on every run. Times are checked with

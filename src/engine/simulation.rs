@@ -3,10 +3,10 @@
 //!
 //! The loop never asks which integrator a mode uses. A mode's flow gives a
 //! *segment*: for an exact flow, the whole future (guards predicted by the
-//! model's exact crossing times); for an ODE, one accepted Dormand-Prince
-//! step with dense output (guards located on it, see [`locate`]), whose end
-//! is queued like an event. The queue holds one prediction per guard and the
-//! step end; whatever pops first happens next.
+//! model's exact crossing times); for an ODE, one accepted step with dense
+//! output (guards located on it, see [`locate`]). The queue holds one
+//! prediction per guard; whichever comes first, the earliest prediction or
+//! the end of the current step, happens next.
 //!
 //! How a run can end, in [`Status`]: it reaches `t_end`; events of one guard
 //! accumulate faster than the run can resolve (Zeno), and the model either
@@ -165,6 +165,8 @@ struct Run<'m, M: HybridModel + ?Sized> {
     error_squares: f64,
     /// Guard sensitivities of a mode (see [`Run::measure_sensitivity`]).
     sensitivity: (Option<Mode>, Vec<f64>),
+    /// When the integrator's current step ends, for stepped modes.
+    step_end: Option<Time>,
     /// Whether the integrator's last step starts at the current origin.
     stepped: bool,
     /// Set at `t = 0` and after each reset: guards exactly on zero are
@@ -207,6 +209,7 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
             error_squares: 0.0,
             sensitivity: (None, Vec::new()),
             stepped: false,
+            step_end: None,
             fresh: Some(None),
             zeno: ZenoWatch::new(options.t_end),
             zeno_reason: None,
@@ -258,24 +261,30 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
                     }
                 }
             }
-            let next = self.queue.peek().filter(|(_, t)| t.value() <= t_end);
-            let Some((slot, t)) = next else {
-                return self.finish_at(Time::new(t_end));
+            // An event at the very end of a step happens before the step ends.
+            let next = match (self.queue.peek(), self.step_end) {
+                (Some((_, t)), Some(end)) if end < t => (None, end),
+                (Some((slot, t)), _) => (Some(slot), t),
+                (None, Some(end)) => (None, end),
+                (None, None) => return self.finish_at(Time::new(t_end)),
             };
-            self.queue.pop();
-            let model = self.model;
-            let result = if slot == model.guards(self.mode).len() {
-                self.integrator.end(&mut self.state);
-                self.origin = t;
-                self.start_segment()
-            } else {
-                self.fire(slot, t, observer)
+            let result = match next {
+                (_, t) if t.value() > t_end => return self.finish_at(Time::new(t_end)),
+                (Some(slot), t) => {
+                    self.queue.pop();
+                    self.fire(slot, t, observer)
+                }
+                (None, t) => {
+                    self.integrator.end(&mut self.state);
+                    self.origin = t;
+                    self.start_segment()
+                }
             };
             if let Err(end) = result {
                 return end;
             }
             if self.events >= self.budget_check.0
-                && let Err(end) = self.check_budget(t)
+                && let Err(end) = self.check_budget(self.origin)
             {
                 return end;
             }
@@ -441,6 +450,7 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
     /// ODE mode this takes the next integration step.
     fn start_segment(&mut self) -> Result<(), End> {
         self.queue.clear();
+        self.step_end = None;
         let (model, mode) = (self.model, self.mode);
         let guards = model.guards(mode);
         self.motion = self.motion_of(mode)?;
@@ -495,7 +505,7 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
                     }
                 }
                 self.sensitivity.1 = sensitivity;
-                self.queue.schedule(guards.len(), self.origin.after(h));
+                self.step_end = Some(self.origin.after(h));
                 Ok(())
             }
         }
