@@ -59,8 +59,8 @@ def scipy_run(method, tol):
             y = np.array(sol.y_events[0][0])
             y[0], y[1] = 0.0, -y[1]
             impacts += 1
-            # The restart sits on the guard while opening; nudge past it so the
-            # event is not found again at t (solve_ivp has no re-arming rule).
+            # The restart sits on eps = 0 while opening: solve_ivp reports
+            # sign changes after its start only, so it is not found again.
             continue
         t, y = T_END, sol.y[:, -1]
     wall = time.perf_counter() - start
