@@ -250,16 +250,15 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
                     reason: Some("stopped by a signal".into()),
                 };
             }
-            if turn % 1024 == 0 {
-                if let Some(limit) = self.options.max_wall_seconds {
-                    if self.started.elapsed().as_secs_f64() > limit {
-                        return End::failed(format!(
-                            "wall-time budget of {limit} s spent at t = {:e} after {} events",
-                            self.origin.value(),
-                            self.events
-                        ));
-                    }
-                }
+            if turn.is_multiple_of(1024)
+                && let Some(limit) = self.options.max_wall_seconds
+                && self.started.elapsed().as_secs_f64() > limit
+            {
+                return End::failed(format!(
+                    "wall-time budget of {limit} s spent at t = {:e} after {} events",
+                    self.origin.value(),
+                    self.events
+                ));
             }
             // An event at the very end of a step happens before the step ends.
             let next = match (self.queue.peek(), self.step_end) {
