@@ -3,14 +3,13 @@
 pub mod compare;
 pub mod events;
 pub mod exit;
+pub mod progress;
 pub mod run;
 pub mod stress;
 
 use std::path::PathBuf;
 
 use clap::{Parser, Subcommand};
-
-use flicker::scene::solver::SolverSpec;
 
 use crate::cli::exit::{Code, Failure};
 
@@ -28,21 +27,7 @@ pub struct Cli {
 #[derive(Debug, Subcommand)]
 enum Command {
     /// Run a scene and write DIR/summary.json and DIR/events.jsonl.
-    Run {
-        /// The scene file (JSON).
-        scene: PathBuf,
-        /// Output directory (default: out/<scene name>).
-        #[arg(long, value_name = "DIR")]
-        out: Option<PathBuf>,
-        /// Simulated time to stop at, replacing the scene's t_end.
-        #[arg(long = "t-end", value_name = "T", allow_negative_numbers = true)]
-        t_end: Option<f64>,
-        /// Do not write the event log.
-        #[arg(long = "no-events")]
-        no_events: bool,
-        #[command(flatten)]
-        solver: SolverFlags,
-    },
+    Run(run::RunArgs),
     /// Run a scene with every method over a range of tolerances or steps and
     /// measure each against the exact answer: DIR/compare.csv, compare.svg, compare.png.
     Compare {
@@ -94,44 +79,9 @@ enum Command {
     },
 }
 
-/// Flags that override a scene's `solver`.
-#[derive(Debug, clap::Args)]
-pub struct SolverFlags {
-    /// Method: exact, linear, dopri5 or verlet (default: the scene's, else
-    /// the cheapest exact description of the model).
-    #[arg(long, value_name = "M")]
-    method: Option<String>,
-    /// Relative tolerance (dopri5).
-    #[arg(long, value_name = "R", allow_negative_numbers = true)]
-    rtol: Option<f64>,
-    /// Absolute tolerance (dopri5).
-    #[arg(long, value_name = "A", allow_negative_numbers = true)]
-    atol: Option<f64>,
-    /// Fixed step (verlet).
-    #[arg(long, value_name = "H", allow_negative_numbers = true)]
-    step: Option<f64>,
-}
-
-impl SolverFlags {
-    fn spec(self) -> SolverSpec {
-        SolverSpec {
-            method: self.method,
-            rtol: self.rtol,
-            atol: self.atol,
-            step: self.step,
-        }
-    }
-}
-
 pub fn dispatch(cli: Cli) -> Result<Code, Failure> {
     match cli.command {
-        Command::Run {
-            scene,
-            out,
-            t_end,
-            no_events,
-            solver,
-        } => run::run(&scene, out, t_end, solver.spec(), !no_events),
+        Command::Run(args) => run::run(args),
         Command::Compare {
             scene,
             methods,

@@ -15,14 +15,64 @@ use flicker::scene::solver::SolverSpec;
 use flicker::scene::{self, Scene};
 
 use crate::cli::exit::{Code, Failure};
+use crate::cli::progress::WithProgress;
 
-pub fn run(
-    scene_path: &Path,
+/// `flicker run`'s arguments.
+#[derive(Debug, clap::Args)]
+pub struct RunArgs {
+    /// The scene file (JSON).
+    scene: PathBuf,
+    /// Output directory (default: out/<scene name>).
+    #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
+    /// Simulated time to stop at, replacing the scene's t_end.
+    #[arg(long = "t-end", value_name = "T", allow_negative_numbers = true)]
     t_end: Option<f64>,
-    solver: SolverSpec,
-    log_events: bool,
-) -> Result<Code, Failure> {
+    /// Do not write the event log.
+    #[arg(long = "no-events")]
+    no_events: bool,
+    /// No progress bar.
+    #[arg(long)]
+    quiet: bool,
+    #[command(flatten)]
+    solver: SolverFlags,
+}
+
+/// Flags that override a scene's `solver`.
+#[derive(Debug, clap::Args)]
+pub struct SolverFlags {
+    /// Method: exact, linear, dopri5 or verlet (default: the scene's, else
+    /// the cheapest exact description of the model).
+    #[arg(long, value_name = "M")]
+    method: Option<String>,
+    /// Relative tolerance (dopri5).
+    #[arg(long, value_name = "R", allow_negative_numbers = true)]
+    rtol: Option<f64>,
+    /// Absolute tolerance (dopri5).
+    #[arg(long, value_name = "A", allow_negative_numbers = true)]
+    atol: Option<f64>,
+    /// Fixed step (verlet).
+    #[arg(long, value_name = "H", allow_negative_numbers = true)]
+    step: Option<f64>,
+}
+
+pub fn run(args: RunArgs) -> Result<Code, Failure> {
+    let RunArgs {
+        scene: scene_path,
+        out,
+        t_end,
+        no_events,
+        quiet,
+        solver,
+    } = args;
+    let scene_path = scene_path.as_path();
+    let log_events = !no_events;
+    let solver = SolverSpec {
+        method: solver.method,
+        rtol: solver.rtol,
+        atol: solver.atol,
+        step: solver.step,
+    };
     // Everything is checked before any file is touched: bad input loses nothing.
     let mut scene = scene::load(scene_path).map_err(Failure::bad_input)?;
     if let Some(t) = t_end {
@@ -60,10 +110,12 @@ pub fn run(
         let file = File::create(&log_path).map_err(|e| {
             Failure::bad_input(format!("{}: cannot be created: {e}", log_path.display()))
         })?;
-        let mut writer = JsonlWriter::new(BufWriter::new(file));
-        let report = run_scene(&scene, &control, &mut writer)
-            .map_err(|e| Failure::bad_input(e.in_path(scene_path)))?;
-        writer.flush().map_err(|e| {
+        let mut observer =
+            WithProgress::new(JsonlWriter::new(BufWriter::new(file)), scene.t_end(), quiet);
+        let report = run_scene(&scene, &control, &mut observer);
+        observer.finish();
+        let report = report.map_err(|e| Failure::bad_input(e.in_path(scene_path)))?;
+        observer.inner.flush().map_err(|e| {
             Failure::untrusted(format!(
                 "{}: the event log could not be written: {e}",
                 log_path.display()
@@ -71,8 +123,10 @@ pub fn run(
         })?;
         report
     } else {
-        run_scene(&scene, &control, &mut ())
-            .map_err(|e| Failure::bad_input(e.in_path(scene_path)))?
+        let mut observer = WithProgress::new((), scene.t_end(), quiet);
+        let report = run_scene(&scene, &control, &mut observer);
+        observer.finish();
+        report.map_err(|e| Failure::bad_input(e.in_path(scene_path)))?
     };
 
     let log = log_events.then_some(log_path.as_path());

@@ -24,6 +24,12 @@ pub struct EventRecord<'a> {
 /// Receives events as they happen. An error stops the run (status `failed`).
 pub trait Observer {
     fn on_event(&mut self, event: &EventRecord) -> std::io::Result<()>;
+
+    /// Called now and then (every few thousand turns of the loop) with the
+    /// simulated time reached and the events so far, for progress displays.
+    fn on_progress(&mut self, t: f64, events: u64) {
+        let _ = (t, events);
+    }
 }
 
 impl Observer for () {

@@ -250,6 +250,9 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
                     reason: Some("stopped by a signal".into()),
                 };
             }
+            if turn.is_multiple_of(PROGRESS_EVERY) {
+                observer.on_progress(self.origin.value(), self.events);
+            }
             if turn.is_multiple_of(1024)
                 && let Some(limit) = self.options.max_wall_seconds
                 && self.started.elapsed().as_secs_f64() > limit
@@ -686,6 +689,9 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
         }
     }
 }
+
+/// Turns of the loop between two progress reports.
+const PROGRESS_EVERY: u64 = 1 << 14;
 
 /// Events between two projections of the event budget.
 const BUDGET_CHECK: u64 = 1 << 20;

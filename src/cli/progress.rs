@@ -1,0 +1,63 @@
+//! A progress bar on stderr for long runs: simulated time reached, events
+//! and events per second. Drawn only when stderr is a terminal and the user
+//! did not ask for `--quiet`.
+
+use std::io::IsTerminal;
+use std::time::Instant;
+
+use flicker::engine::{EventRecord, Observer};
+use indicatif::{ProgressBar, ProgressStyle};
+
+/// Steps of the bar over `[0, t_end]`.
+const STEPS: u64 = 1000;
+
+/// Passes events on to `inner` and shows progress.
+pub struct WithProgress<O> {
+    pub inner: O,
+    bar: Option<ProgressBar>,
+    t_end: f64,
+    started: Instant,
+}
+
+impl<O> WithProgress<O> {
+    pub fn new(inner: O, t_end: f64, quiet: bool) -> Self {
+        let bar = (!quiet && std::io::stderr().is_terminal()).then(|| {
+            let bar = ProgressBar::new(STEPS);
+            bar.set_style(
+                ProgressStyle::with_template("{bar:40} t = {msg} ({elapsed})")
+                    .unwrap_or_else(|_| ProgressStyle::default_bar()),
+            );
+            bar
+        });
+        WithProgress {
+            inner,
+            bar,
+            t_end,
+            started: Instant::now(),
+        }
+    }
+
+    /// Remove the bar, leaving the terminal clean for the report.
+    pub fn finish(&self) {
+        if let Some(bar) = &self.bar {
+            bar.finish_and_clear();
+        }
+    }
+}
+
+impl<O: Observer> Observer for WithProgress<O> {
+    fn on_event(&mut self, event: &EventRecord) -> std::io::Result<()> {
+        self.inner.on_event(event)
+    }
+
+    fn on_progress(&mut self, t: f64, events: u64) {
+        if let Some(bar) = &self.bar {
+            let rate = events as f64 / self.started.elapsed().as_secs_f64().max(1e-9);
+            bar.set_position((t / self.t_end * STEPS as f64) as u64);
+            bar.set_message(format!(
+                "{t:.6e} of {:e}, {events} events, {rate:.3e} events/s",
+                self.t_end
+            ));
+        }
+    }
+}
