@@ -64,4 +64,5 @@ pub mod models;
 pub mod runner;
 pub mod scene;
 pub mod stress;
+pub mod sweep;
 pub mod time;

@@ -6,6 +6,7 @@ pub mod exit;
 pub mod progress;
 pub mod run;
 pub mod stress;
+pub mod sweep;
 
 use std::path::PathBuf;
 
@@ -60,6 +61,31 @@ enum Command {
         #[arg(long)]
         markdown: bool,
     },
+    /// Run a grid of scenes in parallel: one CSV row per point.
+    Sweep {
+        /// The sweep file (JSON).
+        sweep: PathBuf,
+        /// Run only the points I, I+N, I+2N, ... (0 <= I < N), for batch jobs.
+        #[arg(long, value_name = "I/N")]
+        shard: Option<String>,
+        /// Threads (default: one per core).
+        #[arg(long, value_name = "T")]
+        threads: Option<usize>,
+        /// Output CSV (default: out/<sweep name>.csv, or .shard-I-of-N.csv).
+        #[arg(long, value_name = "FILE")]
+        out: Option<PathBuf>,
+    },
+    /// Join the shard CSVs of a sweep into the CSV a single run writes.
+    Merge {
+        /// The sweep file (JSON) the shards ran.
+        sweep: PathBuf,
+        /// The shard CSVs.
+        #[arg(required = true)]
+        shards: Vec<PathBuf>,
+        /// The merged CSV.
+        #[arg(long, value_name = "FILE")]
+        out: PathBuf,
+    },
     /// Filter or summarise an event log.
     Events {
         /// The log (events.jsonl).
@@ -94,6 +120,17 @@ pub fn dispatch(cli: Cli) -> Result<Code, Failure> {
             wall,
             markdown,
         } => stress::stress(&dir, wall, markdown),
+        Command::Sweep {
+            sweep: file,
+            shard,
+            threads,
+            out,
+        } => sweep::sweep(&file, shard, threads, out),
+        Command::Merge {
+            sweep: file,
+            shards,
+            out,
+        } => sweep::merge(&file, &shards, &out),
         Command::Events {
             log,
             guard,

@@ -123,7 +123,12 @@ pub fn parse(text: &str) -> Result<Scene, SceneError> {
         field: None,
         reason: format!("is not valid JSON: {e}"),
     })?;
-    let mut fields = Fields::open(&value, "")?;
+    from_value(&value)
+}
+
+/// Validate a scene given as a parsed JSON value.
+pub fn from_value(value: &Value) -> Result<Scene, SceneError> {
+    let mut fields = Fields::open(value, "")?;
     let model = fields.required("model")?;
     match model.as_str() {
         Some("mechanism") => mechanism::validate(fields).map(Scene::Mechanism),

@@ -12,3 +12,4 @@ mod mechanism_strain;
 mod reproducible;
 mod scenes;
 mod stress;
+mod sweep;

@@ -1,0 +1,77 @@
+//! `flicker sweep` and `flicker merge`: a grid of scenes in parallel, in
+//! shards for batch schedulers, and the shards joined again.
+
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use flicker::sweep::{self, Shard};
+
+use crate::cli::exit::{Code, Failure};
+
+pub fn sweep(
+    file: &Path,
+    shard: Option<String>,
+    threads: Option<usize>,
+    out: Option<PathBuf>,
+) -> Result<Code, Failure> {
+    let spec = sweep::load(file).map_err(Failure::bad_input)?;
+    let shard = match shard {
+        Some(text) => {
+            Shard::parse(&text).map_err(|e| Failure::bad_input(format!("--shard: {e}")))?
+        }
+        None => Shard::WHOLE,
+    };
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.unwrap_or(0))
+        .build()
+        .map_err(|e| Failure::bad_input(format!("--threads: {e}")))?;
+    let out = out.unwrap_or_else(|| {
+        let stem = file
+            .file_stem()
+            .map_or_else(|| "sweep".into(), |s| s.to_string_lossy().into_owned());
+        let name = if shard == Shard::WHOLE {
+            format!("{stem}.csv")
+        } else {
+            format!("{stem}.shard-{}-of-{}.csv", shard.index, shard.count)
+        };
+        Path::new("out").join(name)
+    });
+    if let Some(folder) = out.parent().filter(|p| !p.as_os_str().is_empty()) {
+        std::fs::create_dir_all(folder).map_err(|e| {
+            Failure::bad_input(format!(
+                "{}: cannot create the folder: {e}",
+                folder.display()
+            ))
+        })?;
+    }
+    let started = Instant::now();
+    let rows = pool.install(|| spec.run(shard));
+    let seconds = started.elapsed().as_secs_f64();
+    let file = File::create(&out)
+        .map_err(|e| Failure::bad_input(format!("{}: cannot be created: {e}", out.display())))?;
+    sweep::write_csv(&spec, &rows, &mut BufWriter::new(file))
+        .map_err(|e| Failure::untrusted(format!("{}: {e}", out.display())))?;
+    let failed = rows
+        .iter()
+        .filter(|r| r.status != "completed" && !r.status.starts_with("zeno"))
+        .count();
+    println!(
+        "{} points of {} in {seconds:.2} s on {} threads ({failed} not completed); wrote {}",
+        rows.len(),
+        spec.points(),
+        pool.current_num_threads(),
+        out.display()
+    );
+    Ok(Code::Ok)
+}
+
+pub fn merge(file: &Path, shards: &[PathBuf], out: &Path) -> Result<Code, Failure> {
+    let spec = sweep::load(file).map_err(Failure::bad_input)?;
+    let text = sweep::merge(&spec, shards).map_err(Failure::bad_input)?;
+    std::fs::write(out, text)
+        .map_err(|e| Failure::untrusted(format!("{}: cannot be written: {e}", out.display())))?;
+    println!("merged {} shards into {}", shards.len(), out.display());
+    Ok(Code::Ok)
+}

@@ -1,0 +1,459 @@
+//! Parameter sweeps: one scene, a grid of values for some of its keys, one
+//! CSV row per point, run in parallel; shards for batch schedulers.
+//!
+//! ```json
+//! {"scene": "../mechanism_impacting.json",
+//!  "grid": [{"key": "eta", "from": 0.5, "to": 1.5, "count": 100},
+//!           {"key": "initial.energy", "values": [0.01, 0.1, 1.0]}],
+//!  "description": "..."}
+//! ```
+//!
+//! `scene` is a path (relative to the sweep file) or an inline scene object.
+//! Each grid entry names a key of the scene by its dotted path and gives its
+//! values, as a list or as `from`, `to`, `count` (evenly spaced, or
+//! geometrically with `"spacing": "log"`). Points are the Cartesian product,
+//! the last key varying fastest, numbered from 0. A shard `i/n` runs the
+//! points whose number is `i` modulo `n`; merging the shards gives the same
+//! file, byte for byte, as one run of the whole sweep: rows are written in
+//! point order and each row depends only on its point.
+
+use std::path::{Path, PathBuf};
+
+use rayon::prelude::*;
+use serde_json::Value;
+
+use crate::engine::{EventRecord, Observer, SETTLE, Status};
+use crate::models::mechanism::ExactOrbit;
+use crate::runner::{self, Control};
+use crate::scene::fields::Fields;
+use crate::scene::{self, Scene, SceneError};
+
+/// One axis of the grid.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Axis {
+    pub key: String,
+    pub values: Vec<f64>,
+}
+
+/// A validated sweep.
+#[derive(Debug, Clone)]
+pub struct Sweep {
+    pub base: Value,
+    pub axes: Vec<Axis>,
+}
+
+/// Which points this process runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Shard {
+    pub index: usize,
+    pub count: usize,
+}
+
+impl Shard {
+    pub const WHOLE: Shard = Shard { index: 0, count: 1 };
+
+    /// Parse `I/N` with `0 <= I < N`.
+    pub fn parse(text: &str) -> Result<Self, String> {
+        let (i, n) = text
+            .split_once('/')
+            .ok_or_else(|| format!("{text:?} is not of the form I/N"))?;
+        let (index, count) = (i.trim().parse::<usize>(), n.trim().parse::<usize>());
+        match (index, count) {
+            (Ok(index), Ok(count)) if index < count => Ok(Shard { index, count }),
+            _ => Err(format!(
+                "{text:?} must be I/N with whole numbers 0 <= I < N"
+            )),
+        }
+    }
+}
+
+/// One point's result.
+#[derive(Debug, Clone)]
+pub struct Row {
+    pub point: usize,
+    /// The grid values, in axis order.
+    pub values: Vec<f64>,
+    pub status: String,
+    pub events: u64,
+    pub first_impact: Option<f64>,
+    /// Mean interval between consecutive impacts.
+    pub impact_period: Option<f64>,
+    /// The closed form's impact period, for the mechanism.
+    pub exact_period: Option<f64>,
+    pub period_error: Option<f64>,
+    pub energy_error: Option<f64>,
+    pub t_reached: f64,
+}
+
+/// Read and validate a sweep file.
+pub fn load(path: &Path) -> Result<Sweep, SceneError> {
+    let text = std::fs::read_to_string(path).map_err(|e| SceneError {
+        file: Some(path.to_path_buf()),
+        field: None,
+        reason: format!("cannot be read: {e}"),
+    })?;
+    let value: Value = serde_json::from_str(&text).map_err(|e| SceneError {
+        file: Some(path.to_path_buf()),
+        field: None,
+        reason: format!("is not valid JSON: {e}"),
+    })?;
+    let folder = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    parse(&value, &folder).map_err(|e| e.in_path(path))
+}
+
+fn parse(value: &Value, folder: &Path) -> Result<Sweep, SceneError> {
+    let mut f = Fields::open(value, "")?;
+    let base = match f.required("scene")? {
+        Value::String(relative) => {
+            let path: PathBuf = folder.join(relative);
+            let text = std::fs::read_to_string(&path).map_err(|e| {
+                SceneError::field("scene", format!("{} cannot be read: {e}", path.display()))
+            })?;
+            serde_json::from_str(&text).map_err(|e| {
+                SceneError::field(
+                    "scene",
+                    format!("{} is not valid JSON: {e}", path.display()),
+                )
+            })?
+        }
+        inline @ Value::Object(_) => inline.clone(),
+        _ => {
+            return Err(SceneError::field(
+                "scene",
+                "must be a path or a scene object".into(),
+            ));
+        }
+    };
+    let Some(entries) = f.required("grid")?.as_array() else {
+        return Err(SceneError::field("grid", "must be an array of axes".into()));
+    };
+    let axes = entries
+        .iter()
+        .enumerate()
+        .map(|(i, e)| axis(e, &format!("grid[{i}]")))
+        .collect::<Result<Vec<_>, _>>()?;
+    if axes.is_empty() {
+        return Err(SceneError::field(
+            "grid",
+            "must hold at least one axis".into(),
+        ));
+    }
+    f.optional_string("description")?;
+    f.finish()?;
+    // Every swept key must be in the scene, so a typo fails before any run.
+    for (i, axis) in axes.iter().enumerate() {
+        let found = axis.key.split('.').try_fold(&base, |here, key| here.get(key));
+        if found.is_none() {
+            return Err(SceneError::field(
+                &format!("grid[{i}].key"),
+                format!("{:?} is not a key of the scene", axis.key),
+            ));
+        }
+    }
+    Ok(Sweep { base, axes })
+}
+
+fn axis(value: &Value, path: &str) -> Result<Axis, SceneError> {
+    let mut f = Fields::open(value, path)?;
+    let key = f.string("key")?.to_string();
+    let values = if f.has("values") {
+        let list = f.required("values")?.as_array().ok_or_else(|| {
+            SceneError::field(&f.path("values"), "must be an array of numbers".into())
+        })?;
+        list.iter()
+            .map(|v| v.as_f64().filter(|x| x.is_finite()))
+            .collect::<Option<Vec<f64>>>()
+            .ok_or_else(|| {
+                SceneError::field(&f.path("values"), "must hold finite numbers only".into())
+            })?
+    } else {
+        let from = f.number("from")?;
+        let to = f.number("to")?;
+        let count = f
+            .optional_count("count")?
+            .ok_or_else(|| SceneError::field(&f.path("count"), "is missing".into()))?;
+        let log = match f.optional_string("spacing")? {
+            None | Some("linear") => false,
+            Some("log") if from > 0.0 && to > 0.0 => true,
+            Some("log") => {
+                return Err(SceneError::field(
+                    &f.path("spacing"),
+                    "\"log\" needs from > 0 and to > 0".into(),
+                ));
+            }
+            Some(other) => {
+                return Err(SceneError::field(
+                    &f.path("spacing"),
+                    format!("must be \"linear\" or \"log\" (got {other:?})"),
+                ));
+            }
+        };
+        spaced(from, to, count as usize, log)
+    };
+    if values.is_empty() {
+        return Err(SceneError::field(
+            &f.path("values"),
+            "must not be empty".into(),
+        ));
+    }
+    f.finish()?;
+    Ok(Axis { key, values })
+}
+
+/// `count` values from `from` to `to`, evenly or geometrically spaced.
+fn spaced(from: f64, to: f64, count: usize, log: bool) -> Vec<f64> {
+    if count == 1 {
+        return vec![from];
+    }
+    (0..count)
+        .map(|i| match i {
+            0 => from,
+            _ if i == count - 1 => to,
+            _ => {
+                let u = i as f64 / (count - 1) as f64;
+                if log {
+                    from * (to / from).powf(u)
+                } else {
+                    from + u * (to - from)
+                }
+            }
+        })
+        .collect()
+}
+
+impl Sweep {
+    /// The number of points in the grid.
+    pub fn points(&self) -> usize {
+        self.axes.iter().map(|a| a.values.len()).product()
+    }
+
+    /// The grid values of point `index`, the last axis varying fastest.
+    pub fn values_at(&self, mut index: usize) -> Vec<f64> {
+        let mut values = vec![0.0; self.axes.len()];
+        for (slot, axis) in values.iter_mut().zip(&self.axes).rev() {
+            *slot = axis.values[index % axis.values.len()];
+            index /= axis.values.len();
+        }
+        values
+    }
+
+    /// The scene JSON of point `index`.
+    pub fn scene_at(&self, index: usize) -> Result<Value, SceneError> {
+        let mut scene = self.base.clone();
+        for (axis, value) in self.axes.iter().zip(self.values_at(index)) {
+            set(&mut scene, &axis.key, value)
+                .map_err(|reason| SceneError::field(&axis.key, reason))?;
+        }
+        Ok(scene)
+    }
+
+    /// Run the points of `shard`, in parallel, in point order.
+    pub fn run(&self, shard: Shard) -> Vec<Row> {
+        let points: Vec<usize> = (shard.index..self.points()).step_by(shard.count).collect();
+        points
+            .par_iter()
+            .map(|&point| self.run_point(point))
+            .collect()
+    }
+
+    fn run_point(&self, point: usize) -> Row {
+        let values = self.values_at(point);
+        let failed = |reason: String| Row {
+            point,
+            values: values.clone(),
+            status: format!("invalid: {reason}"),
+            events: 0,
+            first_impact: None,
+            impact_period: None,
+            exact_period: None,
+            period_error: None,
+            energy_error: None,
+            t_reached: 0.0,
+        };
+        let scene = match self.scene_at(point).and_then(|v| scene::from_value(&v)) {
+            Ok(scene) => scene,
+            Err(e) => return failed(e.to_string()),
+        };
+        let mut times = FirstAndLast::default();
+        let report = match runner::run(&scene, &Control::default(), &mut times) {
+            Ok(report) => report,
+            Err(e) => return failed(e.to_string()),
+        };
+        let o = &report.outcome;
+        let impact_period = match times.span {
+            Some((first, last)) if times.count > 1 => Some((last - first) / (times.count - 1) as f64),
+            _ => None,
+        };
+        let exact_period = match &scene {
+            Scene::Mechanism(m) => {
+                let (eps, rate) = m.initial_strain;
+                let h0 = m.mechanism.energy(eps, rate);
+                let impacts = ExactOrbit::new(m.mechanism, eps, rate).impacts_until(m.t_end);
+                (h0 > 0.0 && impacts > 0).then(|| m.mechanism.impact_period(h0))
+            }
+        };
+        let status = match (o.status, &o.reason) {
+            (Status::Completed, _) | (_, None) => o.status.as_str().to_string(),
+            (status, Some(reason)) => format!("{}: {reason}", status.as_str()),
+        };
+        Row {
+            point,
+            values,
+            status,
+            events: o.events,
+            first_impact: times.span.map(|(first, _)| first),
+            impact_period,
+            exact_period,
+            period_error: impact_period
+                .zip(exact_period)
+                .map(|(a, b)| ((a - b) / b).abs()),
+            energy_error: o.max_energy_error,
+            t_reached: o.t_reached,
+        }
+    }
+
+    /// The CSV header: `point`, the axis keys, then the results.
+    pub fn header(&self) -> Vec<String> {
+        let mut header = vec!["point".to_string()];
+        header.extend(self.axes.iter().map(|a| a.key.clone()));
+        header.extend(
+            [
+                "status",
+                "events",
+                "first_impact",
+                "impact_period",
+                "exact_period",
+                "period_error",
+                "energy_error",
+                "t_reached",
+            ]
+            .map(str::to_string),
+        );
+        header
+    }
+}
+
+/// The first and last event times and the count: all a row needs, without
+/// keeping every time.
+#[derive(Debug, Default)]
+struct FirstAndLast {
+    span: Option<(f64, f64)>,
+    count: u64,
+}
+
+impl Observer for FirstAndLast {
+    fn on_event(&mut self, e: &EventRecord) -> std::io::Result<()> {
+        if e.guard != SETTLE {
+            self.span = Some(self.span.map_or((e.t, e.t), |(first, _)| (first, e.t)));
+            self.count += 1;
+        }
+        Ok(())
+    }
+}
+
+/// Set the number at dotted `path` in a JSON object, creating nothing but
+/// the last key.
+fn set(value: &mut Value, path: &str, x: f64) -> Result<(), String> {
+    let mut keys = path.split('.').peekable();
+    let mut here = value;
+    while let Some(key) = keys.next() {
+        let object = here
+            .as_object_mut()
+            .ok_or_else(|| format!("cannot be set: the scene has no object at {key:?}"))?;
+        if keys.peek().is_none() {
+            object.insert(key.to_string(), Value::from(x));
+            return Ok(());
+        }
+        here = object
+            .get_mut(key)
+            .ok_or_else(|| format!("cannot be set: the scene has no key {key:?}"))?;
+    }
+    Err("is empty".into())
+}
+
+/// Write rows (in point order) as CSV.
+pub fn write_csv(
+    sweep: &Sweep,
+    rows: &[Row],
+    out: &mut impl std::io::Write,
+) -> Result<(), csv::Error> {
+    let mut writer = csv::Writer::from_writer(out);
+    writer.write_record(sweep.header())?;
+    let number =
+        |x: Option<f64>| x.map_or(String::new(), |x| ryu::Buffer::new().format(x).to_string());
+    for r in rows {
+        let mut record = vec![r.point.to_string()];
+        record.extend(r.values.iter().map(|v| number(Some(*v))));
+        record.extend([
+            r.status.clone(),
+            r.events.to_string(),
+            number(r.first_impact),
+            number(r.impact_period),
+            number(r.exact_period),
+            number(r.period_error),
+            number(r.energy_error),
+            number(Some(r.t_reached)),
+        ]);
+        writer.write_record(&record)?;
+    }
+    writer.flush()?;
+    Ok(())
+}
+
+/// Join the shard files of `sweep` into the CSV one run of the whole sweep
+/// writes; every point must be in exactly one shard.
+pub fn merge(sweep: &Sweep, shards: &[PathBuf]) -> Result<String, String> {
+    let mut header: Option<String> = None;
+    let mut rows: Vec<(usize, String)> = Vec::new();
+    for path in shards {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| format!("{}: cannot be read: {e}", path.display()))?;
+        let mut lines = text.lines();
+        let first = lines
+            .next()
+            .ok_or_else(|| format!("{}: is empty", path.display()))?;
+        match &header {
+            None => header = Some(first.to_string()),
+            Some(h) if h != first => {
+                return Err(format!(
+                    "{}: its header differs from the other shards'",
+                    path.display()
+                ));
+            }
+            _ => {}
+        }
+        for (n, line) in lines.enumerate() {
+            let point = line
+                .split(',')
+                .next()
+                .and_then(|p| p.parse::<usize>().ok())
+                .ok_or_else(|| format!("{}: line {}: no point number", path.display(), n + 2))?;
+            rows.push((point, line.to_string()));
+        }
+    }
+    rows.sort_by_key(|(p, _)| *p);
+    for (i, (point, _)) in rows.iter().enumerate() {
+        if *point != i {
+            let what = if *point > i {
+                "missing"
+            } else {
+                "in two shards"
+            };
+            return Err(format!("point {i} is {what}"));
+        }
+    }
+    if rows.len() != sweep.points() {
+        return Err(format!(
+            "points {}.. are missing: the sweep has {}",
+            rows.len(),
+            sweep.points()
+        ));
+    }
+    let mut text = header.ok_or("no shard given")?;
+    text.push('\n');
+    for (_, line) in rows {
+        text.push_str(&line);
+        text.push('\n');
+    }
+    Ok(text)
+}
