@@ -58,7 +58,7 @@ pub fn sweep(
         .filter(|r| r.status != "completed" && !r.status.starts_with("zeno"))
         .count();
     println!(
-        "{} points of {} in {seconds:.2} s on {} threads ({failed} not completed); wrote {}",
+        "{} points of {} in {seconds:.3} s on {} threads ({failed} not completed); wrote {}",
         rows.len(),
         spec.points(),
         pool.current_num_threads(),
