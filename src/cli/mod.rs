@@ -1,5 +1,6 @@
 //! Command-line arguments and their dispatch to subcommands.
 
+pub mod check;
 pub mod compare;
 pub mod events;
 pub mod exit;
@@ -86,6 +87,11 @@ enum Command {
         #[arg(long, value_name = "FILE")]
         out: PathBuf,
     },
+    /// Validate a scene without running it, and say what it describes.
+    Check {
+        /// The scene file (JSON).
+        scene: PathBuf,
+    },
     /// Filter or summarise an event log.
     Events {
         /// The log (events.jsonl).
@@ -131,6 +137,7 @@ pub fn dispatch(cli: Cli) -> Result<Code, Failure> {
             shards,
             out,
         } => sweep::merge(&file, &shards, &out),
+        Command::Check { scene } => check::check(&scene),
         Command::Events {
             log,
             guard,

@@ -11,5 +11,6 @@ mod mechanism_angle;
 mod mechanism_strain;
 mod reproducible;
 mod scenes;
+mod schemas;
 mod stress;
 mod sweep;

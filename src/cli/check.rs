@@ -1,0 +1,60 @@
+//! `flicker check`: validate a scene without running it, and say what it
+//! describes.
+
+use std::path::Path;
+
+use flicker::models::mechanism::Mechanism;
+use flicker::scene::{self, Formulation, Scene};
+
+use crate::cli::exit::{Code, Failure};
+
+pub fn check(path: &Path) -> Result<Code, Failure> {
+    let scene = scene::load(path).map_err(Failure::bad_input)?;
+    match &scene {
+        Scene::Mechanism(m) => {
+            let (eps, rate) = m.initial_strain;
+            let h0 = m.mechanism.energy(eps, rate);
+            let formulation = match m.formulation {
+                Formulation::Strain => "strain formulation",
+                Formulation::Angle(_) => "angle formulation",
+            };
+            println!(
+                "{}: a valid mechanism scene ({formulation}, method {})",
+                path.display(),
+                m.method.name()
+            );
+            println!(
+                "  eta {}, omega {}, t_end {}",
+                m.mechanism.eta, m.mechanism.omega, m.t_end
+            );
+            println!(
+                "  initial strain {eps:e}, strain rate {rate:e}, energy H0 = {h0:e}: {}",
+                regime(m.mechanism, h0, m.t_end)
+            );
+        }
+    }
+    Ok(Code::Ok)
+}
+
+/// Which regime of PHYSICS.md s.2 an orbit of energy `h0` is in.
+fn regime(m: Mechanism, h0: f64, t_end: f64) -> String {
+    let c = m.centre();
+    // The engine's Zeno resolution (flicker::engine::zeno).
+    let resolution = t_end / (1u64 << 40) as f64;
+    if h0 > 0.0 && m.impact_period(h0) <= resolution {
+        format!(
+            "chattering towards resting contact: an impact every {:e}, faster than the run can resolve (expect zeno)",
+            m.impact_period(h0)
+        )
+    } else if h0 > 0.0 {
+        format!("impacting, an impact every {:e}", m.impact_period(h0))
+    } else if h0 == 0.0 && c > 0.0 {
+        "the grazing separatrix: touches eps = 0 at zero speed, no impact".into()
+    } else if h0 == 0.0 && c < 0.0 {
+        "resting contact at the trivial state".into()
+    } else if h0 == 0.0 {
+        "at rest at the critical load".into()
+    } else {
+        "a loose oscillation about the buckled strain, no impact".into()
+    }
+}
