@@ -9,7 +9,18 @@ use flicker::log::reader::for_each_event;
 
 use crate::cli::exit::{Code, Failure};
 
-pub fn events(log: &Path, filter: Filter, summarise: bool) -> Result<Code, Failure> {
+/// What to print of the kept events.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Format {
+    /// The log lines as they are.
+    Lines,
+    /// A JSON summary.
+    Summary,
+    /// CSV: seq, t, guard, energy_before, energy_after.
+    Csv,
+}
+
+pub fn events(log: &Path, filter: Filter, format: Format) -> Result<Code, Failure> {
     for (flag, value) in [("--from", filter.from), ("--to", filter.to)] {
         if value.is_some_and(|t| !t.is_finite()) {
             return Err(Failure::bad_input(format!("{flag}: must be a finite time")));
@@ -26,18 +37,34 @@ pub fn events(log: &Path, filter: Filter, summarise: bool) -> Result<Code, Failu
     let stdout = io::stdout();
     let mut out = io::BufWriter::new(stdout.lock());
     let mut write_error = None;
+    if format == Format::Csv {
+        write_error = writeln!(out, "seq,t,guard,energy_before,energy_after").err();
+    }
+    let number = |x: Option<f64>| x.map_or(String::new(), |x| x.to_string());
     for_each_event(log, |event, line| {
-        if !filter.keeps(event) {
+        if !filter.keeps(event) || write_error.is_some() {
             return;
         }
-        if summarise {
-            summary.add(event);
-        } else if write_error.is_none() {
-            write_error = writeln!(out, "{line}").err();
-        }
+        write_error = match format {
+            Format::Summary => {
+                summary.add(event);
+                None
+            }
+            Format::Lines => writeln!(out, "{line}").err(),
+            Format::Csv => writeln!(
+                out,
+                "{},{},{},{},{}",
+                event.seq,
+                event.t,
+                csv_field(&event.guard),
+                number(event.energy_before),
+                number(event.energy_after)
+            )
+            .err(),
+        };
     })
     .map_err(Failure::bad_input)?;
-    if summarise {
+    if format == Format::Summary {
         let text = serde_json::to_string_pretty(&summary).map_err(Failure::untrusted)?;
         write_error = writeln!(out, "{text}").err();
     }
@@ -47,5 +74,14 @@ pub fn events(log: &Path, filter: Filter, summarise: bool) -> Result<Code, Failu
             Err(Failure::untrusted(format!("stdout: {e}")))
         }
         _ => Ok(Code::Ok),
+    }
+}
+
+/// A guard name as a CSV field, quoted if it needs to be.
+fn csv_field(text: &str) -> String {
+    if text.contains([',', '"', '\n']) {
+        format!("\"{}\"", text.replace('"', "\"\""))
+    } else {
+        text.to_string()
     }
 }

@@ -106,8 +106,11 @@ enum Command {
         #[arg(long, value_name = "T", allow_negative_numbers = true)]
         to: Option<f64>,
         /// Print a summary (JSON) instead of the events.
-        #[arg(long)]
+        #[arg(long, conflicts_with = "csv")]
         summary: bool,
+        /// Print the events as CSV (seq, t, guard, energy_before, energy_after).
+        #[arg(long)]
+        csv: bool,
     },
 }
 
@@ -144,6 +147,14 @@ pub fn dispatch(cli: Cli) -> Result<Code, Failure> {
             from,
             to,
             summary,
-        } => events::events(&log, events::Filter { guard, from, to }, summary),
+            csv,
+        } => {
+            let format = match (summary, csv) {
+                (true, _) => events::Format::Summary,
+                (_, true) => events::Format::Csv,
+                _ => events::Format::Lines,
+            };
+            events::events(&log, events::Filter { guard, from, to }, format)
+        }
     }
 }

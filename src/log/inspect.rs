@@ -73,6 +73,9 @@ pub struct Summary {
     pub by_guard: BTreeMap<String, GuardSummary>,
     /// Between consecutive kept events, whatever their guard.
     pub intervals: Spread,
+    /// The same intervals counted per decade: `"1e-3"` holds those in
+    /// `[1e-3, 1e-2)`; `"0"` holds simultaneous events.
+    pub interval_histogram: BTreeMap<String, u64>,
     pub largest_energy_jump: Option<EnergyJump>,
     /// Events whose time is earlier than the one before (should be none).
     pub out_of_order: u64,
@@ -85,6 +88,10 @@ impl Summary {
                 self.out_of_order += 1;
             }
             self.intervals.add(e.t - last);
+            *self
+                .interval_histogram
+                .entry(decade(e.t - last))
+                .or_insert(0) += 1;
         }
         self.events += 1;
         self.first_t.get_or_insert(e.t);
@@ -111,6 +118,15 @@ impl Summary {
                 });
             }
         }
+    }
+}
+
+/// The decade an interval falls in, as a histogram key.
+fn decade(interval: f64) -> String {
+    if interval > 0.0 {
+        format!("1e{}", interval.log10().floor() as i32)
+    } else {
+        "0".into()
     }
 }
 
@@ -146,6 +162,7 @@ mod tests {
         let jump = s.largest_energy_jump.unwrap();
         assert_eq!((jump.seq, jump.guard.as_str()), (2, "b"));
         assert_eq!(s.out_of_order, 0);
+        assert_eq!(s.interval_histogram["1e0"], 2);
     }
 
     #[test]

@@ -372,3 +372,35 @@ fn an_interrupted_run_keeps_its_log_and_says_so() {
     let last: Value = serde_json::from_str(text.lines().last().unwrap()).unwrap();
     assert_eq!(last["t"], summary["t_reached"]);
 }
+
+#[test]
+fn events_exports_csv_with_one_row_per_kept_event() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("run");
+    flicker(&[
+        "run",
+        &models("mechanism_subcritical.json"),
+        "--out",
+        out.to_str().unwrap(),
+        "--t-end",
+        "40",
+    ]);
+    let log = out.join("events.jsonl");
+    let lines = std::fs::read_to_string(&log).unwrap().lines().count();
+    let csv_out = flicker(&["events", log.to_str().unwrap(), "--csv"]);
+    assert_eq!(csv_out.status.code(), Some(0));
+    let mut reader = csv::Reader::from_reader(csv_out.stdout.as_slice());
+    assert_eq!(
+        reader.headers().unwrap(),
+        vec!["seq", "t", "guard", "energy_before", "energy_after"]
+    );
+    let rows: Vec<csv::StringRecord> = reader.records().map(|r| r.unwrap()).collect();
+    assert_eq!(rows.len(), lines);
+    for (k, r) in rows.iter().enumerate() {
+        assert_eq!(r[0].parse::<usize>().unwrap(), k + 1);
+        let jump = r[4].parse::<f64>().unwrap() - r[3].parse::<f64>().unwrap();
+        assert!(jump.abs() < 1e-15);
+    }
+    let both = flicker(&["events", log.to_str().unwrap(), "--csv", "--summary"]);
+    assert_eq!(both.status.code(), Some(2));
+}
