@@ -3,7 +3,7 @@
 //!
 //! A row per run: its cost (wall time, the median of a few repeats, and flow
 //! evaluations) beside its errors (final state, event times and energy,
-//! against the [`reference`]). [`chart`] draws error against cost.
+//! against the [`Reference`]). [`chart`] draws error against cost.
 
 pub mod chart;
 pub mod reference;

@@ -23,7 +23,7 @@
 //!
 //! A state that sits on a guard at the start of a step has not crossed it.
 //! After a reset the engine asks whether such a guard should fire at once
-//! ([`fires_at_start`]): it does if it is on or past zero and its rate (its
+//! (`fires_at_start`): it does if it is on or past zero and its rate (its
 //! first non-zero derivative) points further in its direction. That is how
 //! an event at `t = 0`, or a reset that fails to turn the motion around
 //! (resting contact), shows up.

@@ -1,12 +1,12 @@
 //! What a hybrid model tells the engine: its state, its modes, the flow in
 //! each mode, its guards and its resets.
 //!
-//! A model is data plus a few pure functions; the [`Simulation`] owns the
+//! A model is data plus a few pure functions; the [`simulate`] owns the
 //! event queue, event location, the loop and the log. The required methods
 //! are the minimum for a model with an ODE flow; everything else has a
 //! default.
 //!
-//! [`Simulation`]: crate::engine::Simulation
+//! [`simulate`]: crate::engine::simulate
 
 use nalgebra::{DMatrix, DVector};
 
