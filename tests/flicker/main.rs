@@ -14,3 +14,4 @@ mod scenes;
 mod schemas;
 mod stress;
 mod sweep;
+mod thermostat;
