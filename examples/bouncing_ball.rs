@@ -80,7 +80,7 @@ impl HybridModel for BouncingBall {
         Some(0.5 * x[1] * x[1] + self.gravity * x[0])
     }
 
-    fn settle(&self, _: Mode, _: usize, x: &mut [f64]) -> Option<Mode> {
+    fn settle(&self, _: Mode, x: &mut [f64]) -> Option<Mode> {
         x.copy_from_slice(&[0.0, 0.0]);
         Some(RESTING)
     }

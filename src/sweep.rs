@@ -28,6 +28,9 @@ use crate::runner::{self, Control};
 use crate::scene::fields::Fields;
 use crate::scene::{self, Scene, SceneError};
 
+/// The largest grid a sweep file may describe.
+const MAX_POINTS: usize = 1 << 32;
+
 /// One axis of the grid.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Axis {
@@ -140,6 +143,15 @@ fn parse(value: &Value, folder: &Path) -> Result<Sweep, SceneError> {
     }
     f.optional_string("description")?;
     f.finish()?;
+    let points = axes
+        .iter()
+        .try_fold(1usize, |n, a| n.checked_mul(a.values.len()));
+    if points.is_none_or(|n| n > MAX_POINTS) {
+        return Err(SceneError::field(
+            "grid",
+            format!("has more than {MAX_POINTS} points"),
+        ));
+    }
     // Every swept key must be in the scene, so a typo fails before any run.
     for (i, axis) in axes.iter().enumerate() {
         let found = axis
@@ -411,7 +423,9 @@ pub fn write_csv(
 /// Join the shard files of `sweep` into the CSV one run of the whole sweep
 /// writes; every point must be in exactly one shard.
 pub fn merge(sweep: &Sweep, shards: &[PathBuf]) -> Result<String, String> {
-    let mut header: Option<String> = None;
+    let mut expected = Vec::new();
+    write_csv(sweep, &[], &mut expected).map_err(|e| e.to_string())?;
+    let expected = String::from_utf8_lossy(&expected).trim_end().to_string();
     let mut rows: Vec<(usize, String)> = Vec::new();
     for path in shards {
         let text = std::fs::read_to_string(path)
@@ -420,15 +434,11 @@ pub fn merge(sweep: &Sweep, shards: &[PathBuf]) -> Result<String, String> {
         let first = lines
             .next()
             .ok_or_else(|| format!("{}: is empty", path.display()))?;
-        match &header {
-            None => header = Some(first.to_string()),
-            Some(h) if h != first => {
-                return Err(format!(
-                    "{}: its header differs from the other shards'",
-                    path.display()
-                ));
-            }
-            _ => {}
+        if first != expected {
+            return Err(format!(
+                "{}: its header is not this sweep's ({expected})",
+                path.display()
+            ));
         }
         for (n, line) in lines.enumerate() {
             let point = line
@@ -440,24 +450,25 @@ pub fn merge(sweep: &Sweep, shards: &[PathBuf]) -> Result<String, String> {
         }
     }
     rows.sort_by_key(|(p, _)| *p);
+    let total = sweep.points();
     for (i, (point, _)) in rows.iter().enumerate() {
-        if *point != i {
-            let what = if *point > i {
-                "missing"
-            } else {
-                "in two shards"
-            };
-            return Err(format!("point {i} is {what}"));
+        if *point >= total {
+            return Err(format!(
+                "point {point} is not in the sweep, which has {total} points"
+            ));
+        } else if *point < i {
+            return Err(format!("point {point} is in two shards"));
+        } else if *point > i {
+            return Err(format!("point {i} is missing"));
         }
     }
-    if rows.len() != sweep.points() {
+    if rows.len() < total {
         return Err(format!(
-            "points {}.. are missing: the sweep has {}",
-            rows.len(),
-            sweep.points()
+            "points {}.. are missing: the sweep has {total}",
+            rows.len()
         ));
     }
-    let mut text = header.ok_or("no shard given")?;
+    let mut text = expected;
     text.push('\n');
     for (_, line) in rows {
         text.push_str(&line);

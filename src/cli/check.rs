@@ -39,8 +39,7 @@ pub fn check(path: &Path) -> Result<Code, Failure> {
 /// Which regime of PHYSICS.md s.2 an orbit of energy `h0` is in.
 fn regime(m: Mechanism, h0: f64, t_end: f64) -> String {
     let c = m.centre();
-    // The engine's Zeno resolution (flicker::engine::zeno).
-    let resolution = t_end / (1u64 << 40) as f64;
+    let resolution = flicker::engine::zeno::resolution(0.0, t_end);
     if h0 > 0.0 && m.impact_period(h0) <= resolution {
         format!(
             "chattering towards resting contact: an impact every {:e}, faster than the run can resolve (expect zeno)",

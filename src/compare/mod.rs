@@ -134,20 +134,13 @@ fn measure(scene: &Scene, setting: &SolverSpec, reference: &Reference) -> Result
         .zip(&reference.final_state)
         .map(|(a, b)| (a - b).abs())
         .fold(0.0, f64::max);
-    let common = times.0.len().min(reference.event_times.len());
-    let max_event_time_error = (common > 0).then(|| {
-        times.0[..common]
-            .iter()
-            .zip(&reference.event_times)
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0, f64::max)
-    });
+    let max_event_time_error = reference.largest_time_error(&times.0);
     let status = match (o.status, &o.reason) {
         (Status::Failed, Some(reason)) => format!("failed: {reason}"),
-        _ if times.0.len() != reference.event_times.len() => format!(
+        _ if times.0.len() as u64 != reference.events => format!(
             "events differ: {} against {} in the reference",
             times.0.len(),
-            reference.event_times.len()
+            reference.events
         ),
         (status, _) => status.as_str().to_string(),
     };

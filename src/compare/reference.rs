@@ -9,7 +9,27 @@ pub struct Reference {
     /// How the reference was obtained, for the output.
     pub kind: &'static str,
     pub final_state: Vec<f64>,
-    pub event_times: Vec<f64>,
+    /// Events up to the end (saturating for chattering orbits).
+    pub events: u64,
+    orbit: ExactOrbit,
+}
+
+impl Reference {
+    /// The time of event number `k` (from 0).
+    pub fn event_time(&self, k: u64) -> f64 {
+        self.orbit.impact_time(k)
+    }
+
+    /// The largest difference between `times` and the reference's event
+    /// times, over the events both have; `None` if either has none.
+    pub fn largest_time_error(&self, times: &[f64]) -> Option<f64> {
+        let common = (times.len() as u64).min(self.events);
+        (common > 0).then(|| {
+            (0..common)
+                .map(|k| (times[k as usize] - self.event_time(k)).abs())
+                .fold(0.0, f64::max)
+        })
+    }
 }
 
 impl Reference {
@@ -24,7 +44,8 @@ impl Reference {
                 Reference {
                     kind: "closed form (46) of the strain, impacts every T_imp",
                     final_state: vec![e, r],
-                    event_times: orbit.impact_times_until(m.t_end),
+                    events: orbit.impacts_until(m.t_end),
+                    orbit,
                 }
             }
         }

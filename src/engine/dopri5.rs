@@ -81,6 +81,9 @@ pub enum StepFailure {
 pub struct DenseStep {
     pub h: f64,
     r: [Vec<f64>; 5],
+    /// The step's end state as the integrator computed it (the polynomial
+    /// at `s = 1` may differ from it in the last bit).
+    y1: Vec<f64>,
 }
 
 impl DenseStep {
@@ -96,9 +99,7 @@ impl DenseStep {
 
     /// The state at the end of the step, exactly as the integrator computed it.
     pub fn end(&self, x: &mut [f64]) {
-        for (i, xi) in x.iter_mut().enumerate() {
-            *xi = self.r[0][i] + self.r[1][i];
-        }
+        x.copy_from_slice(&self.y1);
     }
 }
 
@@ -134,6 +135,7 @@ impl Dopri5 {
             dense: DenseStep {
                 h: 0.0,
                 r: [v(), v(), v(), v(), v()],
+                y1: v(),
             },
             evaluations: 0,
             trial_error: 0.0,
@@ -275,6 +277,7 @@ impl Dopri5 {
                     + D7 * k[6][i]);
         }
         self.dense.h = h;
+        self.dense.y1.copy_from_slice(&self.y1);
         self.k.swap(0, 6);
         self.fsal = true;
     }

@@ -69,7 +69,7 @@ pub fn scan_step(
     };
     if !guard.affine {
         let cuts: [f64; 16] = std::array::from_fn(|k| (k + 1) as f64 / 16.0);
-        let crossing = scan(guard.direction, &cuts, start, &mut g, &|_| f64::NAN);
+        let crossing = scan_from(guard.direction, 0.0, &cuts, start, &mut g, &|_| f64::NAN);
         return StepScan {
             crossing,
             margin: f64::INFINITY,
@@ -292,17 +292,6 @@ fn scan_from(
         (left, g_left) = (right, g_right);
     }
     None
-}
-
-/// [`scan_from`] over the whole step.
-fn scan(
-    direction: Direction,
-    cuts: &[f64],
-    g0: f64,
-    g: &mut impl FnMut(f64) -> f64,
-    fallback: &dyn Fn(f64) -> f64,
-) -> Option<f64> {
-    scan_from(direction, 0.0, cuts, g0, g, fallback)
 }
 
 /// Illinois iteration on a bracket `g(a) * g(b) <= 0`. Returns the end on

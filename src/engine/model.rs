@@ -209,12 +209,13 @@ pub trait HybridModel {
         initial_energy.abs()
     }
 
-    /// Called when events of `guard` accumulate faster than the run can
-    /// resolve (a Zeno point). A model that knows the limit (resting contact)
+    /// Called when the events of one guard accumulate faster than the run
+    /// can resolve (a Zeno point), with the state `x` in `mode` just after
+    /// the last of them. A model that knows the limit (resting contact)
     /// writes its state into `x` and returns the mode to go on in; `None`
     /// ends the run there.
-    fn settle(&self, mode: Mode, guard: usize, x: &mut [f64]) -> Option<Mode> {
-        let _ = (mode, guard, x);
+    fn settle(&self, mode: Mode, x: &mut [f64]) -> Option<Mode> {
+        let _ = (mode, x);
         None
     }
 

@@ -109,10 +109,12 @@ pub struct Outcome {
     pub final_mode_name: &'static str,
     pub final_state_names: Vec<&'static str>,
     pub final_state: Vec<f64>,
-    /// Right-hand-side evaluations of numerical flows.
     /// Evaluations of the flow: right-hand sides and propagators of
     /// numerical methods, flow maps and crossing times of exact ones.
     pub flow_evaluations: u64,
+    /// Root-sum-square of the local error estimates of numerical steps: an
+    /// estimate of the state error the method accumulated (0 for exact flows).
+    pub error_bound: f64,
     pub wall_seconds: f64,
 }
 
@@ -125,8 +127,28 @@ pub fn simulate<M: HybridModel + ?Sized, O: Observer + ?Sized>(
     options: &Options,
     observer: &mut O,
 ) -> Outcome {
-    let mut run = Run::new(model, mode, x0, options);
-    let end = run.event_loop(observer);
+    // The model is asked nothing about a state it cannot hold.
+    let refused = if x0.len() != model.dimension() {
+        Some(format!(
+            "the initial state has {} components, the model {}",
+            x0.len(),
+            model.dimension()
+        ))
+    } else if !all_finite(x0) {
+        Some(format!("the initial state {x0:?} is not finite"))
+    } else {
+        None
+    };
+    let x0 = if refused.is_some() {
+        vec![0.0; model.dimension()]
+    } else {
+        x0.to_vec()
+    };
+    let mut run = Run::new(model, mode, &x0, options);
+    let end = match refused {
+        Some(reason) => End::failed(reason),
+        None => run.event_loop(observer),
+    };
     run.outcome(end)
 }
 
@@ -214,7 +236,7 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
             zeno: ZenoWatch::new(options.t_end),
             zeno_reason: None,
             settles: 0,
-            budget_check: (BUDGET_CHECK.min(options.max_events), 0, Time::new(0.0)),
+            budget_check: (BUDGET_CHECK, 0, Time::new(0.0)),
             before: vec![0.0; n],
             after: vec![0.0; n],
             events: 0,
@@ -227,12 +249,6 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
 
     fn event_loop<O: Observer + ?Sized>(&mut self, observer: &mut O) -> End {
         let t_end = self.options.t_end;
-        if self.state.len() != self.model.dimension() || !all_finite(&self.state) {
-            return End::failed(format!(
-                "initial state {:?} is not a finite state",
-                self.state
-            ));
-        }
         if let Err(end) = self.start_segment() {
             return end;
         }
@@ -285,6 +301,13 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
             if let Err(end) = result {
                 return end;
             }
+            if self.events > self.options.max_events {
+                return End::failed(format!(
+                    "event budget: more than max_events = {} events by t = {:e}; raise max_events or shorten t_end",
+                    self.options.max_events,
+                    self.origin.value()
+                ));
+            }
             if self.events >= self.budget_check.0
                 && let Err(end) = self.check_budget(self.origin)
             {
@@ -295,13 +318,14 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
 
     /// Every [`BUDGET_CHECK`] events, project the events still needed to
     /// reach `t_end` at the recent rate, so that a run that cannot finish
-    /// within `max_events` says so early instead of grinding to the limit.
+    /// within `max_events` says so early instead of grinding to the limit
+    /// (which fails the run when event `max_events + 1` fires).
     fn check_budget(&mut self, t: Time) -> Result<(), End> {
         let (_, events_then, t_then) = self.budget_check;
         let max = self.options.max_events;
         let rate = (self.events - events_then) as f64 / t.since(t_then);
         let needed = self.events as f64 + rate * Time::new(self.options.t_end).since(t);
-        if self.events >= max || needed > max as f64 {
+        if needed > max as f64 {
             return Err(End::failed(format!(
                 "event budget: {} events by t = {:e}, and at the recent rate ({rate:.3e} events per unit time) \
                  reaching t_end = {} needs about {needed:.3e}, more than max_events = {max}; \
@@ -311,7 +335,7 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
                 self.options.t_end
             )));
         }
-        self.budget_check = ((self.events + BUDGET_CHECK).min(max), self.events, t);
+        self.budget_check = (self.events + BUDGET_CHECK, self.events, t);
         Ok(())
     }
 
@@ -347,11 +371,25 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
         std::mem::swap(&mut self.state, &mut self.after);
         self.origin = t;
         self.mode = jump.mode;
-        if !guard.internal && self.zeno.observe(mode, slot, t) {
-            return self.settle(slot, guard.name, t, observer);
+        // Internal switches are watched too: a chart that flickers at one
+        // instant must not spin either.
+        if self.zeno.observe(mode, slot, t) {
+            return self.settle(guard.name, t, observer);
         }
         match (self.motion, jump.affects) {
             (Motion::Exact, Affects::Range { first, count }) if jump.mode == mode => {
+                let guards = model.guards(mode).len();
+                if first.saturating_add(count) > guards {
+                    return Err(End::failed(format!(
+                        "the `{}` reset re-predicts guards {first}..{} of a mode with {guards}",
+                        guard.name,
+                        first.saturating_add(count)
+                    )));
+                }
+                // The guard that fired left the queue: it is always predicted anew.
+                if !(first..first + count).contains(&slot) {
+                    self.predict_exact(slot)?;
+                }
                 (first..first + count).try_for_each(|g| self.predict_exact(g))
             }
             _ => {
@@ -409,11 +447,10 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
             .map_err(|e| End::failed(format!("could not write the event log: {e}")))
     }
 
-    /// Events of guard `slot` of `mode` came faster than the run can
-    /// resolve: let the model settle into resting contact, or stop.
+    /// Events of the guard `name` came faster than the run can resolve: let
+    /// the model settle into resting contact, or stop.
     fn settle<O: Observer + ?Sized>(
         &mut self,
-        slot: usize,
         name: &str,
         t: Time,
         observer: &mut O,
@@ -424,7 +461,7 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
             self.zeno.describe()
         );
         self.after.copy_from_slice(&self.state);
-        let Some(rest) = self.model.settle(self.mode, slot, &mut self.after) else {
+        let Some(rest) = self.model.settle(self.mode, &mut self.after) else {
             return Err(End {
                 status: Status::Zeno,
                 reason: Some(format!(
@@ -685,6 +722,7 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
             final_state_names: model.state_names(run.mode).to_vec(),
             final_state: run.state,
             flow_evaluations: run.integrator.evaluations() + run.exact_evaluations,
+            error_bound: run.error_squares.sqrt(),
             wall_seconds: run.started.elapsed().as_secs_f64(),
         }
     }

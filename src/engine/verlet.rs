@@ -15,7 +15,7 @@ use crate::engine::model::{HybridModel, Mode};
 
 #[derive(Debug, Clone)]
 pub struct Verlet {
-    /// The fixed step; the last step before an event or the end is shorter.
+    /// The fixed step; the last step before the end of the run is shorter.
     step: f64,
     /// The length of the last step taken.
     h: f64,
@@ -58,7 +58,7 @@ impl Verlet {
         mode: Mode,
         y0: &[f64],
         h_max: f64,
-        _h_min: f64,
+        h_min: f64,
     ) -> Result<(), StepFailure> {
         let m = y0.len() / 2;
         if self.fsal {
@@ -66,6 +66,9 @@ impl Verlet {
         } else {
             model.rhs(mode, y0, &mut self.f0);
             self.evaluations += 1;
+        }
+        if self.step < h_min {
+            return Err(StepFailure::Collapsed { h: self.step });
         }
         let h = self.step.min(h_max);
         self.y0.copy_from_slice(y0);

@@ -5,7 +5,7 @@
 //! `scene`, `events`, `events_by_guard`, `t_end`, `t_reached`,
 //! `energy_initial`, `energy_final`, `max_energy_error` (relative, against
 //! the model's energy scale), `final_state` (named components), `final_mode`,
-//! `zeno`, `flow_evaluations`, `wall_seconds`, `log` (path of the event log or
+//! `zeno`, `flow_evaluations`, `error_bound`, `wall_seconds`, `log` (path of the event log or
 //! null).
 
 use std::io;
@@ -41,6 +41,7 @@ pub fn summary(report: &Report, model: &str, scene: &Path, log: Option<&Path>) -
         "final_mode": o.final_mode_name,
         "zeno": o.zeno,
         "flow_evaluations": o.flow_evaluations,
+        "error_bound": o.error_bound,
         "wall_seconds": o.wall_seconds,
         "log": log.map(|p| p.display().to_string()),
     })

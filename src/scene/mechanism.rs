@@ -86,16 +86,8 @@ pub(crate) fn validate(mut f: Fields) -> Result<MechanismScene, SceneError> {
         .transpose()?
         .unwrap_or_default();
     let (method, tolerances) = resolve_solver(&solver, formulation)?;
-    let initial = initial(f.required("initial")?, mechanism, angle)?;
-    let initial_strain = match initial {
-        Initial::Strain { strain, rate } => (strain, rate),
-        Initial::Energy { energy, phase } => mechanism
-            .state_with_energy(energy, phase)
-            .map_err(|reason| SceneError::field("initial.energy", reason))?,
-        Initial::Angle { angle, rate } => {
-            crate::models::mechanism::angle::strain_of_angle(angle, rate)
-        }
-    };
+    check_steps(method, t_end)?;
+    let (initial, initial_strain) = initial(f.required("initial")?, mechanism, angle)?;
     if !(initial_strain.0.is_finite() && initial_strain.1.is_finite()) {
         return Err(SceneError::field(
             "initial",
@@ -137,6 +129,23 @@ fn charts(f: &mut Fields) -> Result<Charts, SceneError> {
     }
 }
 
+/// Fixed steps a run may take: beyond this it would run for minutes.
+const MAX_FIXED_STEPS: f64 = 1e9;
+
+/// Refuse a fixed step that would need more than [`MAX_FIXED_STEPS`] steps.
+pub fn check_steps(method: Method, t_end: f64) -> Result<(), SceneError> {
+    match method {
+        Method::Verlet { step } if t_end / step > MAX_FIXED_STEPS => Err(SceneError::field(
+            "solver.step",
+            format!(
+                "{step:e} needs {:.1e} steps to reach t_end = {t_end}, more than 1e9; take a larger step",
+                t_end / step
+            ),
+        )),
+        _ => Ok(()),
+    }
+}
+
 /// The method and tolerances of `spec`, checked against the formulation.
 pub fn resolve_solver(
     spec: &SolverSpec,
@@ -162,7 +171,7 @@ fn initial(
     value: &serde_json::Value,
     mechanism: Mechanism,
     angle: bool,
-) -> Result<Initial, SceneError> {
+) -> Result<(Initial, (f64, f64)), SceneError> {
     let mut f = Fields::open(value, "initial")?;
     let initial = if f.has("strain") {
         let strain = f.number_where(
@@ -170,10 +179,8 @@ fn initial(
             ">= 0 (the strain is a unilateral constraint)",
             |e| e >= 0.0,
         )?;
-        Initial::Strain {
-            strain,
-            rate: f.number("strain_rate")?,
-        }
+        let rate = f.number("strain_rate")?;
+        (Initial::Strain { strain, rate }, (strain, rate))
     } else if f.has("energy") {
         let energy = f.number("energy")?;
         let phase = match f.string("phase")? {
@@ -186,10 +193,10 @@ fn initial(
                 ));
             }
         };
-        mechanism
+        let state = mechanism
             .state_with_energy(energy, phase)
             .map_err(|reason| SceneError::field("initial.energy", reason))?;
-        Initial::Energy { energy, phase }
+        (Initial::Energy { energy, phase }, state)
     } else if f.has("angle") {
         if !angle {
             return Err(SceneError::field(
@@ -198,10 +205,9 @@ fn initial(
             ));
         }
         let theta = f.number_where("angle", "inside (-pi/2, pi/2)", |a| a.abs() < FRAC_PI_2)?;
-        Initial::Angle {
-            angle: theta,
-            rate: f.number("angle_rate")?,
-        }
+        let rate = f.number("angle_rate")?;
+        let state = crate::models::mechanism::angle::strain_of_angle(theta, rate);
+        (Initial::Angle { angle: theta, rate }, state)
     } else {
         return Err(SceneError::field(
             "initial",

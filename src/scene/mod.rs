@@ -46,6 +46,7 @@ impl Scene {
         match self {
             Scene::Mechanism(m) => {
                 (m.method, m.tolerances) = mechanism::resolve_solver(&spec, m.formulation)?;
+                mechanism::check_steps(m.method, m.t_end)?;
                 m.solver = spec;
             }
         }
@@ -61,7 +62,10 @@ impl Scene {
             ));
         }
         match self {
-            Scene::Mechanism(m) => m.t_end = t_end,
+            Scene::Mechanism(m) => {
+                mechanism::check_steps(m.method, t_end)?;
+                m.t_end = t_end;
+            }
         }
         Ok(())
     }

@@ -44,8 +44,13 @@ impl SolverSpec {
         Ok(spec)
     }
 
-    /// This spec with the fields of `other` that are set taking precedence.
+    /// This spec with the fields of `other` that are set taking precedence;
+    /// a different method in `other` replaces this spec whole, since its
+    /// keys belong to the old method.
     pub fn overridden_by(&self, other: &SolverSpec) -> SolverSpec {
+        if other.method.is_some() && other.method != self.method {
+            return other.clone();
+        }
         SolverSpec {
             method: other.method.clone().or_else(|| self.method.clone()),
             rtol: other.rtol.or(self.rtol),
@@ -159,5 +164,10 @@ mod tests {
             scene.overridden_by(&flags),
             spec(Some("dopri5"), Some(1e-9), None)
         );
+        // Another method drops the old one's keys.
+        let verlet = spec(Some("verlet"), None, Some(0.01));
+        let flags = spec(Some("dopri5"), None, None);
+        assert_eq!(verlet.overridden_by(&flags), flags);
+        assert!(verlet.overridden_by(&flags).resolve().is_ok());
     }
 }

@@ -235,7 +235,7 @@ fn a_run_that_cannot_finish_within_its_event_budget_says_so_early() {
         "stopped only after {} events",
         outcome.events
     );
-    // A small budget is a hard limit too.
+    // A small budget is a hard limit too: the event past it fails the run.
     options.max_events = 1000;
     let outcome = simulate(
         &StrainMechanism { mechanism: m },
@@ -244,5 +244,34 @@ fn a_run_that_cannot_finish_within_its_event_budget_says_so_early() {
         &options,
         &mut (),
     );
-    assert_eq!((outcome.status, outcome.events), (Status::Failed, 1000));
+    assert_eq!((outcome.status, outcome.events), (Status::Failed, 1001));
+}
+
+#[test]
+fn a_run_needing_exactly_its_event_budget_completes() {
+    let m = Mechanism {
+        eta: 1.2,
+        omega: 1.0,
+    };
+    let x0 = (0.5, 0.0);
+    let t_end = t_end_after_impacts(m, x0, 50);
+    let mut options = Options::until(t_end);
+    options.max_events = 50;
+    let outcome = simulate(
+        &StrainMechanism { mechanism: m },
+        FLIGHT,
+        &[x0.0, x0.1],
+        &options,
+        &mut (),
+    );
+    assert_eq!((outcome.status, outcome.events), (Status::Completed, 50));
+    options.max_events = 49;
+    let outcome = simulate(
+        &StrainMechanism { mechanism: m },
+        FLIGHT,
+        &[x0.0, x0.1],
+        &options,
+        &mut (),
+    );
+    assert_eq!((outcome.status, outcome.events), (Status::Failed, 50));
 }

@@ -44,6 +44,17 @@ fn no_method_is_silently_wrong_and_each_says_why_it_fails() {
             r.method,
             r.verdict
         );
+        // Accumulated phase error may change the impact count of a long
+        // numerical run (the run states its error bound); nowhere else.
+        if matches!(r.verdict, Verdict::Drifted { .. }) {
+            assert!(
+                r.case == "long_run" && r.method != "exact",
+                "{} with {}: {:?}",
+                r.case,
+                r.method,
+                r.verdict
+            );
+        }
         if let Verdict::Failed { reason } = &r.verdict {
             assert!(
                 !reason.is_empty(),

@@ -178,7 +178,22 @@ fn the_bundled_sweep_loads_and_its_points_match_the_closed_form() {
     let mut reader = csv::Reader::from_path(&out).unwrap();
     let rows: Vec<csv::StringRecord> = reader.records().map(|r| r.unwrap()).collect();
     assert_eq!(rows.len(), 200);
-    for r in rows.iter().filter(|r| !r[8].is_empty()) {
-        assert!(r[8].parse::<f64>().unwrap() < 1e-10, "period error {r:?}");
-    }
+    assert!(
+        rows.iter().all(|r| &r[3] == "completed"),
+        "every point completes"
+    );
+    let checked: Vec<f64> = rows
+        .iter()
+        .filter(|r| !r[8].is_empty())
+        .map(|r| r[8].parse().unwrap())
+        .collect();
+    assert!(
+        checked.len() > 150,
+        "only {} rows have a period to check",
+        checked.len()
+    );
+    assert!(
+        checked.iter().all(|e| *e < 1e-10),
+        "period errors {checked:?}"
+    );
 }

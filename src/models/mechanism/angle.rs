@@ -242,7 +242,7 @@ impl HybridModel for AngleMechanism {
         self.mechanism.energy_scale(initial_energy)
     }
 
-    fn settle(&self, mode: Mode, _: usize, x: &mut [f64]) -> Option<Mode> {
+    fn settle(&self, mode: Mode, x: &mut [f64]) -> Option<Mode> {
         (self.mechanism.eta < 1.0 && is_strain_chart(mode)).then(|| {
             x.copy_from_slice(&[0.0, 0.0]);
             RESTING

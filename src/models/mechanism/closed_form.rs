@@ -152,21 +152,20 @@ impl ExactOrbit {
         }
     }
 
-    /// Impacts in `(0, t]`, counted from the closed form.
+    /// Impacts in `(0, t]`, counted from the closed form; saturates at
+    /// `u64::MAX` for chattering orbits whose count no integer holds.
     pub fn impacts_until(&self, t: f64) -> u64 {
         match self.first_impact {
-            Some(t1) if t1 <= t => 1 + ((t - t1) / self.period).floor() as u64,
+            // The float-to-integer cast saturates.
+            Some(t1) if t1 <= t => (((t - t1) / self.period).floor() as u64).saturating_add(1),
             _ => 0,
         }
     }
 
-    /// The impact times in `(0, t]`, each computed from the first impact
-    /// and the period (no accumulated rounding).
-    pub fn impact_times_until(&self, t: f64) -> Vec<f64> {
-        let first = self.first_impact.unwrap_or(f64::INFINITY);
-        (0..self.impacts_until(t))
-            .map(|k| first + k as f64 * self.period)
-            .collect()
+    /// The time of impact number `k` (from 0), computed from the first
+    /// impact and the period, with no accumulated rounding.
+    pub fn impact_time(&self, k: u64) -> f64 {
+        self.first_impact.unwrap_or(f64::INFINITY) + k as f64 * self.period
     }
 
     /// `(eps, eps')` at time `t`.

@@ -106,7 +106,7 @@ impl HybridModel for StrainMechanism {
         self.mechanism.energy_scale(initial_energy)
     }
 
-    fn settle(&self, _: Mode, _: usize, x: &mut [f64]) -> Option<Mode> {
+    fn settle(&self, _: Mode, x: &mut [f64]) -> Option<Mode> {
         // Only below the critical load does the load hold the unit shut.
         (self.mechanism.eta < 1.0).then(|| {
             x.copy_from_slice(&[0.0, 0.0]);
