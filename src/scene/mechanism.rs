@@ -132,7 +132,7 @@ fn charts(f: &mut Fields) -> Result<Charts, SceneError> {
 /// Fixed steps a run may take: beyond this it would run for minutes.
 const MAX_FIXED_STEPS: f64 = 1e9;
 
-/// Refuse a fixed step that would need more than [`MAX_FIXED_STEPS`] steps.
+/// Refuse a fixed step that would need more than 10^9 steps to reach `t_end`.
 pub fn check_steps(method: Method, t_end: f64) -> Result<(), SceneError> {
     match method {
         Method::Verlet { step } if t_end / step > MAX_FIXED_STEPS => Err(SceneError::field(
