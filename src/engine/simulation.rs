@@ -112,8 +112,9 @@ pub struct Outcome {
     /// Evaluations of the flow: right-hand sides and propagators of
     /// numerical methods, flow maps and crossing times of exact ones.
     pub flow_evaluations: u64,
-    /// Root-sum-square of the local error estimates of numerical steps: an
-    /// estimate of the state error the method accumulated (0 for exact flows).
+    /// Sum of the local error estimates of numerical steps: what the state
+    /// error could have grown to if they all added up without amplification
+    /// (0 for exact flows). Phase errors of oscillations do add up so.
     pub error_bound: f64,
     pub wall_seconds: f64,
 }
@@ -183,8 +184,11 @@ struct Run<'m, M: HybridModel + ?Sized> {
     motions: Vec<Option<Motion>>,
     /// Flow maps and crossing times asked of exact flows.
     exact_evaluations: u64,
-    /// Sum of squared local error estimates of the numerical steps so far.
+    /// Sum of squared local error estimates of the numerical steps so far:
+    /// its root is the graze check's (optimistic) error scale.
     error_squares: f64,
+    /// Sum of the local error estimates (see [`Outcome::error_bound`]).
+    error_sum: f64,
     /// Guard sensitivities of a mode (see [`Run::measure_sensitivity`]).
     sensitivity: (Option<Mode>, Vec<f64>),
     /// When the integrator's current step ends, for stepped modes.
@@ -229,6 +233,7 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
             motions: Vec::new(),
             exact_evaluations: 0,
             error_squares: 0.0,
+            error_sum: 0.0,
             sensitivity: (None, Vec::new()),
             stepped: false,
             step_end: None,
@@ -512,7 +517,9 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
                 {
                     return Err(self.step_failed(failure));
                 }
-                self.error_squares += self.integrator.local_error().powi(2);
+                let local = self.integrator.local_error();
+                self.error_squares += local * local;
+                self.error_sum += local;
                 let h = self.integrator.h();
                 let interpolant = self.integrator.interpolant();
                 let bound = self.error_squares.sqrt();
@@ -722,7 +729,7 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
             final_state_names: model.state_names(run.mode).to_vec(),
             final_state: run.state,
             flow_evaluations: run.integrator.evaluations() + run.exact_evaluations,
-            error_bound: run.error_squares.sqrt(),
+            error_bound: run.error_sum,
             wall_seconds: run.started.elapsed().as_secs_f64(),
         }
     }
