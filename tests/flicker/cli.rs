@@ -2,29 +2,16 @@
 //! that name the file and the field, and nothing lost on bad input.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Command;
 
 use serde_json::Value;
 
-fn flicker(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_flicker"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
+use crate::support::{flicker, models, read_json};
 
 fn scene(dir: &Path, name: &str, text: &str) -> PathBuf {
     let path = dir.join(name);
     std::fs::write(&path, text).unwrap();
     path
-}
-
-fn models(name: &str) -> String {
-    format!("{}/models/{name}", env!("CARGO_MANIFEST_DIR"))
-}
-
-fn read_json(path: &Path) -> Value {
-    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
 }
 
 #[test]

@@ -1,14 +1,7 @@
 //! `flicker compare`: every method's row, errors that fall as the method is
 //! tightened, the exact flow at round-off, and the files a user charts.
 
-use std::process::Command;
-
-fn flicker(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_flicker"))
-        .args(args)
-        .output()
-        .unwrap()
-}
+use crate::support::flicker;
 
 #[test]
 fn compare_writes_rows_that_rank_the_methods() {

@@ -13,5 +13,6 @@ mod reproducible;
 mod scenes;
 mod schemas;
 mod stress;
+mod support;
 mod sweep;
 mod thermostat;

@@ -1,15 +1,8 @@
 //! Sweeps: every point against the closed form, the same CSV whatever the
 //! thread count, and shards that merge into the single run byte for byte.
 
+use crate::support::flicker;
 use std::path::Path;
-use std::process::Command;
-
-fn flicker(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_flicker"))
-        .args(args)
-        .output()
-        .unwrap()
-}
 
 fn small_sweep(dir: &Path) -> String {
     let path = dir.join("sweep.json");
