@@ -95,13 +95,19 @@ pub fn load(path: &Path) -> Result<Sweep, SceneError> {
         field: None,
         reason: format!("cannot be read: {e}"),
     })?;
-    let value: Value = serde_json::from_str(&text).map_err(|e| SceneError {
-        file: Some(path.to_path_buf()),
+    let folder = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    parse_text(&text, &folder).map_err(|e| e.in_path(path))
+}
+
+/// Validate a sweep given as JSON text; a `scene` path is read relative to
+/// `folder`.
+pub fn parse_text(text: &str, folder: &Path) -> Result<Sweep, SceneError> {
+    let value: Value = serde_json::from_str(text).map_err(|e| SceneError {
+        file: None,
         field: None,
         reason: format!("is not valid JSON: {e}"),
     })?;
-    let folder = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    parse(&value, &folder).map_err(|e| e.in_path(path))
+    parse(&value, folder)
 }
 
 fn parse(value: &Value, folder: &Path) -> Result<Sweep, SceneError> {

@@ -36,6 +36,16 @@ impl fmt::Display for LogError {
 
 impl std::error::Error for LogError {}
 
+/// One line of a log, or why it is not an event record.
+pub fn parse_line(line: &str) -> Result<LoggedEvent, String> {
+    let event: LoggedEvent =
+        serde_json::from_str(line).map_err(|e| format!("is not an event record: {e}"))?;
+    if !event.t.is_finite() {
+        return Err(format!("has a non-finite time {}", event.t));
+    }
+    Ok(event)
+}
+
 /// Call `visit` with each event of the log at `path` and its raw line.
 pub fn for_each_event(
     path: &Path,
@@ -62,14 +72,7 @@ pub fn for_each_event(
         if line.is_empty() {
             continue;
         }
-        let event: LoggedEvent = serde_json::from_str(line)
-            .map_err(|e| error(Some(number), format!("is not an event record: {e}")))?;
-        if !event.t.is_finite() {
-            return Err(error(
-                Some(number),
-                format!("has a non-finite time {}", event.t),
-            ));
-        }
+        let event = parse_line(line).map_err(|reason| error(Some(number), reason))?;
         visit(&event, line);
     }
 }

@@ -1,0 +1,20 @@
+//! The scene parser and validator on arbitrary text: an error or a scene,
+//! never a panic. A valid scene is also checked with `flicker check`'s
+//! closed form (energy, regime) and run briefly.
+#![no_main]
+
+use flicker::runner::{Control, run};
+use flicker::scene::{self, Scene};
+use libfuzzer_sys::fuzz_target;
+
+fuzz_target!(|data: &[u8]| {
+    let Ok(text) = std::str::from_utf8(data) else { return };
+    let Ok(mut scene) = scene::parse(text) else { return };
+    // Keep runs short: the fuzzer is after panics, not long simulations.
+    let Scene::Mechanism(m) = &scene;
+    let t_end = m.t_end.min(10.0);
+    if scene.set_t_end(t_end).is_ok() {
+        let control = Control { stop: None, max_wall_seconds: Some(0.05) };
+        let _ = run(&scene, &control, &mut ());
+    }
+});
