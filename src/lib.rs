@@ -61,6 +61,7 @@ pub mod compare;
 pub mod engine;
 pub mod log;
 pub mod models;
+pub mod plot;
 pub mod runner;
 pub mod scene;
 pub mod stress;

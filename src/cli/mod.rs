@@ -4,6 +4,7 @@ pub mod check;
 pub mod compare;
 pub mod events;
 pub mod exit;
+pub mod plot;
 pub mod progress;
 pub mod run;
 pub mod stress;
@@ -87,6 +88,11 @@ enum Command {
         #[arg(long, value_name = "FILE")]
         out: PathBuf,
     },
+    /// Draw pictures.
+    Plot {
+        #[command(subcommand)]
+        what: plot::PlotCommand,
+    },
     /// Validate a scene without running it, and say what it describes.
     Check {
         /// The scene file (JSON).
@@ -141,6 +147,7 @@ pub fn dispatch(cli: Cli) -> Result<Code, Failure> {
             out,
         } => sweep::merge(&file, &shards, &out),
         Command::Check { scene } => check::check(&scene),
+        Command::Plot { what } => plot::plot(what),
         Command::Events {
             log,
             guard,

@@ -3,10 +3,8 @@
 //! font, so a machine without system fonts draws text too.
 
 use std::path::Path;
-use std::sync::Once;
 
 use plotters::prelude::*;
-use plotters::style::{FontStyle, register_font};
 
 use crate::compare::Row;
 
@@ -22,18 +20,9 @@ const COLOURS: [RGBColor; 6] = [
     RGBColor(23, 190, 207),
 ];
 
-/// Register the bundled DejaVu Sans as the `sans-serif` family, once.
-pub fn register_fonts() {
-    static ONCE: Once = Once::new();
-    ONCE.call_once(|| {
-        // The bytes are a valid TrueType font shipped by the dejavu crate.
-        let _ = register_font("sans-serif", FontStyle::Normal, dejavu::sans::regular());
-    });
-}
-
 /// Draw `rows` (failed runs left out) to `path`, titled `title`.
 pub fn draw(rows: &[Row], title: &str, path: &Path) -> Result<(), String> {
-    register_fonts();
+    crate::plot::register_fonts();
     let png = path.extension().is_some_and(|e| e == "png");
     if png {
         draw_on(

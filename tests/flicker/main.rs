@@ -9,6 +9,7 @@ mod event_location;
 mod invariants;
 mod mechanism_angle;
 mod mechanism_strain;
+mod phase;
 mod reproducible;
 mod scenes;
 mod schemas;

@@ -130,6 +130,16 @@ impl AngleMechanism {
         }
     }
 
+    /// `(theta, theta')` of a state in any mode (infinite rate at
+    /// `theta = 0`, which only the strain chart reaches).
+    pub fn angle(&self, mode: Mode, x: &[f64]) -> (f64, f64) {
+        if is_strain_chart(mode) {
+            angle_of_strain(x[0], x[1], side(mode))
+        } else {
+            (x[0], x[1])
+        }
+    }
+
     /// `(eps, eps')` of a state in any mode.
     pub fn strain(&self, mode: Mode, x: &[f64]) -> (f64, f64) {
         if is_strain_chart(mode) {

@@ -1,0 +1,149 @@
+//! Drawing a figure of curves: SVG, or PNG by the file's extension.
+
+use std::path::Path;
+
+use plotters::prelude::*;
+
+/// How a curve is drawn.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Style {
+    /// A level set of a first integral.
+    Level,
+    /// The separatrix.
+    Separatrix,
+    /// A jump of the state (the flipped strain rate), dashed.
+    Jump,
+    /// A trajectory simulated by the engine, as dots.
+    Simulated,
+    /// The edge of the admissible region.
+    Constraint,
+}
+
+/// One curve, with the label drawn at its start (if any).
+#[derive(Debug, Clone)]
+pub struct Curve {
+    pub label: Option<String>,
+    pub points: Vec<(f64, f64)>,
+    pub style: Style,
+}
+
+/// A whole figure.
+#[derive(Debug, Clone)]
+pub struct Figure {
+    pub title: String,
+    pub x_label: String,
+    pub y_label: String,
+    pub curves: Vec<Curve>,
+    /// Points with `|y|` above this are left out (rates that diverge).
+    pub y_limit: Option<f64>,
+}
+
+impl Figure {
+    /// Draw to `path`: PNG if it ends in `.png`, SVG otherwise.
+    pub fn draw(&self, path: &Path) -> Result<(), String> {
+        crate::plot::register_fonts();
+        if path.extension().is_some_and(|e| e == "png") {
+            self.draw_on(BitMapBackend::new(path, (1000, 760)).into_drawing_area())
+        } else {
+            self.draw_on(SVGBackend::new(path, (1000, 760)).into_drawing_area())
+        }
+    }
+
+    fn draw_on<DB: DrawingBackend>(
+        &self,
+        area: DrawingArea<DB, plotters::coord::Shift>,
+    ) -> Result<(), String>
+    where
+        DB::ErrorType: 'static,
+    {
+        let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+        let limit = self.y_limit.unwrap_or(f64::INFINITY);
+        let shown = |&(x, y): &(f64, f64)| x.is_finite() && y.is_finite() && y.abs() <= limit;
+        let all = self
+            .curves
+            .iter()
+            .flat_map(|c| c.points.iter())
+            .filter(|p| shown(p));
+        let (mut x0, mut x1, mut y0, mut y1) = (
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        );
+        for &(x, y) in all {
+            (x0, x1, y0, y1) = (x0.min(x), x1.max(x), y0.min(y), y1.max(y));
+        }
+        if !(x0 < x1 && y0 < y1) {
+            return Err("nothing to draw".into());
+        }
+        let (dx, dy) = (0.05 * (x1 - x0), 0.05 * (y1 - y0));
+        area.fill(&WHITE).map_err(err)?;
+        let mut chart = ChartBuilder::on(&area)
+            .caption(&self.title, ("sans-serif", 24))
+            .margin(20)
+            .x_label_area_size(50)
+            .y_label_area_size(70)
+            .build_cartesian_2d((x0 - dx)..(x1 + dx), (y0 - dy)..(y1 + dy))
+            .map_err(err)?;
+        chart
+            .configure_mesh()
+            .x_desc(&self.x_label)
+            .y_desc(&self.y_label)
+            .label_style(("sans-serif", 15))
+            .light_line_style(WHITE)
+            .draw()
+            .map_err(err)?;
+        let blue = RGBColor(31, 119, 180);
+        let red = RGBColor(214, 39, 40);
+        let grey = RGBColor(120, 120, 120);
+        let orange = RGBColor(255, 127, 14);
+        for curve in &self.curves {
+            let points: Vec<(f64, f64)> = curve.points.iter().copied().filter(shown).collect();
+            match curve.style {
+                Style::Level => {
+                    chart
+                        .draw_series(LineSeries::new(points.clone(), blue.stroke_width(1)))
+                        .map_err(err)?;
+                }
+                Style::Separatrix => {
+                    chart
+                        .draw_series(LineSeries::new(points.clone(), red.stroke_width(2)))
+                        .map_err(err)?;
+                }
+                Style::Constraint => {
+                    chart
+                        .draw_series(LineSeries::new(points.clone(), grey.stroke_width(1)))
+                        .map_err(err)?;
+                }
+                Style::Jump => {
+                    chart
+                        .draw_series(DashedLineSeries::new(
+                            points.clone(),
+                            6,
+                            4,
+                            blue.stroke_width(1),
+                        ))
+                        .map_err(err)?;
+                }
+                Style::Simulated => {
+                    chart
+                        .draw_series(points.iter().map(|p| Circle::new(*p, 2, orange.filled())))
+                        .map_err(err)?;
+                }
+            }
+            // Labels sit at the top of their curve, where level sets are apart.
+            let top = points.iter().copied().max_by(|a, b| a.1.total_cmp(&b.1));
+            if let (Some(label), Some(top)) = (&curve.label, top) {
+                let at = (top.0, top.1 + 0.01 * (y1 - y0));
+                chart
+                    .draw_series(std::iter::once(Text::new(
+                        label.clone(),
+                        at,
+                        ("sans-serif", 13).into_font(),
+                    )))
+                    .map_err(err)?;
+            }
+        }
+        area.present().map_err(err)
+    }
+}
