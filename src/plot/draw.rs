@@ -131,10 +131,15 @@ impl Figure {
                         .map_err(err)?;
                 }
             }
-            // Labels sit at the top of their curve, where level sets are apart.
-            let top = points.iter().copied().max_by(|a, b| a.1.total_cmp(&b.1));
-            if let (Some(label), Some(top)) = (&curve.label, top) {
-                let at = (top.0, top.1 + 0.01 * (y1 - y0));
+            // Labels sit at the upper-right end of their curve, where nested
+            // level sets are furthest apart.
+            let reach = |p: &(f64, f64)| (p.0 - x0) / (x1 - x0) + (p.1 - y0) / (y1 - y0);
+            let corner = points
+                .iter()
+                .copied()
+                .max_by(|a, b| reach(a).total_cmp(&reach(b)));
+            if let (Some(label), Some(corner)) = (&curve.label, corner) {
+                let at = (corner.0, corner.1 + 0.01 * (y1 - y0));
                 chart
                     .draw_series(std::iter::once(Text::new(
                         label.clone(),

@@ -70,9 +70,14 @@ impl Portrait {
             } else {
                 Style::Level
             };
-            let label = Some(match plane {
+            let value = match plane {
                 Plane::Linear { f1 } => format!("h1 = {:.3}", h1_of(level, f1, mechanism.omega)),
                 _ => format!("H0 = {level:.4}"),
+            };
+            let label = Some(if style == Style::Separatrix {
+                format!("separatrix, {value}")
+            } else {
+                value
             });
             curves.extend(level_set(mechanism, plane, level, label, style));
         }
