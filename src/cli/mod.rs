@@ -89,9 +89,13 @@ enum Command {
         out: PathBuf,
     },
     /// Draw pictures.
+    #[command(args_conflicts_with_subcommands = true)]
     Plot {
         #[command(subcommand)]
-        what: plot::PlotCommand,
+        what: Option<plot::PlotCommand>,
+        /// A run's output directory: draws energy.svg and intervals.svg
+        /// from events.jsonl, compare.svg from compare.csv.
+        dir: Option<PathBuf>,
     },
     /// Validate a scene without running it, and say what it describes.
     Check {
@@ -147,7 +151,19 @@ pub fn dispatch(cli: Cli) -> Result<Code, Failure> {
             out,
         } => sweep::merge(&file, &shards, &out),
         Command::Check { scene } => check::check(&scene),
-        Command::Plot { what } => plot::plot(what),
+        Command::Plot {
+            what: Some(what), ..
+        } => plot::plot(what),
+        Command::Plot {
+            what: None,
+            dir: Some(dir),
+        } => plot::plot_dir(&dir),
+        Command::Plot {
+            what: None,
+            dir: None,
+        } => Err(Failure::bad_input(
+            "plot: give a run's directory, or `plot phase ...`",
+        )),
         Command::Events {
             log,
             guard,

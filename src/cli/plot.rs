@@ -1,7 +1,7 @@
 //! `flicker plot phase`: phase portraits of the mechanism, level sets and
 //! simulated trajectories together.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use flicker::models::mechanism::Mechanism;
 use flicker::plot::phase::{Plane, Portrait};
@@ -30,6 +30,14 @@ pub enum PlotCommand {
         #[arg(long, value_name = "FILE")]
         out: PathBuf,
     },
+}
+
+/// `flicker plot DIR`: the pictures of what a run wrote.
+pub fn plot_dir(dir: &Path) -> Result<Code, Failure> {
+    let written = flicker::plot::run::plot_run(dir).map_err(Failure::bad_input)?;
+    let names: Vec<String> = written.iter().map(|p| p.display().to_string()).collect();
+    println!("wrote {}", names.join(", "));
+    Ok(Code::Ok)
 }
 
 pub fn plot(command: PlotCommand) -> Result<Code, Failure> {

@@ -11,7 +11,7 @@ pub mod reference;
 use std::path::Path;
 use std::time::Instant;
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::engine::{EventTimes, Status};
 use crate::runner;
@@ -25,7 +25,7 @@ pub const TOLERANCES: [f64; 9] = [1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-
 pub const STEP_FRACTIONS: [f64; 6] = [1e-1, 3e-2, 1e-2, 3e-3, 1e-3, 3e-4];
 
 /// One run of one method at one setting.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Row {
     pub method: String,
     pub tolerance: Option<f64>,
@@ -87,6 +87,11 @@ pub fn compare(
         }
     }
     Ok((reference, rows))
+}
+
+/// Read rows back from a `compare.csv`.
+pub fn read_csv(path: &Path) -> Result<Vec<Row>, csv::Error> {
+    csv::Reader::from_path(path)?.deserialize().collect()
 }
 
 /// Write `rows` as CSV to `path`.

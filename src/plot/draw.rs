@@ -85,10 +85,14 @@ impl Figure {
             .y_label_area_size(70)
             .build_cartesian_2d((x0 - dx)..(x1 + dx), (y0 - dy)..(y1 + dy))
             .map_err(err)?;
+        let x_format = tick_format(x0.abs().max(x1.abs()));
+        let y_format = tick_format(y0.abs().max(y1.abs()));
         chart
             .configure_mesh()
             .x_desc(&self.x_label)
             .y_desc(&self.y_label)
+            .x_label_formatter(&x_format)
+            .y_label_formatter(&y_format)
             .label_style(("sans-serif", 15))
             .light_line_style(WHITE)
             .draw()
@@ -150,5 +154,19 @@ impl Figure {
             }
         }
         area.present().map_err(err)
+    }
+}
+
+/// Tick labels: plain decimals for ordinary magnitudes, exponents for tiny
+/// or huge ones (energy errors of 1e-10 must not all read 0.0).
+fn tick_format(largest: f64) -> impl Fn(&f64) -> String {
+    let scientific = largest != 0.0 && !(1e-2..1e4).contains(&largest);
+    move |v: &f64| {
+        if scientific {
+            format!("{v:.1e}")
+        } else {
+            let text = format!("{v:.3}");
+            text.trim_end_matches('0').trim_end_matches('.').to_string()
+        }
     }
 }

@@ -1,8 +1,10 @@
-//! Pictures: phase portraits of the mechanism ([`phase`]) drawn with a
-//! bundled font ([`draw`]), so a machine without system fonts draws text.
+//! Pictures: phase portraits of the mechanism ([`phase`]) and what a run
+//! wrote ([`run`]), drawn with a bundled font ([`draw`]), so a machine
+//! without system fonts draws text.
 
 pub mod draw;
 pub mod phase;
+pub mod run;
 
 use std::sync::Once;
 

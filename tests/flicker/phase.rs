@@ -128,3 +128,42 @@ fn plot_phase_draws_and_refuses_bad_flags() {
     ]);
     assert_eq!(bad_plane.status.code(), Some(2));
 }
+
+#[test]
+fn plot_dir_draws_what_a_run_wrote() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("run");
+    let scene = crate::support::models("mechanism_angle.json");
+    assert!(
+        flicker(&["run", &scene, "--out", out.to_str().unwrap(), "--quiet"])
+            .status
+            .success()
+    );
+    let drawn = flicker(&["plot", out.to_str().unwrap()]);
+    assert_eq!(
+        drawn.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&drawn.stderr)
+    );
+    for name in ["energy.svg", "energy.png", "intervals.svg", "intervals.png"] {
+        assert!(
+            std::fs::metadata(out.join(name)).unwrap().len() > 1000,
+            "{name}"
+        );
+    }
+    let svg = std::fs::read_to_string(out.join("energy.svg")).unwrap();
+    assert!(svg.contains("energy across events") && svg.contains("time t"));
+    // One dot per impact with an energy on both sides.
+    let impacts = std::fs::read_to_string(out.join("events.jsonl"))
+        .unwrap()
+        .lines()
+        .count();
+    assert_eq!(svg.matches("<circle").count(), impacts);
+    let empty = dir.path().join("empty");
+    std::fs::create_dir(&empty).unwrap();
+    assert_eq!(
+        flicker(&["plot", empty.to_str().unwrap()]).status.code(),
+        Some(2)
+    );
+}
