@@ -18,16 +18,18 @@ pub fn check(path: &Path) -> Result<Code, Failure> {
                 Formulation::Strain => "strain formulation",
                 Formulation::Angle(_) => "angle formulation",
             };
-            println!(
+            say!(
                 "{}: a valid mechanism scene ({formulation}, method {})",
                 path.display(),
                 m.method.name()
             );
-            println!(
+            say!(
                 "  eta {}, omega {}, t_end {}",
-                m.mechanism.eta, m.mechanism.omega, m.t_end
+                m.mechanism.eta,
+                m.mechanism.omega,
+                m.t_end
             );
-            println!(
+            say!(
                 "  initial strain {eps:e}, strain rate {rate:e}, energy H0 = {h0:e}: {}",
                 regime(m.mechanism, h0, m.t_end)
             );

@@ -71,9 +71,9 @@ pub fn compare(
             .map_err(|e| Failure::untrusted(format!("{}: {e}", path.display())))?;
         written.push(path);
     }
-    println!("reference: {}", reference.kind);
+    say!("reference: {}", reference.kind);
     let names: Vec<String> = written.iter().map(|p| p.display().to_string()).collect();
-    println!("wrote {}", names.join(", "));
+    say!("wrote {}", names.join(", "));
     Ok(Code::Ok)
 }
 

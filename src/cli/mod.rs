@@ -1,5 +1,22 @@
 //! Command-line arguments and their dispatch to subcommands.
 
+/// `println!` that ignores a closed stdout (`flicker ... | head`): what the
+/// reader chose not to read is no error, and must not panic.
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($arg)*);
+    }};
+}
+
+/// `print!` likewise.
+macro_rules! say_raw {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = write!(std::io::stdout(), $($arg)*);
+    }};
+}
+
 pub mod check;
 pub mod compare;
 pub mod events;

@@ -36,7 +36,7 @@ pub enum PlotCommand {
 pub fn plot_dir(dir: &Path) -> Result<Code, Failure> {
     let written = flicker::plot::run::plot_run(dir).map_err(Failure::bad_input)?;
     let names: Vec<String> = written.iter().map(|p| p.display().to_string()).collect();
-    println!("wrote {}", names.join(", "));
+    say!("wrote {}", names.join(", "));
     Ok(Code::Ok)
 }
 
@@ -86,7 +86,7 @@ pub fn plot(command: PlotCommand) -> Result<Code, Failure> {
         .figure
         .draw(&out)
         .map_err(|e| Failure::untrusted(format!("{}: {e}", out.display())))?;
-    println!(
+    say!(
         "wrote {} (level sets and simulated trajectories agree to {:.1e})",
         out.display(),
         portrait.largest_mismatch()

@@ -114,13 +114,18 @@ pub fn run(args: RunArgs) -> Result<Code, Failure> {
             WithProgress::new(JsonlWriter::new(BufWriter::new(file)), scene.t_end(), quiet);
         let report = run_scene(&scene, &control, &mut observer);
         observer.finish();
-        let report = report.map_err(|e| Failure::bad_input(e.in_path(scene_path)))?;
-        observer.inner.flush().map_err(|e| {
-            Failure::untrusted(format!(
-                "{}: the event log could not be written: {e}",
+        let mut report = report.map_err(|e| Failure::bad_input(e.in_path(scene_path)))?;
+        // A log that could not be written spoils the run, but its summary
+        // still says how far it got and why it stopped.
+        if let Err(e) = observer.inner.flush()
+            && report.outcome.status != Status::Failed
+        {
+            report.outcome.status = Status::Failed;
+            report.outcome.reason = Some(format!(
+                "could not write the event log {}: {e}",
                 log_path.display()
-            ))
-        })?;
+            ));
+        }
         report
     } else {
         let mut observer = WithProgress::new((), scene.t_end(), quiet);
@@ -164,16 +169,16 @@ fn model_name(scene: &Scene) -> &'static str {
 
 fn print_report(report: &Report, scene: &Scene, summary: &Path, log: Option<&Path>) {
     let o = &report.outcome;
-    println!(
+    say!(
         "{} {} at t = {} of {}",
         model_name(scene),
         o.status.as_str(),
         o.t_reached,
         o.t_end
     );
-    println!("  method: {} ({})", report.method, report.description);
+    say!("  method: {} ({})", report.method, report.description);
     if let Some(reason) = &o.reason {
-        println!("  reason: {reason}");
+        say!("  reason: {reason}");
     }
     let by_guard: Vec<String> = o
         .events_by_guard
@@ -181,21 +186,21 @@ fn print_report(report: &Report, scene: &Scene, summary: &Path, log: Option<&Pat
         .map(|(g, n)| format!("{g}: {n}"))
         .collect();
     if by_guard.is_empty() {
-        println!("  events: none");
+        say!("  events: none");
     } else {
-        println!("  events: {} ({})", o.events, by_guard.join(", "));
+        say!("  events: {} ({})", o.events, by_guard.join(", "));
     }
     if let (Some(e0), Some(e1), Some(err)) = (o.energy_initial, o.energy_final, o.max_energy_error)
     {
-        println!("  energy: initial {e0:e}, final {e1:e}, largest relative error {err:.2e}");
+        say!("  energy: initial {e0:e}, final {e1:e}, largest relative error {err:.2e}");
     }
     let state: Vec<String> = report
         .final_state
         .iter()
         .map(|(n, x)| format!("{n} = {x:e}"))
         .collect();
-    println!("  final state: {}", state.join(", "));
-    println!(
+    say!("  final state: {}", state.join(", "));
+    say!(
         "  wrote {}{}",
         summary.display(),
         log.map_or(String::new(), |l| format!(" and {}", l.display()))

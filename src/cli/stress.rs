@@ -26,7 +26,7 @@ pub fn stress(dir: &Path, wall_seconds: f64, as_markdown: bool) -> Result<Code, 
         }
     }
     if as_markdown {
-        print!("{}", markdown(&rows));
+        say_raw!("{}", markdown(&rows));
     }
     let wrong = rows
         .iter()

@@ -57,7 +57,7 @@ pub fn sweep(
         .iter()
         .filter(|r| r.status != "completed" && !r.status.starts_with("zeno"))
         .count();
-    println!(
+    say!(
         "{} points of {} in {seconds:.3} s on {} threads ({failed} not completed); wrote {}",
         rows.len(),
         spec.points(),
@@ -72,6 +72,6 @@ pub fn merge(file: &Path, shards: &[PathBuf], out: &Path) -> Result<Code, Failur
     let text = sweep::merge(&spec, shards).map_err(Failure::bad_input)?;
     std::fs::write(out, text)
         .map_err(|e| Failure::untrusted(format!("{}: cannot be written: {e}", out.display())))?;
-    println!("merged {} shards into {}", shards.len(), out.display());
+    say!("merged {} shards into {}", shards.len(), out.display());
     Ok(Code::Ok)
 }

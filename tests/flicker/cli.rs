@@ -325,44 +325,70 @@ fn events_refuses_a_broken_log_naming_the_line() {
 
 #[test]
 fn an_interrupted_run_keeps_its_log_and_says_so() {
+    for signal in ["-INT", "-TERM"] {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("run");
+        let child = Command::new(env!("CARGO_BIN_EXE_flicker"))
+            .args([
+                "run",
+                &models("mechanism_impacting.json"),
+                "--t-end",
+                "4e7",
+                "--out",
+                out.to_str().unwrap(),
+            ])
+            .stdout(std::process::Stdio::null())
+            .spawn()
+            .unwrap();
+        // Wait until the run is writing, then interrupt it.
+        let log = out.join("events.jsonl");
+        let deadline = std::time::Instant::now() + std::time::Duration::from_secs(30);
+        while std::fs::metadata(&log).map_or(0, |m| m.len()) == 0
+            && std::time::Instant::now() < deadline
+        {
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+        let killed = Command::new("kill")
+            .args([signal, &child.id().to_string()])
+            .status()
+            .unwrap();
+        assert!(killed.success());
+        let result = child.wait_with_output().unwrap();
+        assert_eq!(result.status.code(), Some(130), "{signal}");
+        let summary = read_json(&out.join("summary.json"));
+        assert_eq!(summary["status"], "interrupted");
+        assert!(summary["t_reached"].as_f64().unwrap() < 4e7);
+        let text = std::fs::read_to_string(&log).unwrap();
+        assert!(text.ends_with('\n'));
+        let lines = text.lines().count() as u64;
+        assert_eq!(lines, summary["events"].as_u64().unwrap());
+        let last: Value = serde_json::from_str(text.lines().last().unwrap()).unwrap();
+        assert_eq!(last["t"], summary["t_reached"]);
+    }
+}
+
+#[test]
+fn a_full_disk_ends_the_run_with_a_clear_message() {
+    // The log is a link to /dev/full, where every write fails with ENOSPC.
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("run");
-    let child = Command::new(env!("CARGO_BIN_EXE_flicker"))
-        .args([
-            "run",
-            &models("mechanism_impacting.json"),
-            "--t-end",
-            "4e7",
-            "--out",
-            out.to_str().unwrap(),
-        ])
-        .stdout(std::process::Stdio::null())
-        .spawn()
-        .unwrap();
-    // Wait until the run is writing, then interrupt it.
-    let log = out.join("events.jsonl");
-    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(30);
-    while std::fs::metadata(&log).map_or(0, |m| m.len()) == 0
-        && std::time::Instant::now() < deadline
-    {
-        std::thread::sleep(std::time::Duration::from_millis(20));
-    }
-    let killed = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
-        .status()
-        .unwrap();
-    assert!(killed.success());
-    let result = child.wait_with_output().unwrap();
-    assert_eq!(result.status.code(), Some(130));
+    std::fs::create_dir(&out).unwrap();
+    std::os::unix::fs::symlink("/dev/full", out.join("events.jsonl")).unwrap();
+    let result = flicker(&[
+        "run",
+        &models("mechanism_impacting.json"),
+        "--t-end",
+        "1e6",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(result.status.code(), Some(3));
     let summary = read_json(&out.join("summary.json"));
-    assert_eq!(summary["status"], "interrupted");
-    assert!(summary["t_reached"].as_f64().unwrap() < 4e7);
-    let text = std::fs::read_to_string(&log).unwrap();
-    assert!(text.ends_with('\n'));
-    let lines = text.lines().count() as u64;
-    assert_eq!(lines, summary["events"].as_u64().unwrap());
-    let last: Value = serde_json::from_str(text.lines().last().unwrap()).unwrap();
-    assert_eq!(last["t"], summary["t_reached"]);
+    assert_eq!(summary["status"], "failed");
+    let reason = summary["reason"].as_str().unwrap();
+    assert!(reason.contains("could not write the event log"), "{reason}");
+    // It stopped at the first full buffer, not at t_end.
+    assert!(summary["t_reached"].as_f64().unwrap() < 1e6);
 }
 
 #[test]
@@ -395,4 +421,32 @@ fn events_exports_csv_with_one_row_per_kept_event() {
     }
     let both = flicker(&["events", log.to_str().unwrap(), "--csv", "--summary"]);
     assert_eq!(both.status.code(), Some(2));
+}
+
+#[test]
+fn a_closed_stdout_is_not_a_crash() {
+    // `flicker run ... | head -1`: the reader goes away; the run must still
+    // finish its files and exit normally, not panic.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("run");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_flicker"))
+        .args([
+            "run",
+            &models("mechanism_impacting.json"),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let result = child.wait_with_output().unwrap();
+    assert_eq!(
+        result.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&result.stderr)
+    );
+    assert_eq!(read_json(&out.join("summary.json"))["status"], "completed");
 }
