@@ -117,7 +117,8 @@ pub fn run(args: RunArgs) -> Result<Code, Failure> {
         let mut report = report.map_err(|e| Failure::bad_input(e.in_path(scene_path)))?;
         // A log that could not be written spoils the run, but its summary
         // still says how far it got and why it stopped.
-        if let Err(e) = observer.inner.flush()
+        let flushed = observer.inner.flush();
+        if let Err(e) = &flushed
             && report.outcome.status != Status::Failed
         {
             report.outcome.status = Status::Failed;
@@ -125,6 +126,11 @@ pub fn run(args: RunArgs) -> Result<Code, Failure> {
                 "could not write the event log {}: {e}",
                 log_path.display()
             ));
+        }
+        if report.outcome.status == Status::Failed {
+            // A write that failed half way (a full disk) may have left part
+            // of a line: cut the log back to its last whole line.
+            let _ = flicker::log::writer::cut_to_last_line(&log_path);
         }
         report
     } else {

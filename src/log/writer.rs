@@ -108,9 +108,52 @@ impl<W: Write> Observer for JsonlWriter<W> {
     }
 }
 
+/// Truncate the file at `path` after its last newline, so that a log cut
+/// short by a failed write still parses line by line.
+pub fn cut_to_last_line(path: &std::path::Path) -> io::Result<()> {
+    use std::io::{Read, Seek, SeekFrom};
+    let mut file = std::fs::OpenOptions::new()
+        .read(true)
+        .write(true)
+        .open(path)?;
+    let len = file.metadata()?.len();
+    // Lines are short: the last newline is within the final 64 KiB.
+    let start = len.saturating_sub(1 << 16);
+    file.seek(SeekFrom::Start(start))?;
+    let mut tail = Vec::new();
+    file.read_to_end(&mut tail)?;
+    let keep = match tail.iter().rposition(|b| *b == b'\n') {
+        Some(i) => start + i as u64 + 1,
+        None if start == 0 => 0,
+        None => return Ok(()),
+    };
+    if keep < len {
+        file.set_len(keep)
+    } else {
+        Ok(())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_half_written_line_is_cut_off() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("events.jsonl");
+        std::fs::write(&path, "{\"seq\":1}\n{\"seq\":2}\n{\"se").unwrap();
+        cut_to_last_line(&path).unwrap();
+        assert_eq!(
+            std::fs::read_to_string(&path).unwrap(),
+            "{\"seq\":1}\n{\"seq\":2}\n"
+        );
+        cut_to_last_line(&path).unwrap();
+        assert_eq!(
+            std::fs::read_to_string(&path).unwrap(),
+            "{\"seq\":1}\n{\"seq\":2}\n"
+        );
+    }
 
     #[test]
     fn lines_are_json_with_the_documented_keys() {
