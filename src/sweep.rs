@@ -29,7 +29,7 @@ use crate::scene::fields::Fields;
 use crate::scene::{self, Scene, SceneError};
 
 /// The largest grid a sweep file may describe.
-const MAX_POINTS: usize = 1 << 32;
+const MAX_POINTS: usize = 100_000_000;
 
 /// One axis of the grid.
 #[derive(Debug, Clone, PartialEq)]
@@ -193,6 +193,13 @@ fn axis(value: &Value, path: &str) -> Result<Axis, SceneError> {
         let count = f
             .optional_count("count")?
             .ok_or_else(|| SceneError::field(&f.path("count"), "is missing".into()))?;
+        // Checked before the values are made: a huge count must not allocate.
+        if count > MAX_POINTS as u64 {
+            return Err(SceneError::field(
+                &f.path("count"),
+                format!("must be at most {MAX_POINTS}"),
+            ));
+        }
         let log = match f.optional_string("spacing")? {
             None | Some("linear") => false,
             Some("log") if from > 0.0 && to > 0.0 => true,

@@ -116,7 +116,13 @@ pub fn cut_to_last_line(path: &std::path::Path) -> io::Result<()> {
         .read(true)
         .write(true)
         .open(path)?;
-    let len = file.metadata()?.len();
+    let metadata = file.metadata()?;
+    // Only a regular file has an end to cut back to (not /dev/full, whose
+    // reads never end).
+    if !metadata.is_file() {
+        return Ok(());
+    }
+    let len = metadata.len();
     // Lines are short: the last newline is within the final 64 KiB.
     let start = len.saturating_sub(1 << 16);
     file.seek(SeekFrom::Start(start))?;

@@ -6,6 +6,7 @@ mod compare;
 mod convergence;
 mod engine_generic;
 mod event_location;
+mod fuzz_regressions;
 mod invariants;
 mod mechanism_angle;
 mod mechanism_strain;
