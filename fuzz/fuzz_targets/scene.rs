@@ -8,13 +8,20 @@ use flicker::scene::{self, Scene};
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
-    let Ok(text) = std::str::from_utf8(data) else { return };
-    let Ok(mut scene) = scene::parse(text) else { return };
+    let Ok(text) = std::str::from_utf8(data) else {
+        return;
+    };
+    let Ok(mut scene) = scene::parse(text) else {
+        return;
+    };
     // Keep runs short: the fuzzer is after panics, not long simulations.
     let Scene::Mechanism(m) = &scene;
     let t_end = m.t_end.min(10.0);
     if scene.set_t_end(t_end).is_ok() {
-        let control = Control { stop: None, max_wall_seconds: Some(0.05) };
+        let control = Control {
+            stop: None,
+            max_wall_seconds: Some(0.05),
+        };
         let _ = run(&scene, &control, &mut ());
     }
 });

@@ -5,9 +5,15 @@
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
-    let Ok(text) = std::str::from_utf8(data) else { return };
-    let Ok(sweep) = flicker::sweep::parse_text(text, std::path::Path::new("/nonexistent")) else { return };
+    let Ok(text) = std::str::from_utf8(data) else {
+        return;
+    };
+    let Ok(sweep) = flicker::sweep::parse_text(text, std::path::Path::new("/nonexistent")) else {
+        return;
+    };
     for point in 0..sweep.points().min(4) {
-        let _ = sweep.scene_at(point).map(|v| flicker::scene::from_value(&v));
+        let _ = sweep
+            .scene_at(point)
+            .map(|v| flicker::scene::from_value(&v));
     }
 });
