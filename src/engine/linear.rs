@@ -24,9 +24,20 @@ pub struct Linear {
     h: f64,
     y0: DVector<f64>,
     y1: Vec<f64>,
+    /// `exp(M h / GRID)` for the step length `h` it was made for: event
+    /// location samples the step at multiples of `h / GRID`, so the states
+    /// there come from powers of it, without a matrix exponential each.
+    /// With it, `exp(M h)` itself, which takes the step to its end in one
+    /// product (no rounding piled up over `GRID` products).
+    grid_propagator: Option<(f64, DMatrix<f64>, DMatrix<f64>)>,
+    /// The states at `k h / GRID`, `k = 0..=GRID`, of the current step.
+    grid: Vec<DVector<f64>>,
     /// Propagator evaluations; a `Cell` because evaluation reads `&self`.
     evaluations: Cell<u64>,
 }
+
+/// Points per step whose states are kept (see `Linear::grid`).
+const GRID: usize = 8;
 
 impl Linear {
     pub fn new(dimension: usize) -> Self {
@@ -37,6 +48,8 @@ impl Linear {
             h: 0.0,
             y0: DVector::zeros(dimension + 1),
             y1: vec![0.0; dimension],
+            grid_propagator: None,
+            grid: Vec::new(),
             evaluations: Cell::new(0),
         }
     }
@@ -80,13 +93,32 @@ impl Linear {
                 f64::INFINITY
             };
             self.mode = Some(mode);
+            self.grid_propagator = None;
         }
         self.y0.rows_mut(0, y0.len()).copy_from_slice(y0);
         self.y0[y0.len()] = 1.0;
         self.h = self.h_bound.min(h_max);
-        let mut y1 = std::mem::take(&mut self.y1);
-        self.eval(self.h, &mut y1);
-        self.y1 = y1;
+        if self
+            .grid_propagator
+            .as_ref()
+            .is_none_or(|(h, _, _)| *h != self.h)
+        {
+            let part = (&self.augmented * (self.h / GRID as f64)).exp();
+            let whole = (&self.augmented * self.h).exp();
+            self.evaluations.set(self.evaluations.get() + 2);
+            self.grid_propagator = Some((self.h, part, whole));
+        }
+        if let Some((_, part, whole)) = &self.grid_propagator {
+            self.grid.clear();
+            self.grid.push(self.y0.clone());
+            for k in 1..GRID {
+                let next = part * &self.grid[k - 1];
+                self.grid.push(next);
+            }
+            self.grid.push(whole * &self.y0);
+        }
+        let n = y0.len();
+        self.y1.copy_from_slice(&self.grid[GRID].as_slice()[..n]);
         if self.y1.iter().any(|x| !x.is_finite()) {
             return Err(StepFailure::NonFinite);
         }
@@ -95,6 +127,13 @@ impl Linear {
 
     /// The exact state `tau` after the step's start.
     pub fn eval(&self, tau: f64, x: &mut [f64]) {
+        let k = (tau / self.h * GRID as f64).round();
+        if (0.0..=GRID as f64).contains(&k)
+            && (tau - k * self.h / GRID as f64).abs() <= 4.0 * f64::EPSILON * self.h
+        {
+            x.copy_from_slice(&self.grid[k as usize].as_slice()[..x.len()]);
+            return;
+        }
         let propagator = (&self.augmented * tau).exp();
         let y = propagator * &self.y0;
         x.copy_from_slice(&y.as_slice()[..x.len()]);
