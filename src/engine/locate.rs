@@ -184,10 +184,13 @@ fn scan_piece(
             if left.crossing.is_some() {
                 return left;
             }
+            // A guard armed on zero that is still exactly on zero at the
+            // midpoint stays armed (see `scan_from`).
+            let armed = start.abs() == f64::MIN_POSITIVE && g_mid == 0.0;
             let right_piece = Piece {
                 a: mid,
                 b,
-                start: g_mid,
+                start: if armed { start } else { g_mid },
                 g_a: g_mid,
                 check_start: false,
             };
@@ -286,6 +289,13 @@ fn scan_from(
             continue;
         }
         let g_right = g(right);
+        // A guard that sat on zero (see `just_before_zero`) and is still
+        // exactly there has not crossed yet (a packed unit at rest stays
+        // packed); it stays armed for when it does leave zero.
+        if g_right == 0.0 && g_left.abs() == f64::MIN_POSITIVE {
+            left = right;
+            continue;
+        }
         if direction.accepts(g_left, g_right) {
             return Some(refine(left, g_left, right, g_right, g, fallback));
         }
@@ -521,6 +531,17 @@ mod tests {
             first_crossing(&FALLING, false, |s: f64| -0.25 * s * s),
             None
         );
+    }
+
+    #[test]
+    fn a_guard_that_stays_on_zero_has_not_crossed() {
+        // A packed unit at rest: the guard is zero all through the step.
+        assert_eq!(first_crossing(&FALLING, true, |_| 0.0), None);
+        // Zero (to rounding) for a while, then closing: it fires when it goes.
+        let g = |s: f64| if s < 0.5 { 0.0 } else { -(s - 0.5) };
+        let scan = scan_step(&FALLING, true, Interpolant::Other, f64::INFINITY, g);
+        let root = scan.crossing.unwrap();
+        assert!((0.49..=0.51).contains(&root), "root {root}");
     }
 
     #[test]

@@ -3,4 +3,5 @@
 //!
 //! [`HybridModel`]: crate::engine::HybridModel
 
+pub mod chain;
 pub mod mechanism;

@@ -1,6 +1,7 @@
 //! flicker's integration tests: one binary, one module per behaviour.
 
 mod bouncing_ball;
+mod chain;
 mod cli;
 mod compare;
 mod convergence;
