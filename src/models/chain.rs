@@ -83,6 +83,17 @@ impl Chain {
         )
     }
 
+    /// The state with every unit at `strain`, at rest: the homogeneous
+    /// static deformation (Cauchy-Born) a release starts from. The unit
+    /// length `2 l` is `critical_load / stiffness` (PHYSICS.md s.4).
+    pub fn homogeneous(&self, strain: f64) -> Vec<f64> {
+        let delta = strain * self.critical_load / self.stiffness;
+        let positions = (1..=self.units).map(|n| delta * n as f64);
+        positions
+            .chain(std::iter::repeat_n(0.0, self.units))
+            .collect()
+    }
+
     /// Elongation of unit `n` (1-based) in state `x`.
     pub fn elongation(&self, x: &[f64], n: usize) -> f64 {
         x[n - 1] - if n > 1 { x[n - 2] } else { 0.0 }

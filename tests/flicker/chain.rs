@@ -89,11 +89,9 @@ fn the_unconstrained_chain_matches_its_modes() {
     // load dropped to zero (PHYSICS.md s.6), constraint off.
     let units = 10;
     let chain = Chain::in_scene_units(units, 2.0, 1.0, 0.0, false);
-    let delta = 0.1 * 2.0 / units as f64;
-    let x0: Vec<f64> = (1..=units)
-        .map(|n| delta * n as f64)
-        .chain(std::iter::repeat_n(0.0, units))
-        .collect();
+    let x0 = chain.homogeneous(0.1);
+    // Unit length 2 l = L / N: strain 0.1 is an elongation of 0.02 per unit.
+    assert!((chain.elongation(&x0, units) - 0.02).abs() < 1e-15);
     let t = 1.3;
     let exact = modal(&chain, &x0, t);
     for (method, tolerance) in [
@@ -125,11 +123,7 @@ fn the_unconstrained_chain_matches_its_modes() {
 fn the_released_chain_keeps_its_energy_across_impacts() {
     let units = 12;
     let chain = Chain::in_scene_units(units, 2.0, 1.0, 0.0, true);
-    let delta = 0.1 * 2.0 / units as f64;
-    let x0: Vec<f64> = (1..=units)
-        .map(|n| delta * n as f64)
-        .chain(std::iter::repeat_n(0.0, units))
-        .collect();
+    let x0 = chain.homogeneous(0.1);
     let mut options = Options::until(2.0);
     options.method = Method::Dopri5(Tolerances {
         rtol: 1e-12,
