@@ -50,6 +50,10 @@ impl<O: Observer> Observer for WithProgress<O> {
         self.inner.on_event(event)
     }
 
+    fn wants_details(&self) -> bool {
+        self.inner.wants_details()
+    }
+
     fn on_progress(&mut self, t: f64, events: u64) {
         if let Some(bar) = &self.bar {
             let rate = events as f64 / self.started.elapsed().as_secs_f64().max(1e-9);

@@ -5,16 +5,19 @@
 pub mod dopri5;
 pub mod integrator;
 pub mod linear;
+pub mod local;
 pub mod locate;
 pub mod model;
 pub mod observer;
 pub mod queue;
 pub mod simulation;
+pub mod taylor;
 pub mod verlet;
 pub mod zeno;
 
 pub use dopri5::Tolerances;
 pub use integrator::Method;
+pub use local::{Fired, LocalModel, simulate_local};
 pub use model::{Affects, Direction, Flow, Guard, HybridModel, Jump, Mode};
 pub use observer::{EventRecord, EventTimes, Observer, RecordedEvent, Recorder, SETTLE};
 pub use simulation::{Options, Outcome, Status, simulate};

@@ -19,6 +19,11 @@ pub struct EventRecord<'a> {
     pub before: &'a [f64],
     pub names_after: &'a [&'static str],
     pub after: &'a [f64],
+    /// The part of a many-part model the event happened at (a chain's
+    /// unit), if the model says.
+    pub unit: Option<u64>,
+    /// The closing speed just before an impact, if the model says.
+    pub rel_velocity: Option<f64>,
 }
 
 /// Receives events as they happen. An error stops the run (status `failed`).
@@ -30,11 +35,22 @@ pub trait Observer {
     fn on_progress(&mut self, t: f64, events: u64) {
         let _ = (t, events);
     }
+
+    /// Whether the observer looks at events at all. An event-local model
+    /// computes the energies of an event (a sum over the whole model) only
+    /// for an observer that does.
+    fn wants_details(&self) -> bool {
+        true
+    }
 }
 
 impl Observer for () {
     fn on_event(&mut self, _: &EventRecord) -> std::io::Result<()> {
         Ok(())
+    }
+
+    fn wants_details(&self) -> bool {
+        false
     }
 }
 
@@ -63,6 +79,8 @@ pub struct RecordedEvent {
     pub energy_after: Option<f64>,
     pub before: Vec<f64>,
     pub after: Vec<f64>,
+    pub unit: Option<u64>,
+    pub rel_velocity: Option<f64>,
 }
 
 /// Keeps every event in memory.
@@ -80,6 +98,8 @@ impl Observer for Recorder {
             energy_after: e.energy_after,
             before: e.before.to_vec(),
             after: e.after.to_vec(),
+            unit: e.unit,
+            rel_velocity: e.rel_velocity,
         });
         Ok(())
     }

@@ -446,6 +446,8 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
             before,
             names_after: model.state_names(mode_after),
             after: &self.after,
+            unit: None,
+            rel_velocity: None,
         };
         observer
             .on_event(&event)

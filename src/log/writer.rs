@@ -99,6 +99,15 @@ impl<W: Write> Observer for JsonlWriter<W> {
         self.state(e.names_before, e.before);
         self.buffer.extend_from_slice(b",\"after\":");
         self.state(e.names_after, e.after);
+        if let Some(unit) = e.unit {
+            self.buffer.extend_from_slice(b",\"unit\":");
+            self.buffer
+                .extend_from_slice(self.integers.format(unit).as_bytes());
+        }
+        if let Some(v) = e.rel_velocity {
+            self.buffer.extend_from_slice(b",\"rel_velocity\":");
+            self.number(v);
+        }
         self.buffer.extend_from_slice(b"}\n");
         if self.buffer.len() >= CHUNK {
             self.out.write_all(&self.buffer)?;
@@ -176,6 +185,8 @@ mod tests {
             before: &[0.0, -1e-300],
             names_after: &["strain", "strain_rate"],
             after: &[0.0, f64::NAN],
+            unit: Some(7),
+            rel_velocity: Some(0.5),
         };
         w.on_event(&event).unwrap();
         w.flush().unwrap();
@@ -189,5 +200,7 @@ mod tests {
         assert!(v["energy_after"].is_null());
         assert_eq!(v["before"]["strain_rate"], -1e-300);
         assert!(v["after"]["strain_rate"].is_null());
+        assert_eq!(v["unit"], 7);
+        assert_eq!(v["rel_velocity"], 0.5);
     }
 }

@@ -1,0 +1,271 @@
+//! Taylor polynomials of exact flows: evaluation, and the certified first
+//! crossing of zero on an interval.
+//!
+//! A model that propagates its state by truncated Taylor series (with a
+//! truncation bound below round-off) has each guard as a polynomial
+//! `p(s) = sum c_k s^k` in the time `s` since the series' origin. Its next
+//! event is the first `s` in `(a, b]` where `p` falls from positive to zero.
+//! [`first_fall`] finds it without sampling: on each piece of the interval
+//! it bounds `p` from below by its second-order expansion at the piece's
+//! left end plus a bound on `p'''` over the whole interval, so a piece is
+//! either proven free of a falling crossing, proven monotone with one
+//! root (then refined), or halved. Pieces are visited left to right, so the
+//! first root found is the earliest; none can be missed.
+
+/// `(p(s), p'(s), p''(s))` of `p = sum c[k] s^k`.
+pub fn eval2(c: &[f64], s: f64) -> (f64, f64, f64) {
+    let (mut p, mut d1, mut d2) = (0.0, 0.0, 0.0);
+    for &ck in c.iter().rev() {
+        d2 = d2 * s + 2.0 * d1;
+        d1 = d1 * s + p;
+        p = p * s + ck;
+    }
+    (p, d1, d2)
+}
+
+/// `p(s)` of `p = sum c[k] s^k`.
+pub fn eval(c: &[f64], s: f64) -> f64 {
+    c.iter().rev().fold(0.0, |p, &ck| p * s + ck)
+}
+
+/// The integral of `p` from 0 to `s`.
+pub fn integral(c: &[f64], s: f64) -> f64 {
+    let k = c.len() as f64;
+    c.iter()
+        .rev()
+        .enumerate()
+        .fold(0.0, |acc, (i, &ck)| acc * s + ck / (k - i as f64))
+        * s
+}
+
+/// A bound on `|p'''|` over `[0, b]`: `sum |c_k| k (k-1) (k-2) b^(k-3)`.
+fn third_derivative_bound(c: &[f64], b: f64) -> f64 {
+    let mut bound = 0.0;
+    for (k, &ck) in c.iter().enumerate().skip(3).rev() {
+        let k = k as f64;
+        bound = bound * b + ck.abs() * k * (k - 1.0) * (k - 2.0);
+    }
+    // Rounding in the sum above is relative and tiny; pad it all the same.
+    bound * (1.0 + 1e-12)
+}
+
+/// Deepest halving of the interval, and most pieces examined; beyond
+/// them the computed sign decides (a graze within round-off).
+const MAX_DEPTH: u32 = 80;
+const MAX_PIECES: u32 = 4096;
+
+/// The first `s` in `(a, b]` (`0 <= a <= b`) where `p` crosses zero falling
+/// (from positive to `<= 0`), or `Some(a)` if `p(a) <= 0` and `p` is moving
+/// down through zero at `a` already. `None` if there is none: in
+/// particular a `p` that rises from zero, or stays exactly on it, has not
+/// crossed.
+pub fn first_fall(c: &[f64], a: f64, b: f64) -> Option<f64> {
+    // Cheap proof of no root, the common case: p(s) >= c_0 - sum |c_k| b^k
+    // on [0, b]. A constant p never crosses either.
+    let reach = c.iter().skip(1).rev().fold(0.0, |acc, ck| (acc + ck.abs()) * b);
+    let constant = c.first().copied().unwrap_or(0.0);
+    if constant - reach * (1.0 + 1e-12) > 0.0 || reach == 0.0 {
+        return None;
+    }
+    let (p, d1, d2) = eval2(c, a);
+    if p <= 0.0 && (d1 < 0.0 || (d1 == 0.0 && d2 < 0.0)) {
+        return Some(a);
+    }
+    let bound = Piece {
+        c,
+        third: third_derivative_bound(c, b),
+        budget: std::cell::Cell::new(MAX_PIECES),
+    };
+    bound.search(a, b, (p, d1, d2), 0)
+}
+
+struct Piece<'c> {
+    c: &'c [f64],
+    third: f64,
+    /// Pieces left to examine: a polynomial that hugs zero within
+    /// round-off over a long stretch must not cost exponential time.
+    budget: std::cell::Cell<u32>,
+}
+
+enum Verdict {
+    /// No falling crossing on the piece.
+    Clear,
+    /// Strictly decreasing on it, from positive to `<= 0`: one root.
+    Root,
+    Unknown,
+}
+
+impl Piece<'_> {
+    fn search(&self, x0: f64, x1: f64, at0: (f64, f64, f64), depth: u32) -> Option<f64> {
+        let end = eval(self.c, x1);
+        match self.classify(x1 - x0, at0, end) {
+            Verdict::Clear => None,
+            Verdict::Root => Some(self.refine(x0, x1)),
+            Verdict::Unknown => {
+                let mid = 0.5 * (x0 + x1);
+                let budget = self.budget.get();
+                self.budget.set(budget.saturating_sub(1));
+                if depth >= MAX_DEPTH || budget == 0 || mid <= x0 || mid >= x1 {
+                    // A graze narrower than round-off: the computed sign decides.
+                    return (at0.0 > 0.0 && end <= 0.0).then_some(x1);
+                }
+                let at_mid = eval2(self.c, mid);
+                self.search(x0, mid, at0, depth + 1)
+                    .or_else(|| self.search(mid, x1, at_mid, depth + 1))
+            }
+        }
+    }
+
+    /// What the expansion at the left end (value `p`, slope `d1`, curvature
+    /// `d2`) and the bound on the third derivative prove over a piece of
+    /// width `w` whose right end has the value `end`.
+    fn classify(&self, w: f64, (p, d1, d2): (f64, f64, f64), end: f64) -> Verdict {
+        // |p''| <= curvature on the piece, so the slope stays within
+        // d1 +- curvature w and p >= p + d1 h - curvature h^2 / 2.
+        let curvature = d2.abs() + self.third * w;
+        if d1 - curvature * w > 0.0 {
+            // Strictly rising: nothing falls.
+            return Verdict::Clear;
+        }
+        if d1 + curvature * w < 0.0 {
+            // Strictly falling: a root only if it starts above zero and ends
+            // at or below it (from below zero it never was positive).
+            return if p > 0.0 && end <= 0.0 {
+                Verdict::Root
+            } else {
+                Verdict::Clear
+            };
+        }
+        let lowest_at_end = p + d1 * w - 0.5 * curvature * w * w;
+        let above = p > 0.0 && lowest_at_end > 0.0;
+        // From exactly zero, rising faster than the curvature can turn it.
+        let lifting = p == 0.0 && d1 - 0.5 * curvature * w > 0.0;
+        if above || lifting {
+            Verdict::Clear
+        } else {
+            Verdict::Unknown
+        }
+    }
+
+    /// The root of a strictly decreasing `p` on `[lo, hi]` with `p(lo) > 0 >=
+    /// p(hi)`, to a few ulps: Newton's method kept inside the bracket
+    /// (bisecting when a step leaves it), ending on a point where `p <= 0`.
+    fn refine(&self, mut lo: f64, mut hi: f64) -> f64 {
+        let mut x = hi;
+        for _ in 0..100 {
+            let (p, d1, _) = eval2(self.c, x);
+            if p > 0.0 {
+                lo = x;
+            } else {
+                hi = x;
+            }
+            let newton = x - p / d1;
+            let next = if newton > lo && newton < hi {
+                newton
+            } else {
+                0.5 * (lo + hi)
+            };
+            if (next - x).abs() <= 4.0 * f64::EPSILON * x.abs() || next <= lo || next >= hi {
+                break;
+            }
+            x = next;
+        }
+        if x == hi {
+            // Converged on an iterate at or below zero.
+            return hi;
+        }
+        // Converged from above zero: step up to the first float at or below
+        // it (a few ulps at most), else bisect.
+        let mut up = lo;
+        for _ in 0..16 {
+            up = f64::from_bits(up.to_bits() + 1);
+            if up >= hi {
+                break;
+            }
+            if eval(self.c, up) <= 0.0 {
+                return up;
+            }
+        }
+        while hi - lo > 4.0 * f64::EPSILON * hi.abs() {
+            let mid = 0.5 * (lo + hi);
+            if eval(self.c, mid) > 0.0 {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        hi
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Coefficients of `prod (s - r_i)` times `scale`.
+    fn from_roots(roots: &[f64], scale: f64) -> Vec<f64> {
+        let mut c = vec![scale];
+        for &r in roots {
+            let mut next = vec![0.0; c.len() + 1];
+            for (k, &ck) in c.iter().enumerate() {
+                next[k + 1] += ck;
+                next[k] -= r * ck;
+            }
+            c = next;
+        }
+        c
+    }
+
+    #[test]
+    fn evaluation_with_derivatives_matches_the_expanded_forms() {
+        let c = [1.0, -2.0, 0.5, 3.0];
+        let s: f64 = 0.7;
+        let (p, d1, d2) = eval2(&c, s);
+        assert!((p - (1.0 - 2.0 * s + 0.5 * s * s + 3.0 * s.powi(3))).abs() < 1e-15);
+        assert!((d1 - (-2.0 + s + 9.0 * s * s)).abs() < 1e-15);
+        assert!((d2 - (1.0 + 18.0 * s)).abs() < 1e-14);
+        assert!((integral(&c, s) - (s - s * s + s.powi(3) / 6.0 + 0.75 * s.powi(4))).abs() < 1e-15);
+    }
+
+    #[test]
+    fn finds_the_first_of_several_falling_roots() {
+        // Positive at 0; falls through 0.3, rises through 0.5, falls through 0.9.
+        let c = from_roots(&[0.3, 0.5, 0.9], -1.0);
+        let s = first_fall(&c, 0.0, 1.0).unwrap();
+        assert!((s - 0.3).abs() < 1e-15, "{s}");
+        let s = first_fall(&c, 0.6, 1.0).unwrap();
+        assert!((s - 0.9).abs() < 1e-15, "{s}");
+    }
+
+    #[test]
+    fn a_double_crossing_inside_a_short_dip_is_not_missed() {
+        // Dips below zero between 0.4 and 0.4 + 1e-6 only; the root of a
+        // dip that narrow is conditioned to about eps / 1e-6.
+        let c = from_roots(&[0.4, 0.4 + 1e-6], 1.0);
+        let s = first_fall(&c, 0.0, 1.0).unwrap();
+        assert!((s - 0.4).abs() < 1e-9, "{s}");
+        // A dip that stays 1e-12 above zero never crosses.
+        let mut c = from_roots(&[0.4, 0.4], 1.0);
+        c[0] += 1e-12;
+        assert_eq!(first_fall(&c, 0.0, 1.0), None);
+    }
+
+    #[test]
+    fn rising_from_zero_or_staying_on_it_is_not_a_crossing() {
+        assert_eq!(first_fall(&[0.0, 1.0, -0.1], 0.0, 1.0), None);
+        assert_eq!(first_fall(&[0.0, 0.0, 0.0], 0.0, 1.0), None);
+        assert_eq!(first_fall(&[0.0, 0.0, 1.0], 0.0, 1.0), None);
+        // Closing through zero right now fires now.
+        assert_eq!(first_fall(&[0.0, -1.0], 0.0, 1.0), Some(0.0));
+        assert_eq!(first_fall(&[-1e-18, 1.0, -4.0], 0.0, 1.0).map(|s| (s - 0.25).abs() < 1e-9), Some(true));
+    }
+
+    #[test]
+    fn the_root_is_within_a_few_ulps_at_or_below_zero() {
+        let c = [1.0, -3.0, 0.5];
+        let s = first_fall(&c, 0.0, 1.0).unwrap();
+        let exact = (3.0 - 7.0f64.sqrt()) / 1.0;
+        assert!(eval(&c, s) <= 0.0);
+        assert!((s - exact).abs() <= 8.0 * f64::EPSILON * exact, "{s} {exact}");
+    }
+}

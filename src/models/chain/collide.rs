@@ -1,0 +1,63 @@
+//! Simultaneous impacts (PHYSICS.md s.4): every shut unit that is closing
+//! swaps its two nodes' velocities (unit 1 flips node 1's against the wall),
+//! again and again until no shut unit closes. With equal masses each swap
+//! puts one pair of a packed block in order, so the result is the sorted
+//! velocities whatever the order of the swaps (a Newton's cradle passes the
+//! incoming speed through the block).
+
+use std::ops::RangeInclusive;
+
+/// Resolve the impacts among units `first ..= first + shut.len() - 1` at one
+/// instant. `shut[i]` says whether unit `first + i` is shut (its gap within
+/// round-off of zero); `v` holds the velocities of nodes `first - 1 ..=
+/// first + shut.len() - 1` (`v[0]` is the wall's, zero, when `first` is 1).
+/// Returns the units whose nodes changed velocity, if any did.
+pub fn cascade(first: usize, shut: &[bool], v: &mut [f64]) -> Option<RangeInclusive<usize>> {
+    assert_eq!(v.len(), shut.len() + 1, "one more node than units");
+    let mut touched: Option<(usize, usize)> = None;
+    // Each pass fixes at least one closing pair; a block of b units is
+    // sorted within b^2 passes (bubble sort), so this bound is never hit.
+    for _ in 0..=shut.len() * shut.len() {
+        let mut changed = false;
+        for (i, _) in shut.iter().enumerate().filter(|(_, shut)| **shut) {
+            let unit = first + i;
+            if v[i] - v[i + 1] <= 0.0 {
+                continue;
+            }
+            if unit == 1 {
+                v[1] = -v[1];
+            } else {
+                v.swap(i, i + 1);
+            }
+            changed = true;
+            touched = Some(touched.map_or((unit, unit), |(a, b)| (a.min(unit), b.max(unit))));
+        }
+        if !changed {
+            break;
+        }
+    }
+    touched.map(|(a, b)| a..=b)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_node_into_a_packed_block_passes_its_speed_through() {
+        // Units 2..4 shut; node 1 arrives at speed 2 on nodes at rest.
+        let mut v = [0.0, 2.0, 0.0, 0.0, 0.0];
+        let touched = cascade(1, &[false, true, true, true], &mut v);
+        assert_eq!(v, [0.0, 0.0, 0.0, 0.0, 2.0]);
+        assert_eq!(touched, Some(2..=4));
+    }
+
+    #[test]
+    fn the_wall_flips_a_closing_first_node_only() {
+        let mut v = [0.0, -1.5, 0.0];
+        assert_eq!(cascade(1, &[true, false], &mut v), Some(1..=1));
+        assert_eq!(v, [0.0, 1.5, 0.0]);
+        let mut v = [0.0, 1.5, 0.0];
+        assert_eq!(cascade(1, &[true, false], &mut v), None);
+    }
+}

@@ -1,0 +1,106 @@
+//! The chain as a linear, second-order ODE in positions and velocities,
+//! `[y_1..y_N, v_1..v_N]`: what Dormand-Prince, Stormer-Verlet and the
+//! linear propagator integrate. Every step costs O(N) and every guard is
+//! scanned on every step, so this path is for checking the exact one
+//! ([`super::TaylorChain`]) and for small chains.
+
+use nalgebra::{DMatrix, DVector};
+
+use super::Chain;
+use super::collide::cascade;
+use crate::engine::{Flow, Guard, HybridModel, Jump, Mode};
+
+impl HybridModel for Chain {
+    fn dimension(&self) -> usize {
+        2 * self.units
+    }
+
+    fn state_names(&self, _: Mode) -> &[&'static str] {
+        // Nodes are many; the log names the two halves of the state.
+        &[]
+    }
+
+    fn mode_name(&self, _: Mode) -> &'static str {
+        "chain"
+    }
+
+    fn guards(&self, _: Mode) -> &[Guard] {
+        &self.guards
+    }
+
+    fn guard(&self, _: Mode, guard: usize, x: &[f64]) -> f64 {
+        self.elongation(x, guard + 1)
+    }
+
+    fn flow(&self, _: Mode) -> Flow {
+        Flow::Ode
+    }
+
+    fn rhs(&self, _: Mode, x: &[f64], dx: &mut [f64]) {
+        let n = self.units;
+        let force = |unit: usize| self.critical_load + self.stiffness * self.elongation(x, unit);
+        for node in 1..=n {
+            dx[node - 1] = x[n + node - 1];
+            let pull = if node < n { force(node + 1) } else { self.load };
+            dx[n + node - 1] = (pull - force(node)) / self.mass;
+        }
+    }
+
+    fn second_order(&self, _: Mode) -> bool {
+        true
+    }
+
+    fn linear(&self, _: Mode) -> Option<(DMatrix<f64>, DVector<f64>)> {
+        let n = self.units;
+        let mut a = DMatrix::zeros(2 * n, 2 * n);
+        let mut b = DVector::zeros(2 * n);
+        let w = self.stiffness / self.mass;
+        for node in 0..n {
+            a[(node, n + node)] = 1.0;
+            a[(n + node, node)] = if node + 1 < n { -2.0 * w } else { -w };
+            if node > 0 {
+                a[(n + node, node - 1)] = w;
+            }
+            if node + 1 < n {
+                a[(n + node, node + 1)] = w;
+            }
+        }
+        b[2 * n - 1] = (self.load - self.critical_load) / self.mass;
+        Some((a, b))
+    }
+
+    fn reset(&self, mode: Mode, _: usize, x: &mut [f64]) -> Jump {
+        // A unit takes part if it is shut to within a few ulps of its
+        // nodes' positions (and closing, which the cascade checks).
+        let n = self.units;
+        let window = 8.0 * f64::EPSILON;
+        let shut: Vec<bool> = (1..=n)
+            .map(|unit| {
+                let scale = x[unit - 1].abs().max(if unit > 1 { x[unit - 2].abs() } else { 0.0 });
+                self.elongation(x, unit) <= window * scale
+            })
+            .collect();
+        let mut v = Vec::with_capacity(n + 1);
+        v.push(0.0);
+        v.extend_from_slice(&x[n..]);
+        cascade(1, &shut, &mut v);
+        x[n..].copy_from_slice(&v[1..]);
+        Jump::to(mode)
+    }
+
+    fn energy(&self, _: Mode, x: &[f64]) -> Option<f64> {
+        let n = self.units;
+        let kinetic: f64 = x[n..].iter().map(|v| 0.5 * self.mass * v * v).sum();
+        let elastic: f64 = (1..=n)
+            .map(|unit| {
+                let d = self.elongation(x, unit);
+                self.critical_load * d + 0.5 * self.stiffness * d * d
+            })
+            .sum();
+        Some(kinetic + elastic - self.load * x[n - 1])
+    }
+
+    fn energy_scale(&self, initial_energy: f64) -> f64 {
+        initial_energy.abs().max(f64::MIN_POSITIVE)
+    }
+}
