@@ -94,6 +94,7 @@ pub fn settings(scene: &Scene) -> Vec<SolverSpec> {
             ]
         }
         Scene::Mechanism(_) => vec![spec("dopri5", Some(TOLERANCE), None)],
+        Scene::Chain(_) => Vec::new(),
     }
 }
 
@@ -106,7 +107,7 @@ pub fn run_case(
 ) -> Result<Row, SceneError> {
     let mut scene = scene.clone();
     scene.set_solver(setting.clone())?;
-    let reference = Reference::of(&scene);
+    let reference = Reference::of(&scene)?;
     let mut times = EventTimes::default();
     let control = Control {
         stop: None,

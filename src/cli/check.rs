@@ -34,6 +34,28 @@ pub fn check(path: &Path) -> Result<Code, Failure> {
                 regime(m.mechanism, h0, m.t_end)
             );
         }
+        Scene::Chain(c) => {
+            say!(
+                "{}: a valid chain scene ({} units, method {})",
+                path.display(),
+                c.units,
+                c.method.name()
+            );
+            say!(
+                "  length {}, wave speed {}, load {} -> {} (F / F_cr), constraint {}, t_end {}",
+                c.length,
+                c.wave_speed,
+                c.load_before,
+                c.load_after,
+                if c.constraint { "on" } else { "off" },
+                c.t_end
+            );
+            say!(
+                "  {} snapshots, {} trace samples",
+                c.snapshots.len(),
+                c.samples
+            );
+        }
     }
     Ok(Code::Ok)
 }

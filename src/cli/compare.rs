@@ -84,6 +84,7 @@ fn applicable(scene: &Scene) -> Vec<String> {
             &["exact", "linear", "dopri5", "verlet"]
         }
         Scene::Mechanism(_) => &["dopri5"],
+        Scene::Chain(_) => &["exact", "linear", "dopri5", "verlet"],
     };
     names.iter().map(|s| s.to_string()).collect()
 }

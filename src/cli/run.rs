@@ -9,6 +9,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use flicker::engine::Status;
 use flicker::log::JsonlWriter;
+use flicker::log::chain_files;
 use flicker::log::summary::{summary, write_atomically};
 use flicker::runner::{Control, Report, run as run_scene};
 use flicker::scene::solver::SolverSpec;
@@ -141,6 +142,15 @@ pub fn run(args: RunArgs) -> Result<Code, Failure> {
     };
 
     let log = log_events.then_some(log_path.as_path());
+    let mut written = Vec::new();
+    if let Some(chain) = &report.chain {
+        let profiles = out.join("profiles.json");
+        let trace = out.join("trace.csv");
+        write_atomically(&profiles, &chain_files::profiles(chain))
+            .and_then(|()| chain_files::write_trace(chain, &trace))
+            .map_err(|e| Failure::untrusted(format!("{}: cannot be written: {e}", out.display())))?;
+        written.extend([profiles, trace]);
+    }
     let summary_path = out.join("summary.json");
     write_atomically(
         &summary_path,
@@ -152,7 +162,7 @@ pub fn run(args: RunArgs) -> Result<Code, Failure> {
             summary_path.display()
         ))
     })?;
-    print_report(&report, &scene, &summary_path, log);
+    print_report(&report, &scene, &summary_path, log, &written);
     Ok(match report.outcome.status {
         Status::Completed | Status::Zeno => Code::Ok,
         Status::Failed => Code::Untrusted,
@@ -170,10 +180,17 @@ fn default_out(scene: &Path) -> PathBuf {
 fn model_name(scene: &Scene) -> &'static str {
     match scene {
         Scene::Mechanism(_) => "mechanism",
+        Scene::Chain(_) => "chain",
     }
 }
 
-fn print_report(report: &Report, scene: &Scene, summary: &Path, log: Option<&Path>) {
+fn print_report(
+    report: &Report,
+    scene: &Scene,
+    summary: &Path,
+    log: Option<&Path>,
+    written: &[PathBuf],
+) {
     let o = &report.outcome;
     say!(
         "{} {} at t = {} of {}",
@@ -206,9 +223,13 @@ fn print_report(report: &Report, scene: &Scene, summary: &Path, log: Option<&Pat
         .map(|(n, x)| format!("{n} = {x:e}"))
         .collect();
     say!("  final state: {}", state.join(", "));
-    say!(
-        "  wrote {}{}",
-        summary.display(),
-        log.map_or(String::new(), |l| format!(" and {}", l.display()))
-    );
+    if let Some(err) = report.chain.as_ref().and_then(|c| c.momentum_balance_error) {
+        say!("  momentum against the end load's and the wall's impulses: relative error {err:.2e}");
+    }
+    let files: Vec<String> = std::iter::once(summary)
+        .chain(log)
+        .chain(written.iter().map(PathBuf::as_path))
+        .map(|p| p.display().to_string())
+        .collect();
+    say!("  wrote {}", files.join(", "));
 }

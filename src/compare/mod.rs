@@ -55,7 +55,7 @@ pub fn compare(
     plan: &Plan,
     progress: &mut dyn FnMut(&Row),
 ) -> Result<(Reference, Vec<Row>), SceneError> {
-    let reference = Reference::of(scene);
+    let reference = Reference::of(scene)?;
     let mut rows = Vec::new();
     for method in &plan.methods {
         let settings: Vec<SolverSpec> = match method.as_str() {
@@ -117,6 +117,7 @@ fn spec(method: &str, tolerance: Option<f64>, step: Option<f64>) -> SolverSpec {
 fn scene_period(scene: &Scene) -> f64 {
     match scene {
         Scene::Mechanism(m) => std::f64::consts::TAU / m.mechanism.omega,
+        Scene::Chain(c) => c.length / c.wave_speed,
     }
 }
 

@@ -1,7 +1,7 @@
 //! The exact answer a comparison measures against.
 
 use crate::models::mechanism::ExactOrbit;
-use crate::scene::Scene;
+use crate::scene::{Scene, SceneError};
 
 /// The final state and event times of the exact solution.
 #[derive(Debug, Clone)]
@@ -35,19 +35,26 @@ impl Reference {
 impl Reference {
     /// The mechanism's closed form (46) with impacts every `T_imp`, whatever
     /// the formulation (both describe the same `eps(t)`).
-    pub fn of(scene: &Scene) -> Self {
+    /// Chains have no closed form to measure against and are refused.
+    pub fn of(scene: &Scene) -> Result<Self, SceneError> {
         match scene {
             Scene::Mechanism(m) => {
                 let (eps, rate) = m.initial_strain;
                 let orbit = ExactOrbit::new(m.mechanism, eps, rate);
                 let (e, r) = orbit.state_at(m.t_end);
-                Reference {
+                Ok(Reference {
                     kind: "closed form (46) of the strain, impacts every T_imp",
                     final_state: vec![e, r],
                     events: orbit.impacts_until(m.t_end),
                     orbit,
-                }
+                })
             }
+            Scene::Chain(_) => Err(SceneError::field(
+                "model",
+                "method comparisons measure against the mechanism's closed form; a chain scene has none \
+                 (its exact and ODE paths are checked against each other in tests/flicker/chain.rs)"
+                    .into(),
+            )),
         }
     }
 }

@@ -219,6 +219,14 @@ pub trait HybridModel {
         None
     }
 
+    /// Where the event of `guard` at state `before` happened, for the log:
+    /// the part of a many-part model (a chain's unit) and the closing speed
+    /// of an impact, where the model has them.
+    fn site(&self, mode: Mode, guard: usize, before: &[f64]) -> (Option<u64>, Option<f64>) {
+        let _ = (mode, guard, before);
+        (None, None)
+    }
+
     /// A sentence explaining why a numerical flow may fail at `x`, added to
     /// the engine's own message (e.g. a coordinate singularity).
     fn diagnose(&self, mode: Mode, x: &[f64]) -> Option<String> {

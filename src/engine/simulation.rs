@@ -369,7 +369,8 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
             Ok(())
         } else {
             self.count(mode, slot);
-            self.record(guard.name, t, jump.mode, &before, observer)
+            let site = model.site(mode, slot, &before);
+            self.record(guard.name, t, jump.mode, &before, site, observer)
         };
         self.before = before;
         recorded?;
@@ -426,6 +427,7 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
         t: Time,
         mode_after: Mode,
         before: &[f64],
+        (unit, rel_velocity): (Option<u64>, Option<f64>),
         observer: &mut O,
     ) -> Result<(), End> {
         let (model, mode) = (self.model, self.mode);
@@ -446,8 +448,8 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
             before,
             names_after: model.state_names(mode_after),
             after: &self.after,
-            unit: None,
-            rel_velocity: None,
+            unit,
+            rel_velocity,
         };
         observer
             .on_event(&event)
@@ -478,7 +480,7 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
         };
         let before = std::mem::take(&mut self.state);
         self.settles += 1;
-        let recorded = self.record(SETTLE, t, rest, &before, observer);
+        let recorded = self.record(SETTLE, t, rest, &before, (None, None), observer);
         self.state = before;
         recorded?;
         std::mem::swap(&mut self.state, &mut self.after);

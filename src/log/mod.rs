@@ -13,7 +13,11 @@
 //! | `guard` | the guard that fired (`impact`, ...; `settle` when a Zeno accumulation is handed to resting contact) |
 //! | `mode_before`, `mode_after` | the automaton's mode on either side |
 //! | `energy_before`, `energy_after` | the model's energy on either side (`null` if it has none) |
-//! | `before`, `after` | the state on either side, as an object of named components |
+//! | `before`, `after` | the state on either side, as an object of named components (empty for a chain, whose state is too large) |
+//! | `unit` | chains only: the unit that closed (1 = next to the wall) |
+//! | `rel_velocity` | chains only: `y'_{n-1} - y'_n` just before the impact (`-y'_1` for unit 1), positive when closing |
+//!
+//! A chain run also writes `profiles.json` and `trace.csv` ([`chain_files`]).
 //!
 //! ```json
 //! {"seq":1,"t":2.2142,"guard":"impact","mode_before":"flight","mode_after":"flight","energy_before":0.025,"energy_after":0.025,"before":{"strain":0.0,"strain_rate":-0.2236},"after":{"strain":0.0,"strain_rate":0.2236}}
@@ -25,6 +29,7 @@
 //! `t_reached`, `energy_initial`, `energy_final`, `max_energy_error`,
 //! `final_state`, `zeno`, `method` and `wall_seconds`; see [`summary`].
 
+pub mod chain_files;
 pub mod inspect;
 pub mod reader;
 pub mod summary;

@@ -6,7 +6,9 @@
 //! `energy_initial`, `energy_final`, `max_energy_error` (relative, against
 //! the model's energy scale), `final_state` (named components), `final_mode`,
 //! `zeno`, `flow_evaluations`, `error_bound`, `wall_seconds`, `log` (path of the event log or
-//! null).
+//! null); for chains, `momentum` (total, at the end) and
+//! `momentum_balance_error` (against the end load's and the wall's
+//! impulses, relative; exact path only), null for other models.
 
 use std::io;
 use std::path::Path;
@@ -44,6 +46,8 @@ pub fn summary(report: &Report, model: &str, scene: &Path, log: Option<&Path>) -
         "error_bound": o.error_bound,
         "wall_seconds": o.wall_seconds,
         "log": log.map(|p| p.display().to_string()),
+        "momentum": report.chain.as_ref().map(|c| c.momentum),
+        "momentum_balance_error": report.chain.as_ref().and_then(|c| c.momentum_balance_error),
     })
 }
 

@@ -6,6 +6,7 @@
 //! keys are errors, so a typo never silently falls back to a default.
 //! The keys of each model are documented in its module ([`mechanism`]).
 
+pub mod chain;
 pub mod fields;
 pub mod mechanism;
 pub mod solver;
@@ -16,12 +17,14 @@ use std::path::{Path, PathBuf};
 use serde_json::Value;
 
 use crate::scene::fields::{Fields, kind};
+pub use crate::scene::chain::ChainScene;
 pub use crate::scene::mechanism::{Formulation, Initial, MechanismScene};
 
 /// A validated scene.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Scene {
     Mechanism(MechanismScene),
+    Chain(ChainScene),
 }
 
 impl Scene {
@@ -29,6 +32,7 @@ impl Scene {
     pub fn t_end(&self) -> f64 {
         match self {
             Scene::Mechanism(m) => m.t_end,
+            Scene::Chain(c) => c.t_end,
         }
     }
 
@@ -37,6 +41,7 @@ impl Scene {
     pub fn override_solver(&mut self, flags: &solver::SolverSpec) -> Result<(), SceneError> {
         let spec = match self {
             Scene::Mechanism(m) => m.solver.overridden_by(flags),
+            Scene::Chain(c) => c.solver.overridden_by(flags),
         };
         self.set_solver(spec)
     }
@@ -48,6 +53,11 @@ impl Scene {
                 (m.method, m.tolerances) = mechanism::resolve_solver(&spec, m.formulation)?;
                 mechanism::check_steps(m.method, m.t_end)?;
                 m.solver = spec;
+            }
+            Scene::Chain(c) => {
+                (c.method, c.tolerances) = chain::resolve_solver(&spec, c.units)?;
+                mechanism::check_steps(c.method, c.t_end)?;
+                c.solver = spec;
             }
         }
         Ok(())
@@ -65,6 +75,16 @@ impl Scene {
             Scene::Mechanism(m) => {
                 mechanism::check_steps(m.method, t_end)?;
                 m.t_end = t_end;
+            }
+            Scene::Chain(c) => {
+                mechanism::check_steps(c.method, t_end)?;
+                if let Some(t) = c.snapshots.iter().find(|&&t| t > t_end) {
+                    return Err(SceneError::field(
+                        "t_end",
+                        format!("{t_end} comes before the snapshot at {t}"),
+                    ));
+                }
+                c.t_end = t_end;
             }
         }
         Ok(())
@@ -136,9 +156,10 @@ pub fn from_value(value: &Value) -> Result<Scene, SceneError> {
     let model = fields.required("model")?;
     match model.as_str() {
         Some("mechanism") => mechanism::validate(fields).map(Scene::Mechanism),
+        Some("chain") => chain::validate(fields).map(Scene::Chain),
         Some(other) => Err(SceneError::field(
             "model",
-            format!("unknown model {other:?} (known: \"mechanism\")"),
+            format!("unknown model {other:?} (known: \"mechanism\", \"chain\")"),
         )),
         None => Err(SceneError::field(
             "model",

@@ -88,6 +88,12 @@ impl HybridModel for Chain {
         Jump::to(mode)
     }
 
+    fn site(&self, _: Mode, guard: usize, x: &[f64]) -> (Option<u64>, Option<f64>) {
+        let n = self.units;
+        let left = if guard > 0 { x[n + guard - 1] } else { 0.0 };
+        (Some(guard as u64 + 1), Some(left - x[n + guard]))
+    }
+
     fn energy(&self, _: Mode, x: &[f64]) -> Option<f64> {
         let n = self.units;
         let kinetic: f64 = x[n..].iter().map(|v| 0.5 * self.mass * v * v).sum();

@@ -1,47 +1,12 @@
-//! Running a validated scene: build its model, pick its method, run it, and
-//! describe the result in the scene's own terms.
+//! Running a mechanism scene in the formulation and method it asks for.
 
-use std::sync::Arc;
-use std::sync::atomic::AtomicBool;
-
-use crate::engine::{Method, Observer, Options, Outcome, simulate};
+use crate::engine::{Method, Observer, Options, simulate};
 use crate::models::mechanism::strain::FLIGHT;
 use crate::models::mechanism::{AngleMechanism, Charts, StrainMechanism};
-use crate::scene::{Formulation, Initial, MechanismScene, Scene, SceneError};
+use crate::runner::{Control, Report};
+use crate::scene::{Formulation, Initial, MechanismScene, SceneError};
 
-/// A finished run and what the summary needs to say about it.
-#[derive(Debug, Clone)]
-pub struct Report {
-    pub outcome: Outcome,
-    /// The method used, in the names `flicker compare` uses (`exact`, `dopri5`).
-    pub method: &'static str,
-    /// A sentence saying which description of the model was used and why.
-    pub description: String,
-    /// The final state in the scene's physical variables.
-    pub final_state: Vec<(&'static str, f64)>,
-}
-
-/// What may stop a run from outside the scene.
-#[derive(Debug, Clone, Default)]
-pub struct Control {
-    /// Interrupts the run cleanly when set (a signal handler sets it).
-    pub stop: Option<Arc<AtomicBool>>,
-    /// Fails the run after this much wall time.
-    pub max_wall_seconds: Option<f64>,
-}
-
-/// Run `scene` under `control`.
-pub fn run(
-    scene: &Scene,
-    control: &Control,
-    observer: &mut dyn Observer,
-) -> Result<Report, SceneError> {
-    match scene {
-        Scene::Mechanism(m) => run_mechanism(m, control, observer),
-    }
-}
-
-fn run_mechanism(
+pub(super) fn run(
     scene: &MechanismScene,
     control: &Control,
     observer: &mut dyn Observer,
@@ -86,6 +51,7 @@ fn run_mechanism(
                 method,
                 description,
                 final_state,
+                chain: None,
             })
         }
         Formulation::Angle(charts) => {
@@ -114,6 +80,7 @@ fn run_mechanism(
                 method: "dopri5",
                 description: description.into(),
                 final_state: vec![("strain", e), ("strain_rate", r)],
+                chain: None,
             })
         }
     }

@@ -1,0 +1,352 @@
+//! Running a chain scene: the exact event-local flow by default, or the
+//! chain as an ODE under a numerical method (the independent path), with
+//! profiles at the snapshot times and the trace at the sample times.
+
+use crate::engine::{
+    EventRecord, HybridModel, LocalModel, Method, Observer, Options, Outcome, Status, simulate,
+    simulate_local,
+};
+use crate::models::chain::{Chain, TaylorChain};
+use crate::runner::{Control, Report};
+use crate::scene::{ChainScene, SceneError};
+use crate::time::Time;
+
+/// What a chain run reports besides the engine's outcome.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ChainOutputs {
+    /// Total momentum `sum m v` at the end.
+    pub momentum: f64,
+    /// `|P - P_impulses| / max(|P|, |F - F_cr| t, m c)` at the end, with
+    /// `P_impulses` the momentum the end load and the wall gave (exact path).
+    pub momentum_balance_error: Option<f64>,
+    /// `y_N` at the end.
+    pub right_end: f64,
+    pub profiles: Vec<Profile>,
+    pub trace: Vec<TraceRow>,
+}
+
+/// The chain at one time: entry `n` is unit `n + 1` (its centre `x`, its
+/// strain) and node `n + 1` (its displacement and velocity).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Profile {
+    pub t: f64,
+    pub x: Vec<f64>,
+    pub strain: Vec<f64>,
+    pub displacement: Vec<f64>,
+    pub velocity: Vec<f64>,
+}
+
+/// One row of `trace.csv`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TraceRow {
+    pub t: f64,
+    pub energy: f64,
+    pub momentum: f64,
+    pub right_end: f64,
+}
+
+/// The chain's state at one time, in gaps and velocities.
+struct State {
+    gaps: Vec<f64>,
+    velocities: Vec<f64>,
+}
+
+/// The profiles and trace rows that fall due as the run passes time `t`.
+struct Sampler<'s> {
+    scene: &'s ChainScene,
+    chain: &'s Chain,
+    snapshots: std::iter::Peekable<std::slice::Iter<'s, f64>>,
+    samples: std::iter::Peekable<std::vec::IntoIter<f64>>,
+    profiles: Vec<Profile>,
+    trace: Vec<TraceRow>,
+}
+
+impl<'s> Sampler<'s> {
+    fn new(scene: &'s ChainScene, chain: &'s Chain) -> Self {
+        Sampler {
+            scene,
+            chain,
+            snapshots: scene.snapshots.iter().peekable(),
+            samples: scene.sample_times().into_iter().peekable(),
+            profiles: Vec::new(),
+            trace: Vec::new(),
+        }
+    }
+
+    /// Every time due (snapshots and samples merged), in order.
+    fn times(&self) -> Vec<f64> {
+        let mut times: Vec<f64> = self.scene.snapshots.clone();
+        times.extend(self.scene.sample_times());
+        times.sort_by(f64::total_cmp);
+        times.dedup();
+        times
+    }
+
+    /// Record what is due at `t`, given the state and energy there.
+    fn at(&mut self, t: f64, state: impl FnOnce() -> (State, Option<f64>)) {
+        let snapshot = self.snapshots.next_if(|&&s| s <= t).is_some();
+        let sample = self.samples.next_if(|&s| s <= t).is_some();
+        if !(snapshot || sample) {
+            return;
+        }
+        let (state, energy) = state();
+        let c = self.chain;
+        let momentum = c.mass * state.velocities.iter().sum::<f64>();
+        let displacement: Vec<f64> = state
+            .gaps
+            .iter()
+            .scan(0.0, |y, d| {
+                *y += d;
+                Some(*y)
+            })
+            .collect();
+        let right_end = displacement.last().copied().unwrap_or(0.0);
+        if sample {
+            self.trace.push(TraceRow {
+                t,
+                energy: energy.unwrap_or(f64::NAN),
+                momentum,
+                right_end,
+            });
+        }
+        if snapshot {
+            let n = c.units as f64;
+            let cell = self.scene.length / n;
+            // Unit length 2l = F_cr / k: strain = Delta / 2l.
+            let unit_length = c.critical_load / c.stiffness;
+            self.profiles.push(Profile {
+                t,
+                x: (0..c.units)
+                    .map(|i| -0.5 * self.scene.length + (i as f64 + 0.5) * cell)
+                    .collect(),
+                strain: state.gaps.iter().map(|d| d / unit_length).collect(),
+                displacement,
+                velocity: state.velocities,
+            });
+        }
+    }
+}
+
+pub(super) fn run(
+    scene: &ChainScene,
+    control: &Control,
+    observer: &mut dyn Observer,
+) -> Result<Report, SceneError> {
+    let chain = Chain::in_scene_units(
+        scene.units,
+        scene.length,
+        scene.wave_speed,
+        scene.load_after,
+        scene.constraint,
+    );
+    let options = Options {
+        t_end: scene.t_end,
+        max_events: scene.max_events,
+        method: scene.method,
+        tolerances: scene.tolerances,
+        stop: control.stop.clone(),
+        max_wall_seconds: control.max_wall_seconds,
+    };
+    let unit_length = chain.critical_load / chain.stiffness;
+    let gaps: Vec<f64> = scene.strain.iter().map(|e| e * unit_length).collect();
+    match scene.method {
+        Method::Auto | Method::Exact => run_exact(scene, &chain, &gaps, &options, observer),
+        numerical => run_ode(scene, &chain, &gaps, &options, numerical, observer),
+    }
+}
+
+fn run_exact(
+    scene: &ChainScene,
+    chain: &Chain,
+    gaps: &[f64],
+    options: &Options,
+    observer: &mut dyn Observer,
+) -> Result<Report, SceneError> {
+    let mut model = TaylorChain::new(chain.clone(), gaps, &scene.velocity)
+        .map_err(|why| SceneError::field("initial", why))?;
+    let (order, reach) = model.order_and_reach();
+    let mut sampler = Sampler::new(scene, chain);
+    let times = sampler.times();
+    let outcome = simulate_local(
+        &mut model,
+        options,
+        &times,
+        &mut |m: &TaylorChain, t| {
+            sampler.at(t, || {
+                let at = Time::new(t);
+                let (gaps, velocities) = m.state_at(at);
+                (State { gaps, velocities }, m.energy(at))
+            })
+        },
+        observer,
+    );
+    let end = Time::new(outcome.t_reached);
+    let momentum = model.momentum(end);
+    let expected = model.momentum_by_impulses(end);
+    let scale = momentum
+        .abs()
+        .max(((chain.load - chain.critical_load) * end.value()).abs())
+        .max(chain.mass * scene.wave_speed);
+    let right_end = model.right_end(end);
+    let description = format!(
+        "chain of {} units: exact event-local flow (Taylor series of order {order} in windows of omega t = {}; \
+         each impact re-expands the {} units within its certified reach), impacts as the first roots of the series",
+        scene.units,
+        crate::models::chain::taylor::WINDOW,
+        2 * reach + 1
+    );
+    Ok(report(
+        outcome,
+        "exact",
+        description,
+        ChainOutputs {
+            momentum,
+            momentum_balance_error: Some((momentum - expected).abs() / scale),
+            right_end,
+            profiles: sampler.profiles,
+            trace: sampler.trace,
+        },
+    ))
+}
+
+/// The chain as an ODE, run from sample time to sample time (the state is
+/// continuous there, so a restart changes nothing) to take the profiles.
+fn run_ode(
+    scene: &ChainScene,
+    chain: &Chain,
+    gaps: &[f64],
+    options: &Options,
+    method: Method,
+    observer: &mut dyn Observer,
+) -> Result<Report, SceneError> {
+    let n = chain.units;
+    let mut x: Vec<f64> = gaps
+        .iter()
+        .scan(0.0, |y, d| {
+            *y += d;
+            Some(*y)
+        })
+        .chain(scene.velocity.iter().copied())
+        .collect();
+    let mut sampler = Sampler::new(scene, chain);
+    let mut stops = sampler.times();
+    stops.push(scene.t_end);
+    let energy_initial = chain.energy(0, &x).unwrap_or(0.0);
+    let scale = chain.energy_scale(energy_initial);
+    let mut total: Option<Outcome> = None;
+    let mut reached = 0.0;
+    // Largest energy error of any leg, against the run's initial energy.
+    let mut energy_error: f64 = 0.0;
+    for &stop in &stops {
+        if stop > reached {
+            let mut options = options.clone();
+            options.t_end = stop - reached;
+            let mut leg = Leg {
+                inner: &mut *observer,
+                seq: total.as_ref().map_or(0, |o| o.events),
+                t: reached,
+            };
+            let o = simulate(chain, 0, &x, &options, &mut leg);
+            x.copy_from_slice(&o.final_state);
+            reached += o.t_reached;
+            if let (Some(e0), Some(err)) = (o.energy_initial, o.max_energy_error) {
+                let leg_scale = chain.energy_scale(e0);
+                energy_error = energy_error.max((err * leg_scale + (e0 - energy_initial).abs()) / scale);
+            }
+            let stopped = o.status != Status::Completed;
+            total = Some(match total {
+                None => o,
+                Some(t) => combine(t, o),
+            });
+            if stopped {
+                break;
+            }
+        }
+        let (ys, vs) = x.split_at(n);
+        let energy = chain.energy(0, &x);
+        sampler.at(stop, || {
+            let gaps = (0..n).map(|i| ys[i] - if i > 0 { ys[i - 1] } else { 0.0 }).collect();
+            (
+                State {
+                    gaps,
+                    velocities: vs.to_vec(),
+                },
+                energy,
+            )
+        });
+    }
+    let mut outcome = total.expect("t_end > 0 gives one leg");
+    outcome.t_reached = reached;
+    outcome.t_end = scene.t_end;
+    outcome.max_energy_error = Some(energy_error);
+    let name = method.name();
+    let description = format!("chain of {n} units as a linear ODE in positions and velocities, by {name}");
+    Ok(report(
+        outcome,
+        name,
+        description,
+        ChainOutputs {
+            momentum: chain.momentum(&x),
+            momentum_balance_error: None,
+            right_end: x[n - 1],
+            profiles: sampler.profiles,
+            trace: sampler.trace,
+        },
+    ))
+}
+
+fn report(outcome: Outcome, method: &'static str, description: String, chain: ChainOutputs) -> Report {
+    Report {
+        outcome,
+        method,
+        description,
+        final_state: vec![("momentum", chain.momentum), ("right_end", chain.right_end)],
+        chain: Some(chain),
+    }
+}
+
+/// Two legs of one run as one outcome.
+fn combine(mut a: Outcome, b: Outcome) -> Outcome {
+    for (guard, n) in b.events_by_guard {
+        *a.events_by_guard.entry(guard).or_insert(0) += n;
+    }
+    Outcome {
+        status: b.status,
+        reason: b.reason,
+        events: a.events + b.events,
+        zeno: a.zeno || b.zeno,
+        energy_final: b.energy_final,
+        final_state: b.final_state,
+        flow_evaluations: a.flow_evaluations + b.flow_evaluations,
+        error_bound: a.error_bound + b.error_bound,
+        wall_seconds: a.wall_seconds + b.wall_seconds,
+        ..a
+    }
+}
+
+/// One leg's events as the run's: numbered on from `seq`, timed from `t`
+/// (each leg counts from 1 and starts its clock at 0).
+struct Leg<'o> {
+    inner: &'o mut dyn Observer,
+    seq: u64,
+    t: f64,
+}
+
+impl Observer for Leg<'_> {
+    fn on_event(&mut self, event: &EventRecord) -> std::io::Result<()> {
+        let moved = EventRecord {
+            seq: event.seq + self.seq,
+            t: event.t + self.t,
+            ..*event
+        };
+        self.inner.on_event(&moved)
+    }
+
+    fn on_progress(&mut self, t: f64, events: u64) {
+        self.inner.on_progress(t + self.t, events + self.seq);
+    }
+
+    fn wants_details(&self) -> bool {
+        self.inner.wants_details()
+    }
+}

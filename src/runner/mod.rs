@@ -1,0 +1,49 @@
+//! Running a validated scene: build its model, pick its method, run it, and
+//! describe the result in the scene's own terms.
+
+mod chain;
+mod mechanism;
+
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
+
+use crate::engine::{Observer, Outcome};
+use crate::scene::{Scene, SceneError};
+
+pub use chain::{ChainOutputs, Profile, TraceRow};
+
+/// A finished run and what the summary needs to say about it.
+#[derive(Debug, Clone)]
+pub struct Report {
+    pub outcome: Outcome,
+    /// The method used, in the names `flicker compare` uses (`exact`, `dopri5`).
+    pub method: &'static str,
+    /// A sentence saying which description of the model was used and why.
+    pub description: String,
+    /// The final state in the scene's physical variables.
+    pub final_state: Vec<(&'static str, f64)>,
+    /// What a chain run adds: momentum, profiles, the trace.
+    pub chain: Option<ChainOutputs>,
+}
+
+/// What may stop a run from outside the scene.
+#[derive(Debug, Clone, Default)]
+pub struct Control {
+    /// Interrupts the run cleanly when set (a signal handler sets it).
+    pub stop: Option<Arc<AtomicBool>>,
+    /// Fails the run after this much wall time.
+    pub max_wall_seconds: Option<f64>,
+}
+
+/// Run `scene` under `control`.
+pub fn run(
+    scene: &Scene,
+    control: &Control,
+    observer: &mut dyn Observer,
+) -> Result<Report, SceneError> {
+    match scene {
+        Scene::Mechanism(m) => mechanism::run(m, control, observer),
+        Scene::Chain(c) => chain::run(c, control, observer),
+    }
+}
+

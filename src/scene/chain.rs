@@ -1,0 +1,235 @@
+//! The keys of a chain scene (PHYSICS.md s.4, scene units).
+//!
+//! ```json
+//! {"model": "chain", "units": 200, "length": 2.0, "wave_speed": 1.0,
+//!  "load": {"before": 1.1, "after": 0.0}, "constraint": true,
+//!  "t_end": 3.0, "snapshots": [0.6667, 1.3333, 2.0], "samples": 300}
+//! ```
+//!
+//! - `units`: N, a whole number from 1 to 10^6; `length` `L > 0`;
+//!   `wave_speed` `c > 0` (so `F_cr = c^2`, node mass `L / N`, unit
+//!   stiffness `F_cr N / L`).
+//! - `load`: `{"before", "after"}`, the end load over `F_cr` before and after
+//!   the release at `t = 0`. Every unit starts at strain `before - 1`, at
+//!   rest, unless `initial` says otherwise; energies use `after`.
+//! - `constraint`: `true` (default, units are unilateral: impacts) or
+//!   `false` (the classical linear chain).
+//! - `t_end > 0`; `snapshots`: times in `[0, t_end]` for `profiles.json`
+//!   (default none); `samples`: how many rows `trace.csv` has, at
+//!   `linspace(0, t_end, samples)` (default 101).
+//! - optional: `initial` `{"strain": [N numbers], "velocity": [N numbers]}`
+//!   (unit strains, `>= 0` with the constraint, and node velocities; either
+//!   may be left out), `solver` (`exact`, the default, the event-local
+//!   Taylor flow; `dopri5`, `verlet` or `linear` run the chain as an ODE, the
+//!   independent path, for up to [`MAX_ODE_UNITS`] units), `max_events`,
+//!   `description`.
+
+use serde_json::Value;
+
+use crate::engine::{Method, Tolerances};
+use crate::scene::SceneError;
+use crate::scene::fields::{Fields, kind};
+use crate::scene::solver::SolverSpec;
+
+/// Most units a scene may have.
+pub const MAX_UNITS: u64 = 1_000_000;
+
+/// Most units the ODE methods are offered for: every step costs O(N) and
+/// scans N guards (the linear propagator a dense 2N x 2N exponential).
+pub const MAX_ODE_UNITS: usize = 2000;
+
+/// Most rows of `trace.csv`.
+const MAX_SAMPLES: u64 = 1_000_000;
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct ChainScene {
+    pub units: usize,
+    pub length: f64,
+    pub wave_speed: f64,
+    pub load_before: f64,
+    pub load_after: f64,
+    pub constraint: bool,
+    pub t_end: f64,
+    /// Sorted times for `profiles.json`.
+    pub snapshots: Vec<f64>,
+    pub samples: usize,
+    /// Initial unit strains and node velocities, N each.
+    pub strain: Vec<f64>,
+    pub velocity: Vec<f64>,
+    pub solver: SolverSpec,
+    pub method: Method,
+    pub tolerances: Tolerances,
+    pub max_events: u64,
+    pub description: Option<String>,
+}
+
+impl ChainScene {
+    /// The times `trace.csv` samples: `linspace(0, t_end, samples)`.
+    pub fn sample_times(&self) -> Vec<f64> {
+        match self.samples {
+            0 => Vec::new(),
+            1 => vec![0.0],
+            n => (0..n)
+                .map(|i| self.t_end * i as f64 / (n - 1) as f64)
+                .collect(),
+        }
+    }
+}
+
+pub(crate) fn validate(mut f: Fields) -> Result<ChainScene, SceneError> {
+    let units = f.optional_count("units")?.ok_or_else(|| SceneError::field("units", "is missing".into()))?;
+    if units > MAX_UNITS {
+        return Err(SceneError::field(
+            "units",
+            format!("must be at most {MAX_UNITS} (got {units})"),
+        ));
+    }
+    let units = units as usize;
+    let length = f.number_where("length", "> 0", |x| x > 0.0)?;
+    let wave_speed = f.number_where("wave_speed", "> 0", |x| x > 0.0)?;
+    let (load_before, load_after) = load(f.required("load")?)?;
+    let constraint = match f.optional("constraint") {
+        None => true,
+        Some(Value::Bool(b)) => *b,
+        Some(other) => {
+            return Err(SceneError::field(
+                "constraint",
+                format!("must be true or false, found {}", kind(other)),
+            ));
+        }
+    };
+    let t_end = f.number_where("t_end", "> 0", |t| t > 0.0)?;
+    let mut snapshots = match f.optional("snapshots") {
+        None => Vec::new(),
+        Some(v) => numbers(v, "snapshots", None)?,
+    };
+    if let Some(t) = snapshots.iter().find(|t| !(0.0..=t_end).contains(*t)) {
+        return Err(SceneError::field(
+            "snapshots",
+            format!("must lie in [0, t_end = {t_end}] (got {t})"),
+        ));
+    }
+    snapshots.sort_by(f64::total_cmp);
+    let samples = match f.optional("samples") {
+        None => 101,
+        Some(v) => match v.as_u64() {
+            Some(n) if n <= MAX_SAMPLES => n as usize,
+            _ => {
+                return Err(SceneError::field(
+                    "samples",
+                    format!("must be a whole number from 0 to {MAX_SAMPLES}, found {}", kind(v)),
+                ));
+            }
+        },
+    };
+    let at_rest = load_before - 1.0;
+    let (strain, velocity) = match f.optional("initial") {
+        None => (vec![at_rest; units], vec![0.0; units]),
+        Some(v) => initial(v, units, at_rest)?,
+    };
+    if constraint && let Some(n) = strain.iter().position(|&e| e < 0.0) {
+        let from = if f.has("initial") {
+            format!("initial.strain[{n}] is {}", strain[n])
+        } else {
+            format!("load.before = {load_before} puts every unit at strain {at_rest}")
+        };
+        return Err(SceneError::field(
+            if f.has("initial") { "initial.strain" } else { "load.before" },
+            format!("{from}, below zero, which the constraint forbids (use \"constraint\": false for the classical chain)"),
+        ));
+    }
+    let solver = f
+        .optional("solver")
+        .map(SolverSpec::from_json)
+        .transpose()?
+        .unwrap_or_default();
+    let (method, tolerances) = resolve_solver(&solver, units)?;
+    crate::scene::mechanism::check_steps(method, t_end)?;
+    let max_events = f.optional_count("max_events")?.unwrap_or(1_000_000_000);
+    let description = f.optional_string("description")?.map(str::to_string);
+    f.finish()?;
+    Ok(ChainScene {
+        units,
+        length,
+        wave_speed,
+        load_before,
+        load_after,
+        constraint,
+        t_end,
+        snapshots,
+        samples,
+        strain,
+        velocity,
+        solver,
+        method,
+        tolerances,
+        max_events,
+        description,
+    })
+}
+
+/// The method and tolerances of `spec` for a chain of `units`.
+pub fn resolve_solver(spec: &SolverSpec, units: usize) -> Result<(Method, Tolerances), SceneError> {
+    let (method, tolerances) = spec.resolve()?;
+    let numerical = !matches!(method, Method::Auto | Method::Exact);
+    if numerical && units > MAX_ODE_UNITS {
+        return Err(SceneError::field(
+            "solver.method",
+            format!(
+                "{} runs the chain as an ODE, for at most {MAX_ODE_UNITS} units (this one has {units}); use \"exact\"",
+                method.name()
+            ),
+        ));
+    }
+    Ok((method, tolerances))
+}
+
+fn load(value: &Value) -> Result<(f64, f64), SceneError> {
+    let mut f = Fields::open(value, "load")?;
+    let before = f.number("before")?;
+    let after = f.number("after")?;
+    f.finish()?;
+    Ok((before, after))
+}
+
+fn initial(value: &Value, units: usize, at_rest: f64) -> Result<(Vec<f64>, Vec<f64>), SceneError> {
+    let mut f = Fields::open(value, "initial")?;
+    let strain = f
+        .optional("strain")
+        .map(|v| numbers(v, "initial.strain", Some(units)))
+        .transpose()?
+        .unwrap_or_else(|| vec![at_rest; units]);
+    let velocity = f
+        .optional("velocity")
+        .map(|v| numbers(v, "initial.velocity", Some(units)))
+        .transpose()?
+        .unwrap_or_else(|| vec![0.0; units]);
+    f.finish()?;
+    Ok((strain, velocity))
+}
+
+/// An array of finite numbers at `path`, of length `len` if given.
+fn numbers(value: &Value, path: &str, len: Option<usize>) -> Result<Vec<f64>, SceneError> {
+    let Value::Array(items) = value else {
+        return Err(SceneError::field(path, format!("must be an array of numbers, found {}", kind(value))));
+    };
+    if let Some(n) = len
+        && items.len() != n
+    {
+        return Err(SceneError::field(
+            path,
+            format!("must have one entry per unit ({n}), found {}", items.len()),
+        ));
+    }
+    items
+        .iter()
+        .enumerate()
+        .map(|(i, v)| match v.as_f64() {
+            Some(x) if x.is_finite() => Ok(x),
+            _ => Err(SceneError::field(
+                &format!("{path}[{i}]"),
+                format!("must be a finite number, found {}", kind(v)),
+            )),
+        })
+        .collect()
+}
