@@ -148,7 +148,9 @@ pub fn run(args: RunArgs) -> Result<Code, Failure> {
         let trace = out.join("trace.csv");
         write_atomically(&profiles, &chain_files::profiles(chain))
             .and_then(|()| chain_files::write_trace(chain, &trace))
-            .map_err(|e| Failure::untrusted(format!("{}: cannot be written: {e}", out.display())))?;
+            .map_err(|e| {
+                Failure::untrusted(format!("{}: cannot be written: {e}", out.display()))
+            })?;
         written.extend([profiles, trace]);
     }
     let summary_path = out.join("summary.json");

@@ -226,9 +226,13 @@ impl LocalRun<'_> {
         let guard = model.guards()[slot];
         let logged = !guard.internal && observer.wants_details();
         let energy_before = if logged { model.energy(t) } else { None };
-        let fired = model
-            .fire(slot, t)
-            .map_err(|why| failed(format!("the `{}` reset at t = {}: {why}", guard.name, t.value())))?;
+        let fired = model.fire(slot, t).map_err(|why| {
+            failed(format!(
+                "the `{}` reset at t = {}: {why}",
+                guard.name,
+                t.value()
+            ))
+        })?;
         self.now = t;
         let guards = model.guards().len();
         if fired.affects.end > guards {
@@ -284,7 +288,10 @@ impl LocalRun<'_> {
         if !fired.affects.contains(&slot) {
             self.predict(model, slot)?;
         }
-        fired.affects.clone().try_for_each(|g| self.predict(model, g))
+        fired
+            .affects
+            .clone()
+            .try_for_each(|g| self.predict(model, g))
     }
 
     fn predict<M: LocalModel + ?Sized>(&mut self, model: &M, g: usize) -> Result<(), Stop> {

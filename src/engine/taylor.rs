@@ -62,7 +62,11 @@ const MAX_PIECES: u32 = 4096;
 pub fn first_fall(c: &[f64], a: f64, b: f64) -> Option<f64> {
     // Cheap proof of no root, the common case: p(s) >= c_0 - sum |c_k| b^k
     // on [0, b]. A constant p never crosses either.
-    let reach = c.iter().skip(1).rev().fold(0.0, |acc, ck| (acc + ck.abs()) * b);
+    let reach = c
+        .iter()
+        .skip(1)
+        .rev()
+        .fold(0.0, |acc, ck| (acc + ck.abs()) * b);
     let constant = c.first().copied().unwrap_or(0.0);
     if constant - reach * (1.0 + 1e-12) > 0.0 || reach == 0.0 {
         return None;
@@ -235,7 +239,10 @@ mod tests {
         assert_eq!(first_fall(&[0.0, 0.0, 1.0], 0.0, 1.0), None);
         // Closing through zero right now fires now.
         assert_eq!(first_fall(&[0.0, -1.0], 0.0, 1.0), Some(0.0));
-        assert_eq!(first_fall(&[-1e-18, 1.0, -4.0], 0.0, 1.0).map(|s| (s - 0.25).abs() < 1e-9), Some(true));
+        assert_eq!(
+            first_fall(&[-1e-18, 1.0, -4.0], 0.0, 1.0).map(|s| (s - 0.25).abs() < 1e-9),
+            Some(true)
+        );
     }
 
     #[test]
@@ -243,6 +250,9 @@ mod tests {
         let c = [1.0, -3.0, 0.5];
         let s = first_fall(&c, 0.0, 1.0).unwrap();
         let exact = 3.0 - 7.0f64.sqrt();
-        assert!((s - exact).abs() <= 8.0 * f64::EPSILON * exact, "{s} {exact}");
+        assert!(
+            (s - exact).abs() <= 8.0 * f64::EPSILON * exact,
+            "{s} {exact}"
+        );
     }
 }

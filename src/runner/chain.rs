@@ -251,7 +251,8 @@ fn run_ode(
             reached += o.t_reached;
             if let (Some(e0), Some(err)) = (o.energy_initial, o.max_energy_error) {
                 let leg_scale = chain.energy_scale(e0);
-                energy_error = energy_error.max((err * leg_scale + (e0 - energy_initial).abs()) / scale);
+                energy_error =
+                    energy_error.max((err * leg_scale + (e0 - energy_initial).abs()) / scale);
             }
             let stopped = o.status != Status::Completed;
             total = Some(match total {
@@ -265,7 +266,9 @@ fn run_ode(
         let (ys, vs) = x.split_at(n);
         let energy = chain.energy(0, &x);
         sampler.at(stop, || {
-            let gaps = (0..n).map(|i| ys[i] - if i > 0 { ys[i - 1] } else { 0.0 }).collect();
+            let gaps = (0..n)
+                .map(|i| ys[i] - if i > 0 { ys[i - 1] } else { 0.0 })
+                .collect();
             (
                 State {
                     gaps,
@@ -280,7 +283,8 @@ fn run_ode(
     outcome.t_end = scene.t_end;
     outcome.max_energy_error = Some(energy_error);
     let name = method.name();
-    let description = format!("chain of {n} units as a linear ODE in positions and velocities, by {name}");
+    let description =
+        format!("chain of {n} units as a linear ODE in positions and velocities, by {name}");
     Ok(report(
         outcome,
         name,
@@ -295,7 +299,12 @@ fn run_ode(
     ))
 }
 
-fn report(outcome: Outcome, method: &'static str, description: String, chain: ChainOutputs) -> Report {
+fn report(
+    outcome: Outcome,
+    method: &'static str,
+    description: String,
+    chain: ChainOutputs,
+) -> Report {
     Report {
         outcome,
         method,

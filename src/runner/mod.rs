@@ -46,4 +46,3 @@ pub fn run(
         Scene::Chain(c) => chain::run(c, control, observer),
     }
 }
-

@@ -77,7 +77,9 @@ impl ChainScene {
 }
 
 pub(crate) fn validate(mut f: Fields) -> Result<ChainScene, SceneError> {
-    let units = f.optional_count("units")?.ok_or_else(|| SceneError::field("units", "is missing".into()))?;
+    let units = f
+        .optional_count("units")?
+        .ok_or_else(|| SceneError::field("units", "is missing".into()))?;
     if units > MAX_UNITS {
         return Err(SceneError::field(
             "units",
@@ -117,7 +119,10 @@ pub(crate) fn validate(mut f: Fields) -> Result<ChainScene, SceneError> {
             _ => {
                 return Err(SceneError::field(
                     "samples",
-                    format!("must be a whole number from 0 to {MAX_SAMPLES}, found {}", kind(v)),
+                    format!(
+                        "must be a whole number from 0 to {MAX_SAMPLES}, found {}",
+                        kind(v)
+                    ),
                 ));
             }
         },
@@ -134,8 +139,14 @@ pub(crate) fn validate(mut f: Fields) -> Result<ChainScene, SceneError> {
             format!("load.before = {load_before} puts every unit at strain {at_rest}")
         };
         return Err(SceneError::field(
-            if f.has("initial") { "initial.strain" } else { "load.before" },
-            format!("{from}, below zero, which the constraint forbids (use \"constraint\": false for the classical chain)"),
+            if f.has("initial") {
+                "initial.strain"
+            } else {
+                "load.before"
+            },
+            format!(
+                "{from}, below zero, which the constraint forbids (use \"constraint\": false for the classical chain)"
+            ),
         ));
     }
     let solver = f
@@ -211,7 +222,10 @@ fn initial(value: &Value, units: usize, at_rest: f64) -> Result<(Vec<f64>, Vec<f
 /// An array of finite numbers at `path`, of length `len` if given.
 fn numbers(value: &Value, path: &str, len: Option<usize>) -> Result<Vec<f64>, SceneError> {
     let Value::Array(items) = value else {
-        return Err(SceneError::field(path, format!("must be an array of numbers, found {}", kind(value))));
+        return Err(SceneError::field(
+            path,
+            format!("must be an array of numbers, found {}", kind(value)),
+        ));
     };
     if let Some(n) = len
         && items.len() != n

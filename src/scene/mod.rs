@@ -16,8 +16,8 @@ use std::path::{Path, PathBuf};
 
 use serde_json::Value;
 
-use crate::scene::fields::{Fields, kind};
 pub use crate::scene::chain::ChainScene;
+use crate::scene::fields::{Fields, kind};
 pub use crate::scene::mechanism::{Formulation, Initial, MechanismScene};
 
 /// A validated scene.

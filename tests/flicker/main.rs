@@ -2,6 +2,8 @@
 
 mod bouncing_ball;
 mod chain;
+mod chain_cli;
+mod chain_exact;
 mod cli;
 mod compare;
 mod convergence;

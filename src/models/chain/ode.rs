@@ -76,7 +76,9 @@ impl HybridModel for Chain {
         let window = 8.0 * f64::EPSILON;
         let shut: Vec<bool> = (1..=n)
             .map(|unit| {
-                let scale = x[unit - 1].abs().max(if unit > 1 { x[unit - 2].abs() } else { 0.0 });
+                let scale = x[unit - 1]
+                    .abs()
+                    .max(if unit > 1 { x[unit - 2].abs() } else { 0.0 });
                 self.elongation(x, unit) <= window * scale
             })
             .collect();

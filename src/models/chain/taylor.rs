@@ -110,7 +110,10 @@ impl TaylorChain {
             return Err("the load and the initial state must be finite".into());
         }
         if chain.constraint && gaps.iter().any(|&d| d < 0.0) {
-            return Err("a unit starts with a negative gap (strain below zero) while the constraint is on".into());
+            return Err(
+                "a unit starts with a negative gap (strain below zero) while the constraint is on"
+                    .into(),
+            );
         }
         let order = order_for(WINDOW);
         let reach = reach_for(WINDOW, order);
@@ -176,7 +179,10 @@ impl TaylorChain {
         let s = self.stride();
         let tau = (sigma - self.origin[n]).max(0.0);
         let range = n * s..(n + 1) * s;
-        (eval(&self.gap[range.clone()], tau), eval(&self.vel[range], tau))
+        (
+            eval(&self.gap[range.clone()], tau),
+            eval(&self.vel[range], tau),
+        )
     }
 
     /// Unit gaps `Delta_n` and node velocities `v_n` at `t` (not before the
@@ -243,7 +249,10 @@ impl TaylorChain {
         loop {
             let reach = lo.saturating_sub(self.reach).max(1)..=(hi + self.reach).min(n);
             let (r_lo, r_hi) = (*reach.start(), *reach.end());
-            let (w_lo, w_hi) = (r_lo.saturating_sub(self.spread).max(1), (r_hi + self.spread).min(n));
+            let (w_lo, w_hi) = (
+                r_lo.saturating_sub(self.spread).max(1),
+                (r_hi + self.spread).min(n),
+            );
             let count = w_hi - w_lo + 1;
             self.scratch_gap.clear();
             self.scratch_gap.resize(count * s, 0.0);
@@ -255,11 +264,14 @@ impl TaylorChain {
                 self.scratch_vel[(i - w_lo) * s] = u;
             }
             let u_at = |node: usize, v: &[f64]| if node == 0 { 0.0 } else { v[(node - w_lo) * s] };
-            let rel_velocity = self.omega * (u_at(unit - 1, &self.scratch_vel) - u_at(unit, &self.scratch_vel));
+            let rel_velocity =
+                self.omega * (u_at(unit - 1, &self.scratch_vel) - u_at(unit, &self.scratch_vel));
             let shut: Vec<bool> = (r_lo..=r_hi)
                 .map(|i| i == unit || self.scratch_gap[(i - w_lo) * s] <= self.shut_below)
                 .collect();
-            let mut v: Vec<f64> = (r_lo - 1..=r_hi).map(|i| u_at(i, &self.scratch_vel)).collect();
+            let mut v: Vec<f64> = (r_lo - 1..=r_hi)
+                .map(|i| u_at(i, &self.scratch_vel))
+                .collect();
             let before: f64 = v.iter().sum();
             let Some(touched) = cascade(r_lo, &shut, &mut v) else {
                 // Not closing after all (a graze within round-off): no reset.
@@ -291,7 +303,13 @@ impl TaylorChain {
                 *g = g.max(0.0);
             }
             let ghost = (w_hi == n).then_some(self.ghost);
-            levels(&mut self.scratch_gap, &mut self.scratch_vel, count, self.order, ghost);
+            levels(
+                &mut self.scratch_gap,
+                &mut self.scratch_vel,
+                count,
+                self.order,
+                ghost,
+            );
             let (from, to) = ((r_lo - w_lo) * s, (r_hi - w_lo + 1) * s);
             self.gap[r_lo * s..(r_hi + 1) * s].copy_from_slice(&self.scratch_gap[from..to]);
             self.vel[r_lo * s..(r_hi + 1) * s].copy_from_slice(&self.scratch_vel[from..to]);
@@ -452,7 +470,8 @@ mod tests {
         // order-2D coefficient, along a single path: 2 theta^(2D) / (2D)!.
         // That lone term must be certified, and must not be one reach closer.
         let reach = reach_for(WINDOW, order) as i32;
-        let leading = |d: i32| 2.0 * WINDOW.powi(2 * d) / (1..=2 * d).map(f64::from).product::<f64>();
+        let leading =
+            |d: i32| 2.0 * WINDOW.powi(2 * d) / (1..=2 * d).map(f64::from).product::<f64>();
         assert!(leading(reach) < CERTIFIED, "{reach}");
         assert!(leading(reach - 1) > CERTIFIED, "{reach}");
         assert!(order < 16 && reach < 8, "{order} {reach}");
