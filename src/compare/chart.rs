@@ -7,18 +7,10 @@ use std::path::Path;
 use plotters::prelude::*;
 
 use crate::compare::Row;
+use crate::plot::draw::PALETTE;
 
 /// Errors below this are drawn at it (an exact method can hit zero).
 const ERROR_FLOOR: f64 = 1e-17;
-
-const COLOURS: [RGBColor; 6] = [
-    RGBColor(31, 119, 180),
-    RGBColor(214, 39, 40),
-    RGBColor(44, 160, 44),
-    RGBColor(148, 103, 189),
-    RGBColor(255, 127, 14),
-    RGBColor(23, 190, 207),
-];
 
 /// Draw `rows` (failed runs left out) to `path`, titled `title`.
 pub fn draw(rows: &[Row], title: &str, path: &Path) -> Result<(), String> {
@@ -91,7 +83,7 @@ where
     let mut methods: Vec<&str> = points.iter().map(|p| p.0).collect();
     methods.dedup();
     for (i, method) in methods.iter().enumerate() {
-        let colour = COLOURS[i % COLOURS.len()];
+        let colour = PALETTE[i % PALETTE.len()];
         let mut line: Vec<(f64, f64)> = points
             .iter()
             .filter(|p| p.0 == *method)

@@ -1,9 +1,14 @@
 //! What a chain run writes besides the log and the summary.
 //!
 //! - `profiles.json`: `{"snapshots": [{"t", "x", "strain", "displacement",
-//!   "velocity"}]}`, one entry per snapshot time; entry `n` of each array is
-//!   unit `n + 1` (its centre `x` and strain) and node `n + 1` (the unit's
-//!   end away from the wall: its displacement and velocity).
+//!   "velocity"}], "classical": ...}`, one entry per snapshot time; entry
+//!   `n` of each array is unit `n + 1` (its centre `x` and strain) and node
+//!   `n + 1` (the unit's end away from the wall: its displacement and
+//!   velocity). `classical` holds the same scene with the constraint off
+//!   (the classical string, for comparison) as `{"snapshots": [..],
+//!   "trace": [{"t", "right_end"}]}`, or null (constraint off already, a
+//!   run that did not complete, or more than
+//!   [`CLASSICAL_MAX_UNITS`](crate::runner::CLASSICAL_MAX_UNITS) units).
 //! - `trace.csv`: columns `t,energy,momentum,right_end` at the scene's
 //!   sample times, `right_end` being the loaded end's displacement `y_N`.
 
@@ -12,12 +17,23 @@ use std::path::Path;
 
 use serde_json::{Value, json};
 
-use crate::runner::ChainOutputs;
+use crate::runner::{ChainOutputs, Profile};
 
 /// The contents of `profiles.json`.
 pub fn profiles(chain: &ChainOutputs) -> Value {
-    let snapshots: Vec<Value> = chain
-        .profiles
+    let classical = chain.classical.as_ref().map(|c| {
+        let trace: Vec<Value> = c
+            .trace
+            .iter()
+            .map(|r| json!({"t": r.t, "right_end": r.right_end}))
+            .collect();
+        json!({ "snapshots": snapshots(&c.profiles), "trace": trace })
+    });
+    json!({ "snapshots": snapshots(&chain.profiles), "classical": classical })
+}
+
+fn snapshots(profiles: &[Profile]) -> Vec<Value> {
+    profiles
         .iter()
         .map(|p| {
             json!({
@@ -28,8 +44,7 @@ pub fn profiles(chain: &ChainOutputs) -> Value {
                 "velocity": p.velocity,
             })
         })
-        .collect();
-    json!({ "snapshots": snapshots })
+        .collect()
 }
 
 /// Write `trace.csv` through a temporary file and a rename.

@@ -141,6 +141,7 @@ mod tests {
             guard: guard.into(),
             energy_before: Some(1.0),
             energy_after: Some(1.0 + jump),
+            unit: None,
         }
     }
 

@@ -15,6 +15,9 @@ pub struct LoggedEvent {
     pub guard: String,
     pub energy_before: Option<f64>,
     pub energy_after: Option<f64>,
+    /// A chain's unit.
+    #[serde(default)]
+    pub unit: Option<u64>,
 }
 
 /// A log that could not be read: which file, which line, why.

@@ -17,7 +17,23 @@ pub enum Style {
     Simulated,
     /// The edge of the admissible region.
     Constraint,
+    /// One of several series: a solid line in palette colour `i`.
+    Line(usize),
+    /// The same, dashed (a reference drawn beside a series).
+    Dashed(usize),
+    /// The same, as dots.
+    Dots(usize),
 }
+
+/// Colours of [`Style::Line`], [`Style::Dashed`] and [`Style::Dots`].
+pub const PALETTE: [RGBColor; 6] = [
+    RGBColor(31, 119, 180),
+    RGBColor(214, 39, 40),
+    RGBColor(44, 160, 44),
+    RGBColor(148, 103, 189),
+    RGBColor(255, 127, 14),
+    RGBColor(23, 190, 207),
+];
 
 /// One curve, with the label drawn at its start (if any).
 #[derive(Debug, Clone)]
@@ -132,6 +148,29 @@ impl Figure {
                 Style::Simulated => {
                     chart
                         .draw_series(points.iter().map(|p| Circle::new(*p, 2, orange.filled())))
+                        .map_err(err)?;
+                }
+                Style::Line(i) => {
+                    let colour = PALETTE[i % PALETTE.len()];
+                    chart
+                        .draw_series(LineSeries::new(points.clone(), colour.stroke_width(2)))
+                        .map_err(err)?;
+                }
+                Style::Dashed(i) => {
+                    let colour = PALETTE[i % PALETTE.len()];
+                    chart
+                        .draw_series(DashedLineSeries::new(
+                            points.clone(),
+                            6,
+                            4,
+                            colour.stroke_width(1),
+                        ))
+                        .map_err(err)?;
+                }
+                Style::Dots(i) => {
+                    let colour = PALETTE[i % PALETTE.len()];
+                    chart
+                        .draw_series(points.iter().map(|p| Circle::new(*p, 1, colour.filled())))
                         .map_err(err)?;
                 }
             }

@@ -1,7 +1,8 @@
 //! Pictures: phase portraits of the mechanism ([`phase`]) and what a run
-//! wrote ([`run`]), drawn with a bundled font ([`draw`]), so a machine
+//! wrote ([`run`], with a chain's own in [`chain`]), drawn with a bundled font ([`draw`]), so a machine
 //! without system fonts draws text.
 
+pub mod chain;
 pub mod draw;
 pub mod phase;
 pub mod run;

@@ -23,7 +23,22 @@ pub struct ChainOutputs {
     pub right_end: f64,
     pub profiles: Vec<Profile>,
     pub trace: Vec<TraceRow>,
+    /// The classical chain (same scene, constraint off) at the same times,
+    /// for the pictures; for constrained chains of up to
+    /// [`CLASSICAL_MAX_UNITS`] units.
+    pub classical: Option<Classical>,
 }
+
+/// The classical chain's profiles and trace.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Classical {
+    pub profiles: Vec<Profile>,
+    pub trace: Vec<TraceRow>,
+}
+
+/// Largest chain the classical companion is computed for: it costs about
+/// as much as the impacting run's flow without its impacts.
+pub const CLASSICAL_MAX_UNITS: usize = 2000;
 
 /// The chain at one time: entry `n` is unit `n + 1` (its centre `x`, its
 /// strain) and node `n + 1` (its displacement and velocity).
@@ -80,6 +95,15 @@ impl<'s> Sampler<'s> {
         times.sort_by(f64::total_cmp);
         times.dedup();
         times
+    }
+
+    /// Record what is due at `t` from the exact flow.
+    fn sample(&mut self, model: &TaylorChain, t: f64) {
+        self.at(t, || {
+            let at = Time::new(t);
+            let (gaps, velocities) = model.state_at(at);
+            (State { gaps, velocities }, model.energy(at))
+        })
     }
 
     /// Record what is due at `t`, given the state and energy there.
@@ -149,10 +173,43 @@ pub(super) fn run(
     };
     let unit_length = chain.critical_load / chain.stiffness;
     let gaps: Vec<f64> = scene.strain.iter().map(|e| e * unit_length).collect();
-    match scene.method {
-        Method::Auto | Method::Exact => run_exact(scene, &chain, &gaps, &options, observer),
-        numerical => run_ode(scene, &chain, &gaps, &options, numerical, observer),
+    let mut report = match scene.method {
+        Method::Auto | Method::Exact => run_exact(scene, &chain, &gaps, &options, observer)?,
+        numerical => run_ode(scene, &chain, &gaps, &options, numerical, observer)?,
+    };
+    if scene.constraint
+        && scene.units <= CLASSICAL_MAX_UNITS
+        && report.outcome.status == Status::Completed
+    {
+        let classical = Chain {
+            constraint: false,
+            ..Chain::in_scene_units(
+                scene.units,
+                scene.length,
+                scene.wave_speed,
+                scene.load_after,
+                false,
+            )
+        };
+        let mut model = TaylorChain::new(classical.clone(), &gaps, &scene.velocity)
+            .map_err(|why| SceneError::field("initial", why))?;
+        let mut sampler = Sampler::new(scene, &classical);
+        let times = sampler.times();
+        simulate_local(
+            &mut model,
+            &options,
+            &times,
+            &mut |m: &TaylorChain, t| sampler.sample(m, t),
+            &mut (),
+        );
+        if let Some(outputs) = report.chain.as_mut() {
+            outputs.classical = Some(Classical {
+                profiles: sampler.profiles,
+                trace: sampler.trace,
+            });
+        }
     }
+    Ok(report)
 }
 
 fn run_exact(
@@ -171,13 +228,7 @@ fn run_exact(
         &mut model,
         options,
         &times,
-        &mut |m: &TaylorChain, t| {
-            sampler.at(t, || {
-                let at = Time::new(t);
-                let (gaps, velocities) = m.state_at(at);
-                (State { gaps, velocities }, m.energy(at))
-            })
-        },
+        &mut |m: &TaylorChain, t| sampler.sample(m, t),
         observer,
     );
     let end = Time::new(outcome.t_reached);
@@ -205,6 +256,7 @@ fn run_exact(
             right_end,
             profiles: sampler.profiles,
             trace: sampler.trace,
+            classical: None,
         },
     ))
 }
@@ -295,6 +347,7 @@ fn run_ode(
             right_end: x[n - 1],
             profiles: sampler.profiles,
             trace: sampler.trace,
+            classical: None,
         },
     ))
 }

@@ -10,7 +10,7 @@ use std::sync::atomic::AtomicBool;
 use crate::engine::{Observer, Outcome};
 use crate::scene::{Scene, SceneError};
 
-pub use chain::{ChainOutputs, Profile, TraceRow};
+pub use chain::{CLASSICAL_MAX_UNITS, ChainOutputs, Classical, Profile, TraceRow};
 
 /// A finished run and what the summary needs to say about it.
 #[derive(Debug, Clone)]

@@ -85,6 +85,22 @@ fn a_release_run_writes_summary_log_profiles_and_trace() {
     let first: serde_json::Value = serde_json::from_str(log.lines().next().unwrap()).unwrap();
     assert_eq!(first["unit"], 200, "the released end closes first");
     assert!(first["rel_velocity"].as_f64().unwrap() > 0.0);
+    // The pictures: snapshots and the end beside the classical string, the
+    // impacts in space and time.
+    let classical = &profiles["classical"]["snapshots"][2]["strain"];
+    assert_eq!(classical.as_array().unwrap().len(), 200);
+    let o = flicker(&["plot", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for name in ["snapshots", "displacement", "end_displacement", "impacts"] {
+        for extension in ["svg", "png"] {
+            let path = out.join(format!("{name}.{extension}"));
+            let size = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
+            assert!(size > 1000, "{} is missing or empty", path.display());
+        }
+    }
+    // Thinned to a picture's worth of dots, and said so.
+    let map = std::fs::read_to_string(out.join("impacts.svg")).unwrap();
+    assert!(map.contains("every") && map.matches("<circle").count() <= 20_000);
 }
 
 #[test]

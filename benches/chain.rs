@@ -1,0 +1,120 @@
+//! The chain's figures: cost per impact against the number of units, the
+//! release scene, and the exact path against the ODE path on one scene.
+//!
+//! `cargo bench --bench chain` prints, as medians of several runs on the
+//! release scene of PHYSICS.md s.6 (traction-free reading, log off):
+//! - wall time per impact for N = 25 ... 3200 (each run to about 4 * 10^5
+//!   impacts), and writes them to `target/chain_cost.csv` with a chart
+//!   `target/chain_cost.svg`;
+//! - the whole release to t = 3 at N = 800 (about 2 million impacts);
+//! - impacts per second at N = 1000 to t = 1;
+//! - at N = 50, the exact path against Dormand-Prince (rtol 1e-12) on the
+//!   chain as an ODE, to t = 3: cost ratio in the same run.
+
+use std::hint::black_box;
+use std::time::Instant;
+
+use flicker::engine::{Method, Options, Tolerances, simulate, simulate_local};
+use flicker::models::chain::{Chain, TaylorChain};
+use flicker::plot::draw::{Curve, Figure, Style};
+
+const REPEATS: usize = 5;
+
+/// Median wall time of `REPEATS` runs of `f`, which returns the impacts.
+fn median_seconds(mut f: impl FnMut() -> u64) -> (f64, u64) {
+    let mut times = Vec::new();
+    let mut impacts = 0;
+    for _ in 0..REPEATS {
+        let start = Instant::now();
+        impacts = black_box(f());
+        times.push(start.elapsed().as_secs_f64());
+    }
+    times.sort_by(f64::total_cmp);
+    (times[REPEATS / 2], impacts)
+}
+
+fn released(units: usize) -> (Chain, TaylorChain) {
+    let chain = Chain::in_scene_units(units, 2.0, 1.0, 0.0, true);
+    let gap = 0.1 * chain.critical_load / chain.stiffness;
+    let model = TaylorChain::new(chain.clone(), &vec![gap; units], &vec![0.0; units]).unwrap();
+    (chain, model)
+}
+
+fn exact(units: usize, t_end: f64) -> u64 {
+    let (_, mut model) = released(units);
+    let o = simulate_local(
+        &mut model,
+        &Options::until(t_end),
+        &[],
+        &mut |_, _| {},
+        &mut (),
+    );
+    assert!(
+        o.max_energy_error.unwrap() < 1e-12,
+        "{:?}",
+        o.max_energy_error
+    );
+    o.events
+}
+
+fn main() {
+    let mut rows = Vec::new();
+    println!("cost per impact, release scene (eta 1.1 -> 0), log off, median of {REPEATS}:");
+    for units in [25, 50, 100, 200, 400, 800, 1600, 3200] {
+        // Impacts come at about 0.24 N^2 per unit time.
+        let t_end = (4e5 / (0.24 * (units * units) as f64)).min(3.0);
+        let (seconds, impacts) = median_seconds(|| exact(units, t_end));
+        let per = seconds / impacts as f64;
+        println!(
+            "  N = {units:>5}: {impacts:>8} impacts to t = {t_end:<8.4} in {seconds:.3} s: {:.3} us per impact ({:.3e} impacts/s)",
+            per * 1e6,
+            1.0 / per
+        );
+        rows.push((units, per));
+    }
+    let csv: String = std::iter::once("units,seconds_per_impact\n".to_string())
+        .chain(rows.iter().map(|(n, s)| format!("{n},{s:e}\n")))
+        .collect();
+    std::fs::write("target/chain_cost.csv", csv).expect("target/ is writable");
+    let figure = Figure {
+        title: "chain: cost per impact against the number of units".into(),
+        x_label: "log10 N".into(),
+        y_label: "microseconds per impact".into(),
+        curves: vec![Curve {
+            label: Some("exact event-local flow".into()),
+            points: rows
+                .iter()
+                .map(|(n, s)| ((*n as f64).log10(), s * 1e6))
+                .collect(),
+            style: Style::Line(0),
+        }],
+        y_limit: None,
+    };
+    figure
+        .draw(std::path::Path::new("target/chain_cost.svg"))
+        .expect("the chart draws");
+    println!("  wrote target/chain_cost.csv and target/chain_cost.svg");
+
+    let (seconds, impacts) = median_seconds(|| exact(800, 3.0));
+    println!("release to t = 3 at N = 800: {impacts} impacts in {seconds:.3} s");
+    let (seconds, impacts) = median_seconds(|| exact(1000, 1.0));
+    println!(
+        "N = 1000 to t = 1: {impacts} impacts in {seconds:.3} s = {:.3e} impacts/s",
+        impacts as f64 / seconds
+    );
+
+    let units = 50;
+    let (exact_seconds, exact_impacts) = median_seconds(|| exact(units, 3.0));
+    let (chain, _) = released(units);
+    let mut options = Options::until(3.0);
+    options.method = Method::Dopri5(Tolerances {
+        rtol: 1e-12,
+        atol: 1e-14,
+    });
+    let (ode_seconds, ode_impacts) =
+        median_seconds(|| simulate(&chain, 0, &chain.homogeneous(0.1), &options, &mut ()).events);
+    println!(
+        "N = {units} to t = 3: exact {exact_impacts} impacts in {exact_seconds:.4} s; Dormand-Prince (1e-12) on the ODE {ode_impacts} in {ode_seconds:.4} s: {:.1}x",
+        ode_seconds / exact_seconds
+    );
+}
