@@ -7,10 +7,11 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use flicker::engine::Status;
+use flicker::engine::{Method, Status};
 use flicker::log::JsonlWriter;
 use flicker::log::chain_files;
 use flicker::log::summary::{summary, write_atomically};
+use flicker::runner::ensemble::run_ensemble;
 use flicker::runner::{Control, Report, run as run_scene};
 use flicker::scene::solver::SolverSpec;
 use flicker::scene::{self, Scene};
@@ -26,7 +27,8 @@ pub struct RunArgs {
     /// Output directory (default: out/<scene name>).
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
-    /// Simulated time to stop at, replacing the scene's t_end.
+    /// Simulated time to stop at, replacing the scene's t_end (a chain
+    /// scene's snapshots after it are not taken).
     #[arg(long = "t-end", value_name = "T", allow_negative_numbers = true)]
     t_end: Option<f64>,
     /// Do not write the event log.
@@ -37,6 +39,24 @@ pub struct RunArgs {
     quiet: bool,
     #[command(flatten)]
     solver: SolverFlags,
+    #[command(flatten)]
+    ensemble: EnsembleFlags,
+}
+
+/// A chain scene's reproducibility horizon.
+#[derive(Debug, clap::Args)]
+pub struct EnsembleFlags {
+    /// Also run K copies with perturbed initial strains (chain scenes, exact
+    /// flow) and report when their unit strains part (the horizon) and how
+    /// far the coarse fields spread, in the summary and ensemble.csv.
+    #[arg(long, value_name = "K")]
+    ensemble: Option<usize>,
+    /// Relative perturbation of each unit's initial strain.
+    #[arg(long, value_name = "P", default_value_t = 1e-12, requires = "ensemble")]
+    perturb: f64,
+    /// Seed of the perturbations (the same seed gives the same ensemble).
+    #[arg(long, value_name = "S", default_value_t = 0, requires = "ensemble")]
+    seed: u64,
 }
 
 /// Flags that override a scene's `solver`.
@@ -65,6 +85,7 @@ pub fn run(args: RunArgs) -> Result<Code, Failure> {
         no_events,
         quiet,
         solver,
+        ensemble,
     } = args;
     let scene_path = scene_path.as_path();
     let log_events = !no_events;
@@ -89,6 +110,18 @@ pub fn run(args: RunArgs) -> Result<Code, Failure> {
             ))
         })?;
     }
+    let ensemble_scene = match (&scene, ensemble.ensemble) {
+        (_, None) => None,
+        (Scene::Chain(c), Some(_)) if matches!(c.method, Method::Auto | Method::Exact) => {
+            Some(c.clone())
+        }
+        _ => {
+            return Err(Failure::bad_input(format!(
+                "--ensemble: {} is not a chain scene run with the exact flow",
+                scene_path.display()
+            )));
+        }
+    };
     let out = out.unwrap_or_else(|| default_out(scene_path));
     std::fs::create_dir_all(&out).map_err(|e| {
         Failure::bad_input(format!(
@@ -153,18 +186,49 @@ pub fn run(args: RunArgs) -> Result<Code, Failure> {
             })?;
         written.extend([profiles, trace]);
     }
+    let mut summary = summary(&report, model_name(&scene), scene_path, log);
+    let mut horizon = None;
+    if let (Some(chain), Some(copies)) = (&ensemble_scene, ensemble.ensemble) {
+        let found = run_ensemble(chain, copies, ensemble.perturb, ensemble.seed, &control)
+            .map_err(|e| Failure::bad_input(format!("--ensemble: {}", e.reason)))?;
+        let path = out.join("ensemble.csv");
+        chain_files::write_ensemble(&found, &path).map_err(|e| {
+            Failure::untrusted(format!("{}: cannot be written: {e}", path.display()))
+        })?;
+        written.push(path);
+        summary["ensemble"] = chain_files::ensemble_summary(&found);
+        horizon = Some(found);
+    }
     let summary_path = out.join("summary.json");
-    write_atomically(
-        &summary_path,
-        &summary(&report, model_name(&scene), scene_path, log),
-    )
-    .map_err(|e| {
+    write_atomically(&summary_path, &summary).map_err(|e| {
         Failure::untrusted(format!(
             "{}: cannot be written: {e}",
             summary_path.display()
         ))
     })?;
     print_report(&report, &scene, &summary_path, log, &written);
+    if let Some(e) = horizon {
+        let last = e.spread.last().copied();
+        say!(
+            "  ensemble of {} copies (perturbation {:e}, seed {}): unit strains part by more than 1e-3 {}",
+            e.copies,
+            e.perturb,
+            e.seed,
+            e.horizon.map_or(format!("nowhere before t_end"), |h| format!(
+                "at t = {h} (to within {:.3e}); unit-level results after that are not reproducible",
+                e.resolution
+            ))
+        );
+        if let Some(s) = last {
+            say!(
+                "  spread at the end: window strain {:.2e}, window velocity {:.2e}, hidden energy {:.2e}, right end {:.2e}",
+                s.window_strain,
+                s.window_velocity,
+                s.hidden_energy,
+                s.right_end
+            );
+        }
+    }
     Ok(match report.outcome.status {
         Status::Completed | Status::Zeno => Code::Ok,
         Status::Failed => Code::Untrusted,

@@ -2,6 +2,7 @@
 //! describe the result in the scene's own terms.
 
 mod chain;
+pub mod ensemble;
 mod mechanism;
 
 use std::sync::Arc;

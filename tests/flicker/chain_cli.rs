@@ -190,3 +190,81 @@ fn bad_chain_scenes_are_refused_naming_the_field() {
     let o = flicker(&["check", path.to_str().unwrap()]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }
+
+#[test]
+fn an_ensemble_finds_the_horizon_reproducibly() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = models("chain_release_free_end.json");
+    let ensemble = |name: &str, seed: &str, threads: &str| {
+        let out = dir.path().join(name);
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_flicker"))
+            .args([
+                "run",
+                &scene,
+                "--out",
+                out.to_str().unwrap(),
+                "--quiet",
+                "--no-events",
+            ])
+            .args(["--t-end", "1.5", "--ensemble", "3", "--seed", seed])
+            .env("RAYON_NUM_THREADS", threads)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        read_json(&out.join("summary.json"))["ensemble"].clone()
+    };
+    let a = ensemble("a", "7", "1");
+    let b = ensemble("b", "7", "2");
+    assert_eq!(
+        a, b,
+        "the same seed gives the same ensemble on 1 or 2 threads"
+    );
+    let c = ensemble("c", "8", "2");
+    assert_ne!(a["spread"], c["spread"], "another seed, other copies");
+    // PHYSICS.md s.7: 1e-12 grows to O(1) within a time of order one.
+    let horizon = a["horizon"]
+        .as_f64()
+        .expect("the copies part before t = 1.5");
+    assert!(horizon > 0.1 && horizon < 1.5, "horizon {horizon}");
+    let spread = a["spread"].as_array().unwrap();
+    let first = &spread[0];
+    assert_eq!(first["t"], 0.0);
+    assert!(
+        first["unit_strain"].as_f64().unwrap() <= 2e-13,
+        "1e-12 of 0.1 at most"
+    );
+    // Before the horizon every field agrees to far better than 1e-3.
+    for s in spread.iter().filter(|s| s["t"].as_f64().unwrap() < horizon) {
+        assert!(s["unit_strain"].as_f64().unwrap() <= 1e-3);
+        assert!(s["right_end"].as_f64().unwrap() <= 1e-3);
+    }
+    let rows = std::fs::read_to_string(dir.path().join("a/ensemble.csv")).unwrap();
+    assert_eq!(rows.lines().count(), spread.len() + 1);
+}
+
+#[test]
+fn ensembles_are_refused_where_they_do_not_apply() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("o");
+    for (scene, extra) in [
+        ("mechanism_impacting.json", vec!["--ensemble", "3"]),
+        ("chain_release_free_end.json", vec!["--ensemble", "1"]),
+        (
+            "chain_release_free_end.json",
+            vec!["--ensemble", "3", "--perturb", "2"],
+        ),
+        (
+            "chain_release_free_end.json",
+            vec!["--ensemble", "3", "--method", "dopri5"],
+        ),
+        ("chain_release_free_end.json", vec!["--perturb", "1e-9"]),
+    ] {
+        let o = run(&models(scene), &out, &extra);
+        assert_eq!(
+            o.status.code(),
+            Some(2),
+            "{scene} {extra:?}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+    }
+}

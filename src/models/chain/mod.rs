@@ -20,6 +20,7 @@
 
 use crate::engine::{Direction, Guard};
 
+pub mod coarse;
 pub mod collide;
 pub mod modal;
 pub mod ode;

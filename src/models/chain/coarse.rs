@@ -1,0 +1,142 @@
+//! Coarse-grained fields of a chain (PHYSICS.md s.6): the averages over
+//! many units that stay reproducible past the chaos horizon, and by which a
+//! chain is compared with a continuum.
+//!
+//! Windows of width [`WINDOW_WIDTH`] are centred on each unit (clipped at
+//! the ends). Window strain = displacement difference across the window
+//! over its width (the mean unit strain); window velocity = the
+//! mass-weighted mean node velocity; hidden energy = the window's energy
+//! minus the energy of its mean fields, per unit length (the rattling the
+//! mean fields do not see). The front is the leftmost window centre whose
+//! strain has dropped below the undisturbed value by [`FRONT_DROP`].
+
+use super::Chain;
+
+/// Width of a coarse-graining window, in the scene's length units.
+pub const WINDOW_WIDTH: f64 = 0.1;
+
+/// How far below the undisturbed strain a window must drop to be behind
+/// the front.
+pub const FRONT_DROP: f64 = 0.008;
+
+/// The coarse fields at the unit centres `x`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Coarse {
+    pub x: Vec<f64>,
+    pub strain: Vec<f64>,
+    pub velocity: Vec<f64>,
+    pub hidden_energy: Vec<f64>,
+}
+
+impl Coarse {
+    /// The fields of `chain` (of total length `length`) with unit gaps
+    /// `gaps` and node velocities `velocities`.
+    pub fn of(chain: &Chain, length: f64, gaps: &[f64], velocities: &[f64]) -> Self {
+        let n = chain.units;
+        let cell = length / n as f64;
+        let unit_length = chain.critical_load / chain.stiffness;
+        // Units on each side of the centre: the window spans 2h + 1 cells.
+        let half = ((0.5 * WINDOW_WIDTH / cell - 0.5).round().max(0.0)) as usize;
+        let mut coarse = Coarse {
+            x: Vec::with_capacity(n),
+            strain: Vec::with_capacity(n),
+            velocity: Vec::with_capacity(n),
+            hidden_energy: Vec::with_capacity(n),
+        };
+        for centre in 0..n {
+            let (lo, hi) = (centre.saturating_sub(half), (centre + half).min(n - 1));
+            let count = (hi - lo + 1) as f64;
+            let (d, v) = (&gaps[lo..=hi], &velocities[lo..=hi]);
+            let mean_gap = d.iter().sum::<f64>() / count;
+            let mean_velocity = v.iter().sum::<f64>() / count;
+            let rattle: f64 = d
+                .iter()
+                .zip(v)
+                .map(|(d, v)| {
+                    let (dd, dv) = (d - mean_gap, v - mean_velocity);
+                    0.5 * chain.stiffness * dd * dd + 0.5 * chain.mass * dv * dv
+                })
+                .sum();
+            coarse.x.push(-0.5 * length + (centre as f64 + 0.5) * cell);
+            coarse.strain.push(mean_gap / unit_length);
+            coarse.velocity.push(mean_velocity);
+            coarse.hidden_energy.push(rattle / (count * cell));
+        }
+        coarse
+    }
+
+    /// The leftmost window centre whose strain is below `undisturbed -
+    /// FRONT_DROP`, if any.
+    pub fn front(&self, undisturbed: f64) -> Option<f64> {
+        self.strain
+            .iter()
+            .position(|&e| e < undisturbed - FRONT_DROP)
+            .map(|i| self.x[i])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_uniform_chain_has_its_own_strain_and_no_hidden_energy() {
+        let chain = Chain::in_scene_units(40, 2.0, 1.0, 0.0, true);
+        let unit = chain.critical_load / chain.stiffness;
+        let c = Coarse::of(&chain, 2.0, &vec![0.1 * unit; 40], &vec![0.3; 40]);
+        assert!(c.strain.iter().all(|e| (e - 0.1).abs() < 1e-15));
+        assert!(c.velocity.iter().all(|v| (v - 0.3).abs() < 1e-15));
+        assert!(c.hidden_energy.iter().all(|h| h.abs() < 1e-15));
+        assert_eq!(c.front(0.1), None);
+    }
+
+    #[test]
+    fn alternating_rattle_shows_as_hidden_energy_and_a_front() {
+        // Units 21..40 alternate between strain 0 and 0.1 with velocities
+        // +-0.2: mean strain 0.05 (below 0.1 - 0.008: behind the front).
+        let n = 40;
+        let chain = Chain::in_scene_units(n, 2.0, 1.0, 0.0, true);
+        let unit = chain.critical_load / chain.stiffness;
+        let gaps: Vec<f64> = (0..n)
+            .map(|i| {
+                if i < 20 || i % 2 == 0 {
+                    0.1 * unit
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        let v: Vec<f64> = (0..n)
+            .map(|i| {
+                if i < 20 {
+                    0.0
+                } else if i % 2 == 0 {
+                    0.2
+                } else {
+                    -0.2
+                }
+            })
+            .collect();
+        let c = Coarse::of(&chain, 2.0, &gaps, &v);
+        // Cells are 0.05 long: windows of 0.1 hold 3 units (h = 1).
+        let far = n - 2;
+        let expected_strain = (0.0 + 0.1 + 0.0) / 3.0;
+        assert!(
+            (c.strain[far] - expected_strain).abs() < 1e-12,
+            "{}",
+            c.strain[far]
+        );
+        // By hand (k = 20, m = 0.05, unit = 0.05, cell = 0.05): gaps
+        // [0, u, 0] deviate by u [-1, 2, -1] / 30, squares u^2 / 150;
+        // velocities [-0.2, 0.2, -0.2] by [-2, 4, -2] / 15, squares 16 / 150:
+        // (k u^2 / 300 + 16 m / 300) / (3 cell) = 0.0188888...
+        let by_hand = (20.0 * 0.05 * 0.05 / 300.0 + 16.0 * 0.05 / 300.0) / 0.15;
+        assert!(
+            (c.hidden_energy[far] - by_hand).abs() < 1e-15,
+            "{}",
+            c.hidden_energy[far]
+        );
+        let front = c.front(0.1).unwrap();
+        assert!((front - c.x[20]).abs() < 0.06, "front at {front}");
+    }
+}
