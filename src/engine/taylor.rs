@@ -23,6 +23,16 @@ pub fn eval2(c: &[f64], s: f64) -> (f64, f64, f64) {
     (p, d1, d2)
 }
 
+/// `(p(s), p'(s))` of `p = sum c[k] s^k`.
+fn eval1(c: &[f64], s: f64) -> (f64, f64) {
+    let (mut p, mut d1) = (0.0, 0.0);
+    for &ck in c.iter().rev() {
+        d1 = d1 * s + p;
+        p = p * s + ck;
+    }
+    (p, d1)
+}
+
 /// `p(s)` of `p = sum c[k] s^k`.
 pub fn eval(c: &[f64], s: f64) -> f64 {
     c.iter().rev().fold(0.0, |p, &ck| p * s + ck)
@@ -104,7 +114,7 @@ impl Piece<'_> {
         let end = eval(self.c, x1);
         match self.classify(x1 - x0, at0, end) {
             Verdict::Clear => None,
-            Verdict::Root => Some(self.refine(x0, x1)),
+            Verdict::Root => Some(self.refine((x0, at0.0), (x1, end))),
             Verdict::Unknown => {
                 let mid = 0.5 * (x0 + x1);
                 let budget = self.budget.get();
@@ -152,12 +162,13 @@ impl Piece<'_> {
     }
 
     /// The root of a strictly decreasing `p` on `[lo, hi]` with `p(lo) > 0 >=
-    /// p(hi)`, to a few ulps: Newton's method kept inside the bracket
-    /// (bisecting when a step leaves it).
-    fn refine(&self, mut lo: f64, mut hi: f64) -> f64 {
-        let mut x = hi;
+    /// p(hi)`, to a few ulps: Newton's method from the secant point, kept
+    /// inside the bracket (bisecting when a step leaves it).
+    fn refine(&self, (mut lo, p_lo): (f64, f64), (mut hi, p_hi): (f64, f64)) -> f64 {
+        let secant = lo + (hi - lo) * p_lo / (p_lo - p_hi);
+        let mut x = if secant > lo && secant < hi { secant } else { 0.5 * (lo + hi) };
         for _ in 0..100 {
-            let (p, d1, _) = eval2(self.c, x);
+            let (p, d1) = eval1(self.c, x);
             if p > 0.0 {
                 lo = x;
             } else {
