@@ -1,11 +1,14 @@
 //! The chain's figures: cost per impact against the number of units, the
 //! release scene, and the exact path against the ODE path on one scene.
 //!
-//! `cargo bench --bench chain` prints, as medians of several runs on the
-//! release scene of PHYSICS.md s.6 (traction-free reading, log off):
-//! - wall time per impact for N = 25 ... 3200 (each run to about 4 * 10^5
-//!   impacts), and writes them to `target/chain_cost.csv` with a chart
-//!   `target/chain_cost.svg`;
+//! `cargo bench --bench chain` prints, as medians of several runs (log off):
+//! - wall time per impact for N = 25 ... 3200 in the release scene of
+//!   PHYSICS.md s.6 (traction-free reading) to t = 3 (about 1.1 N^2
+//!   impacts per unit time; 3 runs at N = 1600, 1 at N = 3200), and in a
+//!   chain rattling sparsely all along from the start (every unit at strain
+//!   0.05, node velocities alternating +-0.05, load F_cr: about 0.15 N^2
+//!   impacts per unit time) to about 4 * 10^5 impacts; writes them to
+//!   `target/chain_cost.csv` with a chart `target/chain_cost.svg`;
 //! - the whole release to t = 3 at N = 800 (about 2 million impacts);
 //! - impacts per second at N = 1000 to t = 1;
 //! - at N = 50, the exact path against Dormand-Prince (rtol 1e-12) on the
@@ -21,16 +24,21 @@ use flicker::plot::draw::{Curve, Figure, Style};
 const REPEATS: usize = 5;
 
 /// Median wall time of `REPEATS` runs of `f`, which returns the impacts.
-fn median_seconds(mut f: impl FnMut() -> u64) -> (f64, u64) {
+fn median_seconds(f: impl FnMut() -> u64) -> (f64, u64) {
+    median_of(REPEATS, f)
+}
+
+/// Median wall time of `repeats` runs of `f`.
+fn median_of(repeats: usize, mut f: impl FnMut() -> u64) -> (f64, u64) {
     let mut times = Vec::new();
     let mut impacts = 0;
-    for _ in 0..REPEATS {
+    for _ in 0..repeats {
         let start = Instant::now();
         impacts = black_box(f());
         times.push(start.elapsed().as_secs_f64());
     }
     times.sort_by(f64::total_cmp);
-    (times[REPEATS / 2], impacts)
+    (times[repeats / 2], impacts)
 }
 
 fn released(units: usize) -> (Chain, TaylorChain) {
@@ -40,8 +48,18 @@ fn released(units: usize) -> (Chain, TaylorChain) {
     (chain, model)
 }
 
-fn exact(units: usize, t_end: f64) -> u64 {
-    let (_, mut model) = released(units);
+/// Every unit at strain 0.05, neighbours moving apart and together at
+/// +-0.05: impacts all along the chain from the start.
+fn rattling(units: usize) -> TaylorChain {
+    let chain = Chain::in_scene_units(units, 2.0, 1.0, 1.0, true);
+    let gap = 0.05 * chain.critical_load / chain.stiffness;
+    let v: Vec<f64> = (0..units)
+        .map(|i| if i % 2 == 0 { 0.05 } else { -0.05 })
+        .collect();
+    TaylorChain::new(chain, &vec![gap; units], &v).unwrap()
+}
+
+fn run(mut model: TaylorChain, t_end: f64) -> u64 {
     let o = simulate_local(
         &mut model,
         &Options::until(t_end),
@@ -57,37 +75,66 @@ fn exact(units: usize, t_end: f64) -> u64 {
     o.events
 }
 
+fn exact(units: usize, t_end: f64) -> u64 {
+    run(released(units).1, t_end)
+}
+
 fn main() {
     let mut rows = Vec::new();
-    println!("cost per impact, release scene (eta 1.1 -> 0), log off, median of {REPEATS}:");
+    println!("cost per impact, log off, median of {REPEATS} (3 at N = 1600, 1 at 3200):");
     for units in [25, 50, 100, 200, 400, 800, 1600, 3200] {
-        // Impacts come at about 0.24 N^2 per unit time.
-        let t_end = (4e5 / (0.24 * (units * units) as f64)).min(3.0);
-        let (seconds, impacts) = median_seconds(|| exact(units, t_end));
-        let per = seconds / impacts as f64;
+        let repeats = match units {
+            3200 => 1,
+            1600 => 3,
+            _ => REPEATS,
+        };
+        let (seconds, impacts) = median_of(repeats, || exact(units, 3.0));
+        let release = seconds / impacts as f64;
+        let t_end = 4e5 / (0.15 * (units * units) as f64);
+        let (seconds, sparse) = median_of(repeats, || run(rattling(units), t_end));
+        let rattle = seconds / sparse as f64;
         println!(
-            "  N = {units:>5}: {impacts:>8} impacts to t = {t_end:<8.4} in {seconds:.3} s: {:.3} us per impact ({:.3e} impacts/s)",
-            per * 1e6,
-            1.0 / per
+            "  N = {units:>5}: release to t = 3, {impacts:>9} impacts: {:.3} us per impact ({:.3e}/s); \
+             sparse rattling, {sparse:>7} impacts: {:.3} us per impact",
+            release * 1e6,
+            1.0 / release,
+            rattle * 1e6,
         );
-        rows.push((units, per));
+        rows.push((units, rattle, Some(release)));
     }
-    let csv: String = std::iter::once("units,seconds_per_impact\n".to_string())
-        .chain(rows.iter().map(|(n, s)| format!("{n},{s:e}\n")))
-        .collect();
+    let csv: String = std::iter::once(
+        "units,rattling_seconds_per_impact,release_seconds_per_impact\n".to_string(),
+    )
+    .chain(rows.iter().map(|(n, r, e)| {
+        format!(
+            "{n},{r:e},{}\n",
+            e.map_or(String::new(), |e| format!("{e:e}"))
+        )
+    }))
+    .collect();
     std::fs::write("target/chain_cost.csv", csv).expect("target/ is writable");
     let figure = Figure {
         title: "chain: cost per impact against the number of units".into(),
         x_label: "log10 N".into(),
         y_label: "microseconds per impact".into(),
-        curves: vec![Curve {
-            label: Some("exact event-local flow".into()),
-            points: rows
-                .iter()
-                .map(|(n, s)| ((*n as f64).log10(), s * 1e6))
-                .collect(),
-            style: Style::Line(0),
-        }],
+        curves: vec![
+            Curve {
+                label: Some("sparse rattling".into()),
+                points: rows
+                    .iter()
+                    .map(|(n, r, _)| ((*n as f64).log10(), r * 1e6))
+                    .collect(),
+                style: Style::Line(0),
+            },
+            Curve {
+                label: Some("release to t = 3".into()),
+                points: rows
+                    .iter()
+                    .filter_map(|(n, _, e)| Some(((*n as f64).log10(), (*e)? * 1e6)))
+                    .collect(),
+                style: Style::Line(1),
+            },
+        ],
         y_limit: None,
     };
     figure

@@ -214,7 +214,7 @@ pub fn run(args: RunArgs) -> Result<Code, Failure> {
             e.copies,
             e.perturb,
             e.seed,
-            e.horizon.map_or(format!("nowhere before t_end"), |h| format!(
+            e.horizon.map_or("nowhere before t_end".to_string(), |h| format!(
                 "at t = {h} (to within {:.3e}); unit-level results after that are not reproducible",
                 e.resolution
             ))

@@ -166,7 +166,11 @@ impl Piece<'_> {
     /// inside the bracket (bisecting when a step leaves it).
     fn refine(&self, (mut lo, p_lo): (f64, f64), (mut hi, p_hi): (f64, f64)) -> f64 {
         let secant = lo + (hi - lo) * p_lo / (p_lo - p_hi);
-        let mut x = if secant > lo && secant < hi { secant } else { 0.5 * (lo + hi) };
+        let mut x = if secant > lo && secant < hi {
+            secant
+        } else {
+            0.5 * (lo + hi)
+        };
         for _ in 0..100 {
             let (p, d1) = eval1(self.c, x);
             if p > 0.0 {

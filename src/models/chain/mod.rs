@@ -16,7 +16,8 @@
 //! - [`Chain`] as a linear second-order ODE ([`ode`]), which the numerical
 //!   methods and the linear propagator run: the independent second path.
 //!
-//! [`modal`] is the exact solution of the unconstrained chain.
+//! [`modal()`] is the exact solution of the unconstrained chain; [`coarse`]
+//! holds the coarse-grained fields a chain is compared by.
 
 use crate::engine::{Direction, Guard};
 
