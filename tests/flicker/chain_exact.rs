@@ -231,3 +231,27 @@ fn bad_initial_states_are_refused_with_a_reason() {
             .contains("at least one unit")
     );
 }
+
+#[test]
+fn a_unit_pushed_shut_at_rest_stops_the_run_as_zeno_with_a_reason() {
+    // Two units, the end load gone (F = 0): unit 2 starts shut and at rest,
+    // and F_cr pulls the end node into it. Resting contact is not modelled
+    // for chains yet: the run must say so and stop, not spin or go on wrong.
+    let chain = Chain::in_scene_units(2, 2.0, 1.0, 0.0, true);
+    let unit = chain.critical_load / chain.stiffness;
+    let mut model = TaylorChain::new(chain, &[0.1 * unit, 0.0], &[0.0, 0.0]).unwrap();
+    let o = simulate_local(
+        &mut model,
+        &Options::until(1.0),
+        &[],
+        &mut |_, _| {},
+        &mut (),
+    );
+    assert_eq!(o.status, Status::Zeno, "{:?}", o.reason);
+    let reason = o.reason.unwrap();
+    assert!(
+        reason.contains("no resting mode") && reason.contains("impact"),
+        "{reason}"
+    );
+    assert_eq!(o.t_reached, 0.0);
+}
