@@ -11,7 +11,7 @@ use flicker::engine::{Method, Status};
 use flicker::log::JsonlWriter;
 use flicker::log::chain_files;
 use flicker::log::summary::{summary, write_atomically};
-use flicker::runner::ensemble::run_ensemble;
+use flicker::runner::ensemble::{check as check_ensemble, run_ensemble};
 use flicker::runner::{Control, Report, run as run_scene};
 use flicker::scene::solver::SolverSpec;
 use flicker::scene::{self, Scene};
@@ -112,7 +112,9 @@ pub fn run(args: RunArgs) -> Result<Code, Failure> {
     }
     let ensemble_scene = match (&scene, ensemble.ensemble) {
         (_, None) => None,
-        (Scene::Chain(c), Some(_)) if matches!(c.method, Method::Auto | Method::Exact) => {
+        (Scene::Chain(c), Some(copies)) if matches!(c.method, Method::Auto | Method::Exact) => {
+            check_ensemble(c, copies, ensemble.perturb)
+                .map_err(|e| Failure::bad_input(format!("--ensemble: {}", e.reason)))?;
             Some(c.clone())
         }
         _ => {
@@ -188,16 +190,25 @@ pub fn run(args: RunArgs) -> Result<Code, Failure> {
     }
     let mut summary = summary(&report, model_name(&scene), scene_path, log);
     let mut horizon = None;
+    let mut ensemble_failed = None;
     if let (Some(chain), Some(copies)) = (&ensemble_scene, ensemble.ensemble) {
-        let found = run_ensemble(chain, copies, ensemble.perturb, ensemble.seed, &control)
-            .map_err(|e| Failure::bad_input(format!("--ensemble: {}", e.reason)))?;
-        let path = out.join("ensemble.csv");
-        chain_files::write_ensemble(&found, &path).map_err(|e| {
-            Failure::untrusted(format!("{}: cannot be written: {e}", path.display()))
-        })?;
-        written.push(path);
-        summary["ensemble"] = chain_files::ensemble_summary(&found);
-        horizon = Some(found);
+        match run_ensemble(chain, copies, ensemble.perturb, ensemble.seed, &control) {
+            Ok(found) => {
+                let path = out.join("ensemble.csv");
+                chain_files::write_ensemble(&found, &path).map_err(|e| {
+                    Failure::untrusted(format!("{}: cannot be written: {e}", path.display()))
+                })?;
+                written.push(path);
+                summary["ensemble"] = chain_files::ensemble_summary(&found);
+                horizon = Some(found);
+            }
+            Err(why) => {
+                // The run itself stands; the ensemble's failure is said in
+                // its summary and in the exit code.
+                summary["ensemble"] = serde_json::json!({ "error": why });
+                ensemble_failed = Some(why);
+            }
+        }
     }
     let summary_path = out.join("summary.json");
     write_atomically(&summary_path, &summary).map_err(|e| {
@@ -228,6 +239,10 @@ pub fn run(args: RunArgs) -> Result<Code, Failure> {
                 s.right_end
             );
         }
+    }
+    if let Some(why) = ensemble_failed {
+        say!("  ensemble failed: {why}");
+        return Ok(Code::Untrusted);
     }
     Ok(match report.outcome.status {
         Status::Completed | Status::Zeno => Code::Ok,

@@ -52,7 +52,7 @@ impl Reference {
             Scene::Chain(_) => Err(SceneError::field(
                 "model",
                 "method comparisons measure against the mechanism's closed form; a chain scene has none \
-                 (its exact and ODE paths are checked against each other in tests/flicker/chain.rs)"
+                 (its exact and ODE paths are checked against each other in tests/flicker/chain_exact.rs)"
                     .into(),
             )),
         }

@@ -59,17 +59,23 @@ fn third_derivative_bound(c: &[f64], b: f64) -> f64 {
     bound * (1.0 + 1e-12)
 }
 
-/// Deepest halving of the interval, and most pieces examined; beyond
-/// them the computed sign decides (a graze within round-off).
+/// Deepest halving of the interval: below it a piece is narrower than the
+/// floats can tell apart, and the computed sign decides (a graze within
+/// round-off).
 const MAX_DEPTH: u32 = 80;
+
+/// Most pieces examined before the search gives up (an error, never a
+/// guess): a polynomial that hugs zero within round-off over a long
+/// stretch must not cost exponential time.
 const MAX_PIECES: u32 = 4096;
 
 /// The first `s` in `(a, b]` (`0 <= a <= b`) where `p` crosses zero falling
 /// (from positive to `<= 0`), or `Some(a)` if `p(a) <= 0` and `p` is moving
-/// down through zero at `a` already. `None` if there is none: in
-/// particular a `p` that rises from zero, or stays exactly on it, has not
-/// crossed.
-pub fn first_fall(c: &[f64], a: f64, b: f64) -> Option<f64> {
+/// down through zero at `a` already (its first nonzero derivative there is
+/// negative). `None` if there is none: in particular a `p` that rises from
+/// zero, or stays exactly on it, has not crossed. An error if the bounds
+/// cannot decide within [`MAX_PIECES`] pieces.
+pub fn first_fall(c: &[f64], a: f64, b: f64) -> Result<Option<f64>, String> {
     // Cheap proof of no root, the common case: p(s) >= c_0 - sum |c_k| b^k
     // on [0, b]. A constant p never crosses either.
     let reach = c
@@ -79,18 +85,78 @@ pub fn first_fall(c: &[f64], a: f64, b: f64) -> Option<f64> {
         .fold(0.0, |acc, ck| (acc + ck.abs()) * b);
     let constant = c.first().copied().unwrap_or(0.0);
     if constant - reach * (1.0 + 1e-12) > 0.0 || reach == 0.0 {
-        return None;
+        return Ok(None);
     }
-    let (p, d1, d2) = eval2(c, a);
-    if p <= 0.0 && (d1 < 0.0 || (d1 == 0.0 && d2 < 0.0)) {
-        return Some(a);
+    let (mut from, mut at) = (a, eval2(c, a));
+    if at.0 <= 0.0 {
+        // On (or a round-off below) zero: the first derivative that is not
+        // zero says whether p is going down through it now.
+        let shifted = shifted_to(c, a, at);
+        match shifted.iter().skip(1).copied().find(|&x| x != 0.0) {
+            Some(slope) if slope < 0.0 => return Ok(Some(a)),
+            // Stays exactly on zero.
+            None => return Ok(None),
+            Some(_) if at.0 < 0.0 => {}
+            // Rising from exactly zero: prove it positive on (a, a + h]
+            // and search on from there.
+            Some(_) => match lift(&shifted, b - a) {
+                Some(h) if a + h >= b => return Ok(None),
+                Some(h) => (from, at) = (a + h, eval2(c, a + h)),
+                None => return Err(format!("cannot tell which way p leaves zero at {a:e}")),
+            },
+        }
     }
     let bound = Piece {
         c,
         third: third_derivative_bound(c, b),
         budget: std::cell::Cell::new(MAX_PIECES),
     };
-    bound.search(a, b, (p, d1, d2), 0)
+    let root = bound.search(from, b, at, 0);
+    if bound.budget.get() == 0 {
+        return Err(format!(
+            "the first root on [{a:e}, {b:e}] could not be isolated within {MAX_PIECES} pieces \
+             (the polynomial stays within round-off of zero over a stretch)"
+        ));
+    }
+    Ok(root)
+}
+
+/// The coefficients of `p(a + h)` in `h`: `p^(k)(a) / k!`. The first three
+/// are taken from `(p, p', p'')` at `a` as already evaluated (the same
+/// numbers the caller decided on); the rest by a Taylor shift (synthetic
+/// division), which only a zero of `p` at `a` needs.
+fn shifted_to(c: &[f64], a: f64, (p, d1, d2): (f64, f64, f64)) -> Vec<f64> {
+    let mut shifted = c.to_vec();
+    for k in 0..shifted.len() {
+        for j in (k..shifted.len() - 1).rev() {
+            shifted[j] += a * shifted[j + 1];
+        }
+    }
+    for (k, x) in [p, d1, 0.5 * d2].into_iter().enumerate() {
+        if let Some(s) = shifted.get_mut(k) {
+            *s = x;
+        }
+    }
+    shifted
+}
+
+/// A width `h <= width` over which `sum_k s_k h^k`, zero at `h = 0` with
+/// its first nonzero coefficient `s_m > 0`, is provably positive:
+/// `s_m > sum_{k > m} |s_k| h^(k - m)`.
+fn lift(shifted: &[f64], width: f64) -> Option<f64> {
+    let m = shifted.iter().skip(1).position(|&x| x != 0.0)? + 1;
+    let mut h = width;
+    while h > 0.0 {
+        let rest = shifted[m + 1..]
+            .iter()
+            .rev()
+            .fold(0.0, |acc, sk| (acc + sk.abs()) * h);
+        if shifted[m] - rest * (1.0 + 1e-12) > 0.0 {
+            return Some(h);
+        }
+        h *= 0.5;
+    }
+    None
 }
 
 struct Piece<'c> {
@@ -118,8 +184,12 @@ impl Piece<'_> {
             Verdict::Unknown => {
                 let mid = 0.5 * (x0 + x1);
                 let budget = self.budget.get();
-                self.budget.set(budget.saturating_sub(1));
-                if depth >= MAX_DEPTH || budget == 0 || mid <= x0 || mid >= x1 {
+                if budget == 0 {
+                    // Given up; `first_fall` reports it.
+                    return None;
+                }
+                self.budget.set(budget - 1);
+                if depth >= MAX_DEPTH || mid <= x0 || mid >= x1 {
                     // A graze narrower than round-off: the computed sign decides.
                     return (at0.0 > 0.0 && end <= 0.0).then_some(x1);
                 }
@@ -228,9 +298,9 @@ mod tests {
     fn finds_the_first_of_several_falling_roots() {
         // Positive at 0; falls through 0.3, rises through 0.5, falls through 0.9.
         let c = from_roots(&[0.3, 0.5, 0.9], -1.0);
-        let s = first_fall(&c, 0.0, 1.0).unwrap();
+        let s = first_fall(&c, 0.0, 1.0).unwrap().unwrap();
         assert!((s - 0.3).abs() < 1e-15, "{s}");
-        let s = first_fall(&c, 0.6, 1.0).unwrap();
+        let s = first_fall(&c, 0.6, 1.0).unwrap().unwrap();
         assert!((s - 0.9).abs() < 1e-15, "{s}");
     }
 
@@ -239,23 +309,31 @@ mod tests {
         // Dips below zero between 0.4 and 0.4 + 1e-6 only; the root of a
         // dip that narrow is conditioned to about eps / 1e-6.
         let c = from_roots(&[0.4, 0.4 + 1e-6], 1.0);
-        let s = first_fall(&c, 0.0, 1.0).unwrap();
+        let s = first_fall(&c, 0.0, 1.0).unwrap().unwrap();
         assert!((s - 0.4).abs() < 1e-9, "{s}");
         // A dip that stays 1e-12 above zero never crosses.
         let mut c = from_roots(&[0.4, 0.4], 1.0);
         c[0] += 1e-12;
-        assert_eq!(first_fall(&c, 0.0, 1.0), None);
+        assert_eq!(first_fall(&c, 0.0, 1.0).unwrap(), None);
     }
 
     #[test]
     fn rising_from_zero_or_staying_on_it_is_not_a_crossing() {
-        assert_eq!(first_fall(&[0.0, 1.0, -0.1], 0.0, 1.0), None);
-        assert_eq!(first_fall(&[0.0, 0.0, 0.0], 0.0, 1.0), None);
-        assert_eq!(first_fall(&[0.0, 0.0, 1.0], 0.0, 1.0), None);
+        assert_eq!(first_fall(&[0.0, 1.0, -0.1], 0.0, 1.0).unwrap(), None);
+        assert_eq!(first_fall(&[0.0, 0.0, 0.0], 0.0, 1.0).unwrap(), None);
+        assert_eq!(first_fall(&[0.0, 0.0, 1.0], 0.0, 1.0).unwrap(), None);
+        // A triple zero falling through (p = -(s - 0.5)^3 at 0.5) fires now;
+        // rising through it does not.
+        let c = from_roots(&[0.5, 0.5, 0.5], -1.0);
+        assert_eq!(first_fall(&c, 0.5, 1.0).unwrap(), Some(0.5));
+        let c = from_roots(&[0.5, 0.5, 0.5], 1.0);
+        assert_eq!(first_fall(&c, 0.5, 1.0).unwrap(), None);
         // Closing through zero right now fires now.
-        assert_eq!(first_fall(&[0.0, -1.0], 0.0, 1.0), Some(0.0));
+        assert_eq!(first_fall(&[0.0, -1.0], 0.0, 1.0).unwrap(), Some(0.0));
         assert_eq!(
-            first_fall(&[-1e-18, 1.0, -4.0], 0.0, 1.0).map(|s| (s - 0.25).abs() < 1e-9),
+            first_fall(&[-1e-18, 1.0, -4.0], 0.0, 1.0)
+                .unwrap()
+                .map(|s| (s - 0.25).abs() < 1e-9),
             Some(true)
         );
     }
@@ -263,7 +341,7 @@ mod tests {
     #[test]
     fn the_root_is_within_a_few_ulps() {
         let c = [1.0, -3.0, 0.5];
-        let s = first_fall(&c, 0.0, 1.0).unwrap();
+        let s = first_fall(&c, 0.0, 1.0).unwrap().unwrap();
         let exact = 3.0 - 7.0f64.sqrt();
         assert!(
             (s - exact).abs() <= 8.0 * f64::EPSILON * exact,

@@ -63,6 +63,7 @@ pub fn plot_chain(dir: &Path) -> Result<Vec<PathBuf>, String> {
         }
     }
     let mut end = end_displacement(dir)?;
+    end.retain(|c| !c.points.is_empty());
     let classical: Vec<(f64, f64)> = list(&profiles["classical"]["trace"])
         .iter()
         .filter_map(|r| Some((r["t"].as_f64()?, r["right_end"].as_f64()?)))

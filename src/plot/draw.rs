@@ -89,9 +89,18 @@ impl Figure {
         for &(x, y) in all {
             (x0, x1, y0, y1) = (x0.min(x), x1.max(x), y0.min(y), y1.max(y));
         }
-        if !(x0 < x1 && y0 < y1) {
-            return Err("nothing to draw".into());
+        if !(x0 <= x1 && y0 <= y1) {
+            return Err(format!("{}: nothing to draw", self.title));
         }
+        // A single point or a flat curve still gets axes around it.
+        let widen = |lo: &mut f64, hi: &mut f64| {
+            if lo == hi {
+                let pad = (lo.abs() * 0.1).max(1e-3);
+                (*lo, *hi) = (*lo - pad, *hi + pad);
+            }
+        };
+        widen(&mut x0, &mut x1);
+        widen(&mut y0, &mut y1);
         let (dx, dy) = (0.05 * (x1 - x0), 0.05 * (y1 - y0));
         area.fill(&WHITE).map_err(err)?;
         let mut chart = ChartBuilder::on(&area)

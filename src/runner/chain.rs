@@ -181,28 +181,28 @@ pub(super) fn run(
         && scene.units <= CLASSICAL_MAX_UNITS
         && report.outcome.status == Status::Completed
     {
-        let classical = Chain {
-            constraint: false,
-            ..Chain::in_scene_units(
-                scene.units,
-                scene.length,
-                scene.wave_speed,
-                scene.load_after,
-                false,
-            )
-        };
+        let classical = Chain::in_scene_units(
+            scene.units,
+            scene.length,
+            scene.wave_speed,
+            scene.load_after,
+            false,
+        );
         let mut model = TaylorChain::new(classical.clone(), &gaps, &scene.velocity)
             .map_err(|why| SceneError::field("initial", why))?;
         let mut sampler = Sampler::new(scene, &classical);
         let times = sampler.times();
-        simulate_local(
+        let companion = simulate_local(
             &mut model,
             &options,
             &times,
             &mut |m: &TaylorChain, t| sampler.sample(m, t),
             &mut (),
         );
-        if let Some(outputs) = report.chain.as_mut() {
+        // A companion cut short (interrupted) is left out, not shown half.
+        if let Some(outputs) = report.chain.as_mut()
+            && companion.status == Status::Completed
+        {
             outputs.classical = Some(Classical {
                 profiles: sampler.profiles,
                 trace: sampler.trace,
@@ -291,8 +291,14 @@ fn run_ode(
     let mut energy_error: f64 = 0.0;
     for &stop in &stops {
         if stop > reached {
+            // Each leg gets what is left of the run's budgets.
+            let spent = total
+                .as_ref()
+                .map_or((0, 0.0), |o| (o.events, o.wall_seconds));
             let mut options = options.clone();
             options.t_end = stop - reached;
+            options.max_events = options.max_events.saturating_sub(spent.0);
+            options.max_wall_seconds = options.max_wall_seconds.map(|w| (w - spent.1).max(0.0));
             let mut leg = Leg {
                 inner: &mut *observer,
                 seq: total.as_ref().map_or(0, |o| o.events),

@@ -1,6 +1,7 @@
 //! The reproducibility horizon of a chain scene (PHYSICS.md s.7): copies
-//! of the run with the initial strains perturbed by a relative `perturb`,
-//! run in parallel, compared at the scene's sample times.
+//! of the run with each initial strain moved by up to `perturb` times the
+//! scene's largest initial strain, run in parallel, compared at the
+//! scene's sample times.
 //!
 //! Copy `i` draws its perturbation from its own xorshift stream seeded by
 //! `(seed, i)`, so the ensemble is the same for a given seed whatever the
@@ -61,14 +62,9 @@ struct Sample {
     front: Option<f64>,
 }
 
-/// Run `copies` perturbed copies of `scene` (exact flow, no log).
-pub fn run_ensemble(
-    scene: &ChainScene,
-    copies: usize,
-    perturb: f64,
-    seed: u64,
-    control: &Control,
-) -> Result<Ensemble, SceneError> {
+/// Whether an ensemble of `copies` at `perturb` can run on `scene`: checked
+/// before anything runs, so bad flags lose nothing.
+pub fn check(scene: &ChainScene, copies: usize, perturb: f64) -> Result<(), SceneError> {
     let refuse = |reason: String| SceneError::field("ensemble", reason);
     if copies < 2 {
         return Err(refuse(format!(
@@ -97,6 +93,20 @@ pub fn run_ensemble(
             scene.units
         )));
     }
+    Ok(())
+}
+
+/// Run `copies` perturbed copies of `scene` (exact flow, no log), which
+/// [`check`] accepted; an error says which copy stopped and why.
+pub fn run_ensemble(
+    scene: &ChainScene,
+    copies: usize,
+    perturb: f64,
+    seed: u64,
+    control: &Control,
+) -> Result<Ensemble, String> {
+    check(scene, copies, perturb).map_err(|e| e.reason)?;
+    let times = scene.sample_times();
     let chain = Chain::in_scene_units(
         scene.units,
         scene.length,
@@ -115,7 +125,7 @@ pub fn run_ensemble(
         .into_par_iter()
         .map(|copy| run_copy(scene, &chain, &options, &times, perturb, seed, copy))
         .collect();
-    let runs: Vec<Vec<Sample>> = runs.into_iter().collect::<Result<_, _>>().map_err(refuse)?;
+    let runs: Vec<Vec<Sample>> = runs.into_iter().collect::<Result<_, _>>()?;
     let spread: Vec<Spread> = times
         .iter()
         .enumerate()
@@ -144,10 +154,22 @@ fn run_copy(
     let mut rng =
         XorShiftRng::seed_from_u64(seed ^ (copy as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15));
     let unit_length = chain.critical_load / chain.stiffness;
+    // Relative to the scene's strain scale, so that units starting shut are
+    // perturbed too (upwards only, where the constraint holds them).
+    let scale = scene.strain.iter().fold(0.0, |m: f64, e| m.max(e.abs()));
+    let scale = if scale > 0.0 { scale } else { 1.0 };
     let gaps: Vec<f64> = scene
         .strain
         .iter()
-        .map(|e| e * unit_length * (1.0 + perturb * rng.random_range(-1.0..=1.0)))
+        .map(|e| {
+            let r: f64 = rng.random_range(-1.0..=1.0);
+            let r = if scene.constraint && *e == 0.0 {
+                r.abs()
+            } else {
+                r
+            };
+            (e + perturb * scale * r) * unit_length
+        })
         .collect();
     let mut model = TaylorChain::new(chain.clone(), &gaps, &scene.velocity)?;
     let undisturbed = scene.load_before - 1.0;

@@ -89,6 +89,32 @@ pub(crate) fn validate(mut f: Fields) -> Result<ChainScene, SceneError> {
     let units = units as usize;
     let length = f.number_where("length", "> 0", |x| x > 0.0)?;
     let wave_speed = f.number_where("wave_speed", "> 0", |x| x > 0.0)?;
+    // The chain's own numbers must be finite and positive too.
+    let critical_load = wave_speed * wave_speed;
+    let (mass, stiffness) = (length / units as f64, critical_load * units as f64 / length);
+    for (name, key, x) in [
+        ("F_cr = wave_speed^2", "wave_speed", critical_load),
+        ("the node mass length / units", "length", mass),
+        (
+            "the unit stiffness F_cr units / length",
+            "length",
+            stiffness,
+        ),
+        (
+            "the frequency sqrt(stiffness / mass)",
+            "wave_speed",
+            (stiffness / mass).sqrt(),
+        ),
+    ] {
+        if !(x.is_finite() && x > 0.0) {
+            return Err(SceneError::field(
+                key,
+                format!(
+                    "makes {name} = {x:e}, which is not a positive finite number; rescale the scene"
+                ),
+            ));
+        }
+    }
     let (load_before, load_after) = load(f.required("load")?)?;
     let constraint = match f.optional("constraint") {
         None => true,
@@ -112,6 +138,7 @@ pub(crate) fn validate(mut f: Fields) -> Result<ChainScene, SceneError> {
         ));
     }
     snapshots.sort_by(f64::total_cmp);
+    snapshots.dedup();
     let samples = match f.optional("samples") {
         None => 101,
         Some(v) => match v.as_u64() {

@@ -75,8 +75,10 @@ fn a_release_run_writes_summary_log_profiles_and_trace() {
     let e0 = summary["energy_initial"].as_f64().unwrap();
     assert!(rows.iter().all(|r| (r[1] - e0).abs() < 1e-12 * e0));
     // Momentum falls as -(1.1 - 0) t until the wall feels the release
-    // (PHYSICS.md s.6); collision pulses running ahead of c_b = 1 get
-    // there near t = 0.45, long before the sound wave would at t = 2.
+    // (PHYSICS.md s.6). Collision pulses run ahead of c_b = 1: the end
+    // unit first closes at about 0.45 (its node's speed), and a pulse
+    // travels at about node speed / strain ahead = 4.5, so the wall, 2
+    // away, feels nothing before t = 2 / 4.5 = 0.44.
     for r in rows.iter().filter(|r| r[0] < 0.4) {
         assert!((r[2] + 1.1 * r[0]).abs() < 1e-9, "{r:?}");
     }
@@ -184,6 +186,20 @@ fn bad_chain_scenes_are_refused_naming_the_field() {
         assert!(err.contains(field), "{body}: {err}");
         assert!(err.contains("bad.json"), "{err}");
     }
+    // Numbers fine one by one, but the chain's own overflow.
+    let path = dir.path().join("huge.json");
+    std::fs::write(
+        &path,
+        r#"{"model": "chain", "units": 3, "length": 2.0, "wave_speed": 1e200, "t_end": 1.0, "load": {"before": 1.1, "after": 0.0}}"#,
+    )
+    .unwrap();
+    let o = flicker(&["check", path.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("field wave_speed") && err.contains("huge.json"),
+        "{err}"
+    );
     // The classical chain takes strains below zero.
     let path = dir.path().join("classical.json");
     std::fs::write(&path, format!(r#"{{{base}, "units": 3, "load": {{"before": 0.9, "after": 0.0}}, "constraint": false}}"#)).unwrap();

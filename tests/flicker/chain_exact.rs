@@ -46,7 +46,7 @@ fn cradles_end_as_worked_out_by_hand() {
     assert!(close(&v, &[0.0, 0.0, 0.0, 2.0], 1e-12), "{v:?}");
     assert_eq!(log.events.len(), 1, "one cascade at t = 0");
     assert_eq!(log.events[0].unit, Some(2));
-    assert_eq!(log.events[0].rel_velocity, Some(2.0));
+    assert!((log.events[0].rel_velocity.unwrap() - 2.0).abs() < 1e-12);
     // Speeds 3 and 1 into two at rest: [0, 0, 1, 3].
     let (v, _) = cradle(&[1.0; 4], &[3.0, 1.0, 0.0, 0.0]);
     assert!(close(&v, &[0.0, 0.0, 1.0, 3.0], 1e-12), "{v:?}");
@@ -254,4 +254,48 @@ fn a_unit_pushed_shut_at_rest_stops_the_run_as_zeno_with_a_reason() {
         "{reason}"
     );
     assert_eq!(o.t_reached, 0.0);
+}
+
+#[test]
+fn a_chain_of_one_unit_is_the_single_mechanism() {
+    // One unit against the wall under F = eta F_cr is the mechanism of
+    // PHYSICS.md s.2 (omega^2 = k / m, strain = gap / (F_cr / k)): its
+    // impacts must come at the closed form's times, to t = 200.
+    use flicker::models::mechanism::{ExactOrbit, Mechanism};
+    for (eta, strain, rate) in [(1.2, 0.5, 0.0), (0.8, 0.1, 0.3), (1.5, 0.0, 0.2)] {
+        let chain = Chain::new(1, 2.0, 8.0, 3.0, 3.0 * eta, true);
+        let omega = 2.0;
+        let unit = 3.0 / 8.0;
+        let mut model = TaylorChain::new(chain, &[strain * unit], &[rate * unit]).unwrap();
+        let mut log = Recorder::default();
+        let t_end = 200.0;
+        let o = simulate_local(
+            &mut model,
+            &Options::until(t_end),
+            &[],
+            &mut |_, _| {},
+            &mut log,
+        );
+        assert_eq!(o.status, Status::Completed, "{:?}", o.reason);
+        let orbit = ExactOrbit::new(Mechanism { eta, omega }, strain, rate);
+        assert_eq!(
+            log.events.len() as u64,
+            orbit.impacts_until(t_end),
+            "eta {eta}"
+        );
+        assert!(log.events.len() > 50, "eta {eta}: an impacting orbit");
+        for (k, e) in log.events.iter().enumerate() {
+            let exact = orbit.impact_time(k as u64);
+            // Impact times add up over hundreds of flights: 1e-12 of t_end.
+            assert!(
+                (e.t - exact).abs() < 2e-10,
+                "eta {eta}, impact {}: {} vs {exact}",
+                k + 1,
+                e.t
+            );
+        }
+        let (eps, eps_rate) = orbit.state_at(t_end);
+        let (g, v) = model.state_at(Time::new(t_end));
+        assert!((g[0] / unit - eps).abs() < 1e-10 && (v[0] / unit - eps_rate).abs() < 1e-10);
+    }
 }

@@ -30,21 +30,28 @@ pub struct Coarse {
 
 impl Coarse {
     /// The fields of `chain` (of total length `length`) with unit gaps
-    /// `gaps` and node velocities `velocities`.
+    /// `gaps` and node velocities `velocities`, at every node `x_j` (the
+    /// wall is node 0): the window around `x_j` holds the `h` units on
+    /// each side, `2 h` cells as close to [`WINDOW_WIDTH`] as whole units
+    /// allow (at least one each side), fewer at the ends.
     pub fn of(chain: &Chain, length: f64, gaps: &[f64], velocities: &[f64]) -> Self {
         let n = chain.units;
         let cell = length / n as f64;
         let unit_length = chain.critical_load / chain.stiffness;
-        // Units on each side of the centre: the window spans 2h + 1 cells.
-        let half = ((0.5 * WINDOW_WIDTH / cell - 0.5).round().max(0.0)) as usize;
+        let half = ((0.5 * WINDOW_WIDTH / cell).round() as usize).max(1);
         let mut coarse = Coarse {
-            x: Vec::with_capacity(n),
-            strain: Vec::with_capacity(n),
-            velocity: Vec::with_capacity(n),
-            hidden_energy: Vec::with_capacity(n),
+            x: Vec::with_capacity(n + 1),
+            strain: Vec::with_capacity(n + 1),
+            velocity: Vec::with_capacity(n + 1),
+            hidden_energy: Vec::with_capacity(n + 1),
         };
-        for centre in 0..n {
-            let (lo, hi) = (centre.saturating_sub(half), (centre + half).min(n - 1));
+        for node in 0..=n {
+            // Units node - h + 1 ..= node + h (1-based), 0-based below;
+            // each unit's velocity is that of its node away from the wall.
+            let (lo, hi) = (
+                (node + 1).saturating_sub(half).max(1) - 1,
+                (node + half).min(n) - 1,
+            );
             let count = (hi - lo + 1) as f64;
             let (d, v) = (&gaps[lo..=hi], &velocities[lo..=hi]);
             let mean_gap = d.iter().sum::<f64>() / count;
@@ -57,7 +64,7 @@ impl Coarse {
                     0.5 * chain.stiffness * dd * dd + 0.5 * chain.mass * dv * dv
                 })
                 .sum();
-            coarse.x.push(-0.5 * length + (centre as f64 + 0.5) * cell);
+            coarse.x.push(-0.5 * length + node as f64 * cell);
             coarse.strain.push(mean_gap / unit_length);
             coarse.velocity.push(mean_velocity);
             coarse.hidden_energy.push(rattle / (count * cell));
@@ -92,8 +99,8 @@ mod tests {
 
     #[test]
     fn alternating_rattle_shows_as_hidden_energy_and_a_front() {
-        // Units 21..40 alternate between strain 0 and 0.1 with velocities
-        // +-0.2: mean strain 0.05 (below 0.1 - 0.008: behind the front).
+        // Units 21..40 (0-based 20..39) alternate between strain 0 and 0.1
+        // with node velocities -+0.2: mean strain 0.05, behind the front.
         let n = 40;
         let chain = Chain::in_scene_units(n, 2.0, 1.0, 0.0, true);
         let unit = chain.critical_load / chain.stiffness;
@@ -107,36 +114,31 @@ mod tests {
             })
             .collect();
         let v: Vec<f64> = (0..n)
-            .map(|i| {
-                if i < 20 {
-                    0.0
-                } else if i % 2 == 0 {
-                    0.2
-                } else {
-                    -0.2
-                }
+            .map(|i| match i {
+                _ if i < 20 => 0.0,
+                _ if i % 2 == 0 => 0.2,
+                _ => -0.2,
             })
             .collect();
         let c = Coarse::of(&chain, 2.0, &gaps, &v);
-        // Cells are 0.05 long: windows of 0.1 hold 3 units (h = 1).
-        let far = n - 2;
-        let expected_strain = (0.0 + 0.1 + 0.0) / 3.0;
+        // Cells are 0.05 long: the window of width 0.1 around node 38
+        // (x = 0.9) holds units 38 and 39 (0-based 37 and 38).
+        assert_eq!(c.x.len(), n + 1);
+        assert!((c.x[38] - 0.9).abs() < 1e-12);
+        assert!((c.strain[38] - 0.05).abs() < 1e-12, "{}", c.strain[38]);
+        assert!(c.velocity[38].abs() < 1e-15);
+        // By hand (k = 20, m = 0.05, unit length u = 0.05, cell = 0.05):
+        // gaps [0, 0.1 u] deviate by -+0.05 u, velocities [-0.2, 0.2] by
+        // -+0.2; the pair holds k (0.05 u)^2 + m 0.2^2 over a length 0.1.
+        let by_hand = (20.0 * (0.05f64 * 0.05).powi(2) + 0.05 * 0.04) / 0.1;
         assert!(
-            (c.strain[far] - expected_strain).abs() < 1e-12,
+            (c.hidden_energy[38] - by_hand).abs() < 1e-15,
             "{}",
-            c.strain[far]
+            c.hidden_energy[38]
         );
-        // By hand (k = 20, m = 0.05, unit = 0.05, cell = 0.05): gaps
-        // [0, u, 0] deviate by u [-1, 2, -1] / 30, squares u^2 / 150;
-        // velocities [-0.2, 0.2, -0.2] by [-2, 4, -2] / 15, squares 16 / 150:
-        // (k u^2 / 300 + 16 m / 300) / (3 cell) = 0.0188888...
-        let by_hand = (20.0 * 0.05 * 0.05 / 300.0 + 16.0 * 0.05 / 300.0) / 0.15;
-        assert!(
-            (c.hidden_energy[far] - by_hand).abs() < 1e-15,
-            "{}",
-            c.hidden_energy[far]
-        );
+        // The front: the first window holding a shut unit, around node 21
+        // (units 21 and 22, 0-based 20 and 21: strains 0.1 and 0).
         let front = c.front(0.1).unwrap();
-        assert!((front - c.x[20]).abs() < 0.06, "front at {front}");
+        assert!((front - c.x[21]).abs() < 1e-12, "front at {front}");
     }
 }

@@ -11,10 +11,13 @@ use std::ops::RangeInclusive;
 /// instant. `shut[i]` says whether unit `first + i` is shut (its gap within
 /// round-off of zero); `v` holds the velocities of nodes `first - 1 ..=
 /// first + shut.len() - 1` (`v[0]` is the wall's, zero, when `first` is 1).
-/// Returns the units whose nodes changed velocity, if any did.
-pub fn cascade(first: usize, shut: &[bool], v: &mut [f64]) -> Option<RangeInclusive<usize>> {
+/// Returns the units whose nodes changed velocity, if any did, and the
+/// change of node 1's velocity the wall made (swaps conserve momentum;
+/// only wall flips change it).
+pub fn cascade(first: usize, shut: &[bool], v: &mut [f64]) -> (Option<RangeInclusive<usize>>, f64) {
     assert_eq!(v.len(), shut.len() + 1, "one more node than units");
     let mut touched: Option<(usize, usize)> = None;
+    let mut wall = 0.0;
     // Each pass fixes at least one closing pair; a block of b units is
     // sorted within b^2 passes (bubble sort), so this bound is never hit.
     for _ in 0..=shut.len() * shut.len() {
@@ -25,6 +28,7 @@ pub fn cascade(first: usize, shut: &[bool], v: &mut [f64]) -> Option<RangeInclus
                 continue;
             }
             if unit == 1 {
+                wall -= 2.0 * v[1];
                 v[1] = -v[1];
             } else {
                 v.swap(i, i + 1);
@@ -36,7 +40,7 @@ pub fn cascade(first: usize, shut: &[bool], v: &mut [f64]) -> Option<RangeInclus
             break;
         }
     }
-    touched.map(|(a, b)| a..=b)
+    (touched.map(|(a, b)| a..=b), wall)
 }
 
 #[cfg(test)]
@@ -49,15 +53,15 @@ mod tests {
         let mut v = [0.0, 2.0, 0.0, 0.0, 0.0];
         let touched = cascade(1, &[false, true, true, true], &mut v);
         assert_eq!(v, [0.0, 0.0, 0.0, 0.0, 2.0]);
-        assert_eq!(touched, Some(2..=4));
+        assert_eq!(touched, (Some(2..=4), 0.0));
     }
 
     #[test]
     fn the_wall_flips_a_closing_first_node_only() {
         let mut v = [0.0, -1.5, 0.0];
-        assert_eq!(cascade(1, &[true, false], &mut v), Some(1..=1));
+        assert_eq!(cascade(1, &[true, false], &mut v), (Some(1..=1), 3.0));
         assert_eq!(v, [0.0, 1.5, 0.0]);
         let mut v = [0.0, 1.5, 0.0];
-        assert_eq!(cascade(1, &[true, false], &mut v), None);
+        assert_eq!(cascade(1, &[true, false], &mut v), (None, 0.0));
     }
 }

@@ -85,7 +85,7 @@ impl HybridModel for Chain {
         let mut v = Vec::with_capacity(n + 1);
         v.push(0.0);
         v.extend_from_slice(&x[n..]);
-        cascade(1, &shut, &mut v);
+        let _ = cascade(1, &shut, &mut v);
         x[n..].copy_from_slice(&v[1..]);
         Jump::to(mode)
     }

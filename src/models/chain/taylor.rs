@@ -21,9 +21,11 @@
 //!
 //! An impact at unit `j` changes the velocities of nodes `j - 1` and `j`
 //! only. A unit or node `d` places beyond them first feels that change in
-//! its coefficient of order `2d`, so over the rest of the window the change
-//! there is below `(2 theta)^(2d) / (2d)!` times the jump. Units within the
-//! reach `D` (the smallest `d` bringing that under `2^-60`) are re-expanded
+//! its coefficient of order `2d` (along a single path, `theta^(2d) / (2d)!`
+//! times the jump); pushing the jump through the recursion with absolute
+//! values bounds every later order too, and orders past the series' own
+//! by `2^k / k!`. Units within the reach `D` (the smallest `d` bringing the
+//! whole bound over the rest of the window under `2^-60`) are re-expanded
 //! from the impact's instant (each keeps its own clock, the time its series
 //! starts at), the rest keep their series, which are still exact to below
 //! round-off. So an impact costs O(K D) whatever N is, and only the `2D + 1`
@@ -272,15 +274,12 @@ impl TaylorChain {
             let mut v: Vec<f64> = (r_lo - 1..=r_hi)
                 .map(|i| u_at(i, &self.scratch_vel))
                 .collect();
-            let before: f64 = v.iter().sum();
-            let Some(touched) = cascade(r_lo, &shut, &mut v) else {
-                // Not closing after all (a graze within round-off): no reset.
-                return Fired {
-                    affects: unit - 1..unit,
-                    unit: Some(unit as u64),
-                    rel_velocity: Some(rel_velocity),
-                };
-            };
+            // Not closing after all (a graze within round-off) changes no
+            // velocity, but the unit is still re-expanded from here with its
+            // gap clamped to zero, so that its series agrees with the state
+            // it was found in and the run moves on.
+            let (touched, wall) = cascade(r_lo, &shut, &mut v);
+            let touched = touched.unwrap_or(unit..=unit);
             if *touched.start() < lo || *touched.end() > hi {
                 // A packed block passed the impact on: widen the reach and
                 // start again from the state before it.
@@ -289,9 +288,9 @@ impl TaylorChain {
                 continue;
             }
             if r_lo == 1 {
-                // Momentum the wall gave (swaps keep it; flips do not).
-                let after: f64 = v.iter().sum();
-                self.wall_impulse += self.chain.mass * self.omega * (after - before);
+                // Momentum the wall gave, and the wall force's integral so
+                // far on unit 1's series before it is replaced.
+                self.wall_impulse += self.chain.mass * self.omega * wall;
                 self.wall_integral += integral(&self.gap[s..2 * s], sigma - self.origin[1]);
             }
             for (k, node) in (r_lo - 1..=r_hi).enumerate().filter(|(_, node)| *node > 0) {
@@ -338,10 +337,16 @@ impl LocalModel for TaylorChain {
         }
         let (unit, s) = (guard + 1, self.stride());
         let origin = self.origin[unit];
-        let end = WINDOW - origin;
+        // An impact tied with the window's end may start a series a hair
+        // past it; the time of a root may round to before `now`.
+        let end = (WINDOW - origin).max(0.0);
         let from = (self.sigma(now) - origin).clamp(0.0, end);
         let series = &self.gap[unit * s..(unit + 1) * s];
-        Ok(first_fall(series, from, end).map(|tau| self.start.after((origin + tau) / self.omega)))
+        let root = first_fall(series, from, end).map_err(|why| format!("unit {unit}: {why}"))?;
+        Ok(root.map(|tau| {
+            let t = self.start.after((origin + tau) / self.omega);
+            if t < now { now } else { t }
+        }))
     }
 
     fn fire(&mut self, guard: usize, t: Time) -> Result<Fired, String> {
