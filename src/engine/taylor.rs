@@ -74,7 +74,7 @@ const MAX_PIECES: u32 = 4096;
 /// down through zero at `a` already (its first nonzero derivative there is
 /// negative). `None` if there is none: in particular a `p` that rises from
 /// zero, or stays exactly on it, has not crossed. An error if the bounds
-/// cannot decide within [`MAX_PIECES`] pieces.
+/// cannot decide within 4096 pieces.
 pub fn first_fall(c: &[f64], a: f64, b: f64) -> Result<Option<f64>, String> {
     // Cheap proof of no root, the common case: p(s) >= c_0 - sum |c_k| b^k
     // on [0, b]. A constant p never crosses either.
