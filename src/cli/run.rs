@@ -191,13 +191,19 @@ pub fn run(args: RunArgs) -> Result<Code, Failure> {
     let mut summary = summary(&report, model_name(&scene), scene_path, log);
     let mut horizon = None;
     let mut ensemble_failed = None;
-    if let (Some(chain), Some(copies)) = (&ensemble_scene, ensemble.ensemble) {
-        match run_ensemble(chain, copies, ensemble.perturb, ensemble.seed, &control) {
+    // The copies run only after a run that completed: an interrupted or
+    // failed run says so by itself.
+    let completed = report.outcome.status == Status::Completed;
+    if let (Some(chain), Some(copies), true) = (&ensemble_scene, ensemble.ensemble, completed) {
+        let path = out.join("ensemble.csv");
+        let found = run_ensemble(chain, copies, ensemble.perturb, ensemble.seed, &control)
+            .and_then(|found| {
+                chain_files::write_ensemble(&found, &path)
+                    .map(|()| found)
+                    .map_err(|e| format!("{}: cannot be written: {e}", path.display()))
+            });
+        match found {
             Ok(found) => {
-                let path = out.join("ensemble.csv");
-                chain_files::write_ensemble(&found, &path).map_err(|e| {
-                    Failure::untrusted(format!("{}: cannot be written: {e}", path.display()))
-                })?;
                 written.push(path);
                 summary["ensemble"] = chain_files::ensemble_summary(&found);
                 horizon = Some(found);
@@ -242,7 +248,15 @@ pub fn run(args: RunArgs) -> Result<Code, Failure> {
     }
     if let Some(why) = ensemble_failed {
         say!("  ensemble failed: {why}");
-        return Ok(Code::Untrusted);
+        let interrupted = control
+            .stop
+            .as_ref()
+            .is_some_and(|s| s.load(Ordering::Relaxed));
+        return Ok(if interrupted {
+            Code::Interrupted
+        } else {
+            Code::Untrusted
+        });
     }
     Ok(match report.outcome.status {
         Status::Completed | Status::Zeno => Code::Ok,

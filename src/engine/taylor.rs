@@ -99,20 +99,27 @@ pub fn first_fall(c: &[f64], a: f64, b: f64) -> Result<Option<f64>, String> {
             Some(_) if at.0 < 0.0 => {}
             // Rising from exactly zero: prove it positive on (a, a + h]
             // and search on from there.
+            Some(_) if b <= a => return Ok(None),
             Some(_) => match lift(&shifted, b - a) {
                 Some(h) if a + h >= b => return Ok(None),
                 Some(h) => (from, at) = (a + h, eval2(c, a + h)),
                 None => return Err(format!("cannot tell which way p leaves zero at {a:e}")),
             },
         }
+        // The proven lift may be below round-off: if p already reads zero
+        // and falling there, that is where it crosses.
+        if at.0 <= 0.0 && at.1 < 0.0 {
+            return Ok(Some(from));
+        }
     }
     let bound = Piece {
         c,
         third: third_derivative_bound(c, b),
         budget: std::cell::Cell::new(MAX_PIECES),
+        gave_up: std::cell::Cell::new(false),
     };
     let root = bound.search(from, b, at, 0);
-    if bound.budget.get() == 0 {
+    if bound.gave_up.get() {
         return Err(format!(
             "the first root on [{a:e}, {b:e}] could not be isolated within {MAX_PIECES} pieces \
              (the polynomial stays within round-off of zero over a stretch)"
@@ -165,6 +172,8 @@ struct Piece<'c> {
     /// Pieces left to examine: a polynomial that hugs zero within
     /// round-off over a long stretch must not cost exponential time.
     budget: std::cell::Cell<u32>,
+    /// Set when a piece was left undecided for want of budget.
+    gave_up: std::cell::Cell<bool>,
 }
 
 enum Verdict {
@@ -186,6 +195,7 @@ impl Piece<'_> {
                 let budget = self.budget.get();
                 if budget == 0 {
                     // Given up; `first_fall` reports it.
+                    self.gave_up.set(true);
                     return None;
                 }
                 self.budget.set(budget - 1);

@@ -155,7 +155,7 @@ fn run_copy(
         XorShiftRng::seed_from_u64(seed ^ (copy as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15));
     let unit_length = chain.critical_load / chain.stiffness;
     // Relative to the scene's strain scale, so that units starting shut are
-    // perturbed too (upwards only, where the constraint holds them).
+    // perturbed too.
     let scale = scene.strain.iter().fold(0.0, |m: f64, e| m.max(e.abs()));
     let scale = if scale > 0.0 { scale } else { 1.0 };
     let gaps: Vec<f64> = scene
@@ -163,12 +163,14 @@ fn run_copy(
         .iter()
         .map(|e| {
             let r: f64 = rng.random_range(-1.0..=1.0);
-            let r = if scene.constraint && *e == 0.0 {
-                r.abs()
+            let moved = e + perturb * scale * r;
+            // The constraint holds strains at zero from below.
+            let moved = if scene.constraint {
+                moved.max(0.0)
             } else {
-                r
+                moved
             };
-            (e + perturb * scale * r) * unit_length
+            moved * unit_length
         })
         .collect();
     let mut model = TaylorChain::new(chain.clone(), &gaps, &scene.velocity)?;

@@ -2,7 +2,7 @@
 //! many units that stay reproducible past the chaos horizon, and by which a
 //! chain is compared with a continuum.
 //!
-//! Windows of width [`WINDOW_WIDTH`] are centred on each unit (clipped at
+//! Windows of width [`WINDOW_WIDTH`] are centred on each node (clipped at
 //! the ends). Window strain = displacement difference across the window
 //! over its width (the mean unit strain); window velocity = the
 //! mass-weighted mean node velocity; hidden energy = the window's energy
@@ -19,7 +19,7 @@ pub const WINDOW_WIDTH: f64 = 0.1;
 /// the front.
 pub const FRONT_DROP: f64 = 0.008;
 
-/// The coarse fields at the unit centres `x`.
+/// The coarse fields at the nodes `x` (the wall's included).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Coarse {
     pub x: Vec<f64>,
@@ -33,7 +33,9 @@ impl Coarse {
     /// `gaps` and node velocities `velocities`, at every node `x_j` (the
     /// wall is node 0): the window around `x_j` holds the `h` units on
     /// each side, `2 h` cells as close to [`WINDOW_WIDTH`] as whole units
-    /// allow (at least one each side), fewer at the ends.
+    /// allow (at least one each side), fewer at the ends. Velocities are
+    /// averaged over the window's mass (its end nodes half each), centred
+    /// on `x_j` too.
     pub fn of(chain: &Chain, length: f64, gaps: &[f64], velocities: &[f64]) -> Self {
         let n = chain.units;
         let cell = length / n as f64;
@@ -50,20 +52,31 @@ impl Coarse {
             // each unit's velocity is that of its node away from the wall.
             let (lo, hi) = (
                 (node + 1).saturating_sub(half).max(1) - 1,
-                (node + half).min(n) - 1,
+                node.saturating_add(half).min(n) - 1,
             );
             let count = (hi - lo + 1) as f64;
-            let (d, v) = (&gaps[lo..=hi], &velocities[lo..=hi]);
+            let d = &gaps[lo..=hi];
             let mean_gap = d.iter().sum::<f64>() / count;
-            let mean_velocity = v.iter().sum::<f64>() / count;
-            let rattle: f64 = d
-                .iter()
-                .zip(v)
-                .map(|(d, v)| {
-                    let (dd, dv) = (d - mean_gap, v - mean_velocity);
-                    0.5 * chain.stiffness * dd * dd + 0.5 * chain.mass * dv * dv
+            // The window's mass: its inner nodes whole, the two at its ends
+            // (nodes lo and hi + 1, 1-based) half each; the wall's node is
+            // at rest.
+            let node_velocity = |j: usize| if j == 0 { 0.0 } else { velocities[j - 1] };
+            let weighted: Vec<(f64, f64)> = (lo..=hi + 1)
+                .map(|j| {
+                    let w = if j == lo || j == hi + 1 { 0.5 } else { 1.0 };
+                    (w, node_velocity(j))
                 })
+                .collect();
+            let mean_velocity = weighted.iter().map(|(w, v)| w * v).sum::<f64>() / count;
+            let elastic: f64 = d
+                .iter()
+                .map(|d| 0.5 * chain.stiffness * (d - mean_gap).powi(2))
                 .sum();
+            let kinetic: f64 = weighted
+                .iter()
+                .map(|(w, v)| 0.5 * chain.mass * w * (v - mean_velocity).powi(2))
+                .sum();
+            let rattle = elastic + kinetic;
             coarse.x.push(-0.5 * length + node as f64 * cell);
             coarse.strain.push(mean_gap / unit_length);
             coarse.velocity.push(mean_velocity);
@@ -92,8 +105,11 @@ mod tests {
         let unit = chain.critical_load / chain.stiffness;
         let c = Coarse::of(&chain, 2.0, &vec![0.1 * unit; 40], &vec![0.3; 40]);
         assert!(c.strain.iter().all(|e| (e - 0.1).abs() < 1e-15));
-        assert!(c.velocity.iter().all(|v| (v - 0.3).abs() < 1e-15));
-        assert!(c.hidden_energy.iter().all(|h| h.abs() < 1e-15));
+        // Windows clear of the wall (whose node is at rest): h = 1 here.
+        assert!(c.velocity[2..].iter().all(|v| (v - 0.3).abs() < 1e-15));
+        assert!(c.hidden_energy[2..].iter().all(|h| h.abs() < 1e-15));
+        // Around the wall the node at rest is part of the window's mass.
+        assert!((c.velocity[0] - 0.15).abs() < 1e-15 && c.hidden_energy[0] > 0.0);
         assert_eq!(c.front(0.1), None);
     }
 

@@ -296,7 +296,7 @@ impl TaylorChain {
             for (k, node) in (r_lo - 1..=r_hi).enumerate().filter(|(_, node)| *node > 0) {
                 self.scratch_vel[(node - w_lo) * s] = v[k];
             }
-            for i in touched {
+            for i in touched.chain(std::iter::once(unit)) {
                 let g = &mut self.scratch_gap[(i - w_lo) * s];
                 // Shut means zero: drop the round-off overlap.
                 *g = g.max(0.0);
