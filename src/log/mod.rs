@@ -14,7 +14,7 @@
 //! | `mode_before`, `mode_after` | the automaton's mode on either side |
 //! | `energy_before`, `energy_after` | the model's energy on either side (`null` if it has none) |
 //! | `before`, `after` | the state on either side, as an object of named components (empty for a chain, whose state is too large) |
-//! | `unit` | chains only: the unit that closed (1 = next to the wall) |
+//! | `unit` | chains only: the unit that closed (1 = next to the wall); with `rel_velocity` 0 it came to rest shut (resting contact); a `release` line names the unit pulled open from rest |
 //! | `rel_velocity` | chains only: `y'_{n-1} - y'_n` just before the impact (`-y'_1` for unit 1), positive when closing |
 //!
 //! A chain run also writes `profiles.json` and `trace.csv` ([`chain_files`]).

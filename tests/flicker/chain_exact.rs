@@ -211,8 +211,8 @@ fn the_release_keeps_energy_momentum_balance_and_every_gap_open() {
         );
         assert_eq!(
             model.guards().len(),
-            units + 1,
-            "one guard per unit and the window"
+            units + 2,
+            "one guard per unit, the release and the window"
         );
     }
 }
@@ -233,27 +233,94 @@ fn bad_initial_states_are_refused_with_a_reason() {
 }
 
 #[test]
-fn a_unit_pushed_shut_at_rest_stops_the_run_as_zeno_with_a_reason() {
-    // Two units, the end load gone (F = 0): unit 2 starts shut and at rest,
-    // and F_cr pulls the end node into it. Resting contact is not modelled
-    // for chains yet: the run must say so and stop, not spin or go on wrong.
+fn a_unit_pushed_shut_rests_and_the_pair_bounces_off_the_wall_as_one() {
+    // Two units (m = k = F_cr = 1, so omega = 1 and the unit length is 1),
+    // the end load gone (F = 0): unit 2 starts shut and at rest, pushed
+    // shut by F_cr (PHYSICS.md s.4: resting contact), unit 1 open at 0.1.
+    // By hand: nodes 1 and 2 move as one body of mass 2 under -F_cr, so
+    // Delta_1'' = (-1 - Delta_1) / 2 and Delta_1 = -1 + 1.1 cos(t / sqrt 2)
+    // reaches 0 at t1 = sqrt 2 arccos(1 / 1.1); the wall sends the pair
+    // back as one (unit 2 stays shut: its contact force 1 - Delta_1 > 0),
+    // and by symmetry it returns at 3 t1, 5 t1, ...
     let chain = Chain::in_scene_units(2, 2.0, 1.0, 0.0, true);
-    let unit = chain.critical_load / chain.stiffness;
-    let mut model = TaylorChain::new(chain, &[0.1 * unit, 0.0], &[0.0, 0.0]).unwrap();
+    assert_eq!(
+        (chain.mass, chain.stiffness, chain.critical_load),
+        (1.0, 1.0, 1.0)
+    );
+    let mut model = TaylorChain::new(chain, &[0.1, 0.0], &[0.0, 0.0]).unwrap();
+    let mut log = Recorder::default();
+    let t_end = 40.0;
     let o = simulate_local(
         &mut model,
-        &Options::until(1.0),
+        &Options::until(t_end),
         &[],
         &mut |_, _| {},
-        &mut (),
+        &mut log,
     );
-    assert_eq!(o.status, Status::Zeno, "{:?}", o.reason);
-    let reason = o.reason.unwrap();
+    assert_eq!(o.status, Status::Completed, "{:?}", o.reason);
+    let t1 = 2f64.sqrt() * (1.0 / 1.1f64).acos();
+    // First the contact at t = 0 (unit 2, no closing speed), then unit 1
+    // against the wall at odd multiples of t1, nothing else.
+    assert_eq!(log.events[0].unit, Some(2));
+    assert_eq!(log.events[0].t, 0.0);
+    assert_eq!(log.events[0].rel_velocity, Some(0.0));
+    let bounces: Vec<f64> = log.events[1..].iter().map(|e| e.t).collect();
     assert!(
-        reason.contains("no resting mode") && reason.contains("impact"),
-        "{reason}"
+        log.events[1..].iter().all(|e| e.unit == Some(1)),
+        "{:?}",
+        log.events
     );
-    assert_eq!(o.t_reached, 0.0);
+    let expected = ((t_end / t1 - 1.0) / 2.0).floor() as usize + 1;
+    assert_eq!(bounces.len(), expected);
+    for (k, t) in bounces.iter().enumerate() {
+        let exact = (2 * k + 1) as f64 * t1;
+        assert!(
+            (t - exact).abs() < 1e-12 * t_end,
+            "bounce {k}: {t} vs {exact}"
+        );
+    }
+    // Unit 2 never opened; energy and the momentum balance hold.
+    let (gaps, v) = model.state_at(Time::new(t_end));
+    assert_eq!(gaps[1], 0.0);
+    assert_eq!(v[0], v[1]);
+    assert!(o.max_energy_error.unwrap() < 1e-13);
+    let at = Time::new(t_end);
+    assert!((model.momentum(at) - model.momentum_by_impulses(at)).abs() < 1e-12);
+}
+
+#[test]
+fn a_resting_block_releases_when_its_neighbour_pulls_hard_enough() {
+    // The same pair, but nodes 1 and 2 start moving out at speed 2:
+    // Delta_1 = -1 + 1.1 cos(s) + 2 sqrt 2 sin(s), s = t / sqrt 2. Unit 2
+    // stays shut while its contact force 1 - Delta_1 > 0; it is released
+    // when Delta_1 reaches 1 (by hand: the first root of that equation).
+    let chain = Chain::in_scene_units(2, 2.0, 1.0, 0.0, true);
+    let mut model = TaylorChain::new(chain, &[0.1, 0.0], &[2.0, 2.0]).unwrap();
+    let mut log = Recorder::default();
+    let o = simulate_local(
+        &mut model,
+        &Options::until(3.0),
+        &[],
+        &mut |_, _| {},
+        &mut log,
+    );
+    assert_eq!(o.status, Status::Completed, "{:?}", o.reason);
+    let (a, b) = (1.1f64, 2.0 * 2f64.sqrt());
+    // 1.1 cos s + b sin s = 2: R cos(s - phi) = 2.
+    let (r, phi) = ((a * a + b * b).sqrt(), b.atan2(a));
+    let released = 2f64.sqrt() * (phi - (2.0 / r).acos());
+    let release = log
+        .events
+        .iter()
+        .find(|e| e.guard == "release")
+        .expect("a release");
+    assert_eq!(release.unit, Some(2));
+    assert!(
+        (release.t - released).abs() < 1e-12,
+        "{} vs {released}",
+        release.t
+    );
+    assert!(o.max_energy_error.unwrap() < 1e-13);
 }
 
 #[test]
@@ -298,4 +365,33 @@ fn a_chain_of_one_unit_is_the_single_mechanism() {
         let (g, v) = model.state_at(Time::new(t_end));
         assert!((g[0] / unit - eps).abs() < 1e-10 && (v[0] / unit - eps_rate).abs() < 1e-10);
     }
+}
+
+#[test]
+fn a_chain_shut_all_along_and_pushed_rests_against_the_wall() {
+    // Every unit shut and at rest, the end pushed by F_cr - F = 0.5 F_cr:
+    // the whole chain rests on the wall (the contact spreads from the end
+    // at t = 0), nothing moves, and the wall's hold balances the load.
+    let units = 30;
+    let chain = Chain::in_scene_units(units, 2.0, 1.0, 0.5, true);
+    let mut model = TaylorChain::new(chain, &vec![0.0; units], &vec![0.0; units]).unwrap();
+    let mut log = Recorder::default();
+    let o = simulate_local(
+        &mut model,
+        &Options::until(5.0),
+        &[],
+        &mut |_, _| {},
+        &mut log,
+    );
+    assert_eq!(o.status, Status::Completed, "{:?}", o.reason);
+    assert!(
+        log.events
+            .iter()
+            .all(|e| e.t == 0.0 && e.rel_velocity == Some(0.0))
+    );
+    let at = Time::new(5.0);
+    let (gaps, v) = model.state_at(at);
+    assert!(gaps.iter().chain(&v).all(|x| *x == 0.0), "{gaps:?} {v:?}");
+    assert_eq!(model.momentum(at), 0.0);
+    assert!(model.momentum_by_impulses(at).abs() < 1e-12);
 }

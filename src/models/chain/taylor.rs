@@ -30,6 +30,15 @@
 //! starts at), the rest keep their series, which are still exact to below
 //! round-off. So an impact costs O(K D) whatever N is, and only the `2D + 1`
 //! guards within the reach are re-predicted.
+//!
+//! Resting contact (PHYSICS.md s.4): a shut unit is pushed shut only at the
+//! loaded end with `F < F_cr` (inside, `Delta_n'' = omega^2 (Delta_{n+1} +
+//! Delta_{n-1}) >= 0` at a shut unit), so units resting shut form one end
+//! block `a..=N` whose nodes `a - 1..=N` move as a rigid body; the series
+//! recursion gives them the block's acceleration. Its contact force is
+//! least in unit `a`; a `release` guard watches it and frees unit `a` when
+//! it would pull. An impact reaching the block breaks it up, and the end
+//! may come to rest again at once.
 
 use crate::engine::taylor::{eval, first_fall, integral};
 use crate::engine::{Direction, Fired, Guard, LocalModel};
@@ -79,10 +88,22 @@ pub struct TaylorChain {
     wall_integral: f64,
     wall_impulse: f64,
     momentum_initial: f64,
+    /// First unit of the end block in resting contact, if any: units
+    /// `a..=N` shut, nodes `a - 1..=N` moving as one (at rest with the wall
+    /// if `a` is 1).
+    block: Option<usize>,
+    /// Since when the whole chain rests shut against the wall (block from
+    /// unit 1), whose contact force then balances the end load.
+    held_since: Option<Time>,
 }
 
-/// Guard name of an impact.
+/// Guard name of an impact (with `rel_velocity` 0: a unit coming to rest
+/// shut, in resting contact).
 pub const IMPACT: &str = "impact";
+
+/// Guard name of the end of resting contact: the end block's first unit
+/// is pulled open.
+pub const RELEASE: &str = "release";
 
 impl TaylorChain {
     /// The chain starting with unit gaps `gaps` (elongations `Delta_n`) and
@@ -123,7 +144,9 @@ impl TaylorChain {
         let ghost = (chain.load - chain.critical_load) / chain.stiffness;
         let stride = order + 1;
         let mut guards = if chain.constraint {
-            vec![Guard::affine(IMPACT, Direction::Falling); n]
+            let mut impacts = vec![Guard::affine(IMPACT, Direction::Falling); n];
+            impacts.push(Guard::affine(RELEASE, Direction::Falling).as_crossing());
+            impacts
         } else {
             Vec::new()
         };
@@ -151,6 +174,8 @@ impl TaylorChain {
             wall_integral: 0.0,
             wall_impulse: 0.0,
             momentum_initial: chain.mass * velocities.iter().sum::<f64>(),
+            block: None,
+            held_since: None,
             chain,
         };
         for i in 1..=n {
@@ -158,7 +183,7 @@ impl TaylorChain {
             model.vel[i * stride] = velocities[i - 1] / omega;
         }
         let (gap, vel) = (&mut model.gap[stride..], &mut model.vel[stride..]);
-        levels(gap, vel, n, order, Some(ghost));
+        levels(gap, vel, n, order, Some(ghost), None);
         Ok(model)
     }
 
@@ -221,8 +246,27 @@ impl TaylorChain {
         let s = self.stride();
         let tau = (self.sigma(t) - self.origin[1]).max(0.0);
         let area = (self.wall_integral + integral(&self.gap[s..2 * s], tau)) / self.omega;
+        let held = self
+            .held_since
+            .map_or(0.0, |since| (c.critical_load - c.load) * t.since(since));
         self.momentum_initial + (c.load - c.critical_load) * t.value() - c.stiffness * area
             + self.wall_impulse
+            + held
+    }
+
+    /// When `series`, which starts on unit `unit`'s clock, first falls
+    /// through zero at or after `now` within the window.
+    fn first_root(&self, unit: usize, series: &[f64], now: Time) -> Result<Option<Time>, String> {
+        let origin = self.origin[unit];
+        // An impact tied with the window's end may start a series a hair
+        // past it; the time of a root may round to before `now`.
+        let end = (WINDOW - origin).max(0.0);
+        let from = (self.sigma(now) - origin).clamp(0.0, end);
+        let root = first_fall(series, from, end).map_err(|why| format!("unit {unit}: {why}"))?;
+        Ok(root.map(|tau| {
+            let t = self.start.after((origin + tau) / self.omega);
+            if t < now { now } else { t }
+        }))
     }
 
     /// Re-expand every unit at the end of the window and start the next.
@@ -238,33 +282,21 @@ impl TaylorChain {
             self.origin[i] = 0.0;
         }
         let (gap, vel) = (&mut self.gap[s..], &mut self.vel[s..]);
-        levels(gap, vel, n, self.order, Some(self.ghost));
+        let block = self.block.map(|a| a - 1);
+        levels(gap, vel, n, self.order, Some(self.ghost), block);
         self.start = self.start.after(self.span);
     }
 
     /// Resolve the impact of unit `unit` at `t` and re-expand the units
     /// within reach of every velocity it changed.
     fn impact(&mut self, unit: usize, t: Time) -> Fired {
-        let (n, s) = (self.chain.units, self.stride());
+        let n = self.chain.units;
         let sigma = self.sigma(t);
         let (mut lo, mut hi) = (unit, unit);
         loop {
-            let reach = lo.saturating_sub(self.reach).max(1)..=(hi + self.reach).min(n);
-            let (r_lo, r_hi) = (*reach.start(), *reach.end());
-            let (w_lo, w_hi) = (
-                r_lo.saturating_sub(self.spread).max(1),
-                (r_hi + self.spread).min(n),
-            );
-            let count = w_hi - w_lo + 1;
-            self.scratch_gap.clear();
-            self.scratch_gap.resize(count * s, 0.0);
-            self.scratch_vel.clear();
-            self.scratch_vel.resize(count * s, 0.0);
-            for i in w_lo..=w_hi {
-                let (d, u) = self.state(i, sigma);
-                self.scratch_gap[(i - w_lo) * s] = d;
-                self.scratch_vel[(i - w_lo) * s] = u;
-            }
+            let (r_lo, r_hi) = self.reach_around(lo, hi);
+            let (w_lo, count) = self.load_window(r_lo, r_hi, sigma);
+            let s = self.stride();
             let u_at = |node: usize, v: &[f64]| if node == 0 { 0.0 } else { v[(node - w_lo) * s] };
             let rel_velocity =
                 self.omega * (u_at(unit - 1, &self.scratch_vel) - u_at(unit, &self.scratch_vel));
@@ -274,10 +306,10 @@ impl TaylorChain {
             let mut v: Vec<f64> = (r_lo - 1..=r_hi)
                 .map(|i| u_at(i, &self.scratch_vel))
                 .collect();
-            // Not closing after all (a graze within round-off) changes no
-            // velocity, but the unit is still re-expanded from here with its
-            // gap clamped to zero, so that its series agrees with the state
-            // it was found in and the run moves on.
+            // Not closing after all (a graze within round-off, or a unit
+            // coming to rest shut) changes no velocity, but the unit is
+            // still re-expanded from here with its gap clamped to zero, so
+            // that its series agrees with the state it was found in.
             let (touched, wall) = cascade(r_lo, &shut, &mut v);
             let touched = touched.unwrap_or(unit..=unit);
             if *touched.start() < lo || *touched.end() > hi {
@@ -296,29 +328,179 @@ impl TaylorChain {
             for (k, node) in (r_lo - 1..=r_hi).enumerate().filter(|(_, node)| *node > 0) {
                 self.scratch_vel[(node - w_lo) * s] = v[k];
             }
-            for i in touched.chain(std::iter::once(unit)) {
+            for i in touched.clone().chain(std::iter::once(unit)) {
                 let g = &mut self.scratch_gap[(i - w_lo) * s];
                 // Shut means zero: drop the round-off overlap.
                 *g = g.max(0.0);
             }
-            let ghost = (w_hi == n).then_some(self.ghost);
-            levels(
-                &mut self.scratch_gap,
-                &mut self.scratch_vel,
-                count,
-                self.order,
-                ghost,
-            );
-            let (from, to) = ((r_lo - w_lo) * s, (r_hi - w_lo + 1) * s);
-            self.gap[r_lo * s..(r_hi + 1) * s].copy_from_slice(&self.scratch_gap[from..to]);
-            self.vel[r_lo * s..(r_hi + 1) * s].copy_from_slice(&self.scratch_vel[from..to]);
-            self.origin[r_lo..=r_hi].fill(sigma);
+            // A collision with the resting end block breaks it up; the end
+            // may come to rest again at once.
+            if self.block.is_some_and(|a| *touched.end() + 1 >= a) {
+                self.set_block(None, t);
+            }
+            if r_hi == n {
+                self.settle_end(r_lo, w_lo, t);
+            }
+            self.store_window(r_lo, r_hi, w_lo, count, sigma);
             return Fired {
-                affects: r_lo - 1..r_hi,
+                affects: self.guards_of(r_lo, r_hi),
                 unit: Some(unit as u64),
                 rel_velocity: Some(rel_velocity),
             };
         }
+    }
+
+    /// The end block's first unit is pulled open: the block shrinks by it.
+    fn release(&mut self, t: Time) -> Fired {
+        let n = self.chain.units;
+        let a = self
+            .block
+            .expect("the release guard is predicted only with a block");
+        let sigma = self.sigma(t);
+        self.set_block((a < n).then_some(a + 1), t);
+        let (r_lo, r_hi) = self.reach_around(a.saturating_sub(1).max(1), n);
+        let (w_lo, count) = self.load_window(r_lo, r_hi, sigma);
+        self.store_window(r_lo, r_hi, w_lo, count, sigma);
+        Fired {
+            affects: self.guards_of(r_lo, r_hi),
+            unit: Some(a as u64),
+            rel_velocity: None,
+        }
+    }
+
+    /// Units `lo - D ..= hi + D`, and the whole end block with the node on
+    /// its left if that comes within reach (a rigid block passes a change
+    /// on at once).
+    fn reach_around(&self, lo: usize, hi: usize) -> (usize, usize) {
+        let n = self.chain.units;
+        let (r_lo, r_hi) = (
+            lo.saturating_sub(self.reach).max(1),
+            (hi + self.reach).min(n),
+        );
+        match self.block {
+            Some(a) if r_hi + 1 >= a => (r_lo.min(a.saturating_sub(1).max(1)), n),
+            _ => (r_lo, r_hi),
+        }
+    }
+
+    /// The state at `sigma` of the units within the series' spread of
+    /// `r_lo..=r_hi`, into the scratch series' order 0; returns the
+    /// window's first unit and its length.
+    fn load_window(&mut self, r_lo: usize, r_hi: usize, sigma: f64) -> (usize, usize) {
+        let (n, s) = (self.chain.units, self.stride());
+        let (w_lo, w_hi) = (
+            r_lo.saturating_sub(self.spread).max(1),
+            (r_hi + self.spread).min(n),
+        );
+        let count = w_hi - w_lo + 1;
+        self.scratch_gap.clear();
+        self.scratch_gap.resize(count * s, 0.0);
+        self.scratch_vel.clear();
+        self.scratch_vel.resize(count * s, 0.0);
+        for i in w_lo..=w_hi {
+            let (d, u) = self.state(i, sigma);
+            self.scratch_gap[(i - w_lo) * s] = d;
+            self.scratch_vel[(i - w_lo) * s] = u;
+        }
+        (w_lo, count)
+    }
+
+    /// Expand the scratch window and keep the series of `r_lo..=r_hi`,
+    /// which start at `sigma`.
+    fn store_window(&mut self, r_lo: usize, r_hi: usize, w_lo: usize, count: usize, sigma: f64) {
+        let (n, s) = (self.chain.units, self.stride());
+        let reaches_end = w_lo + count - 1 == n;
+        let ghost = reaches_end.then_some(self.ghost);
+        let block = self.block.filter(|_| reaches_end).map(|a| a - w_lo);
+        levels(
+            &mut self.scratch_gap,
+            &mut self.scratch_vel,
+            count,
+            self.order,
+            ghost,
+            block,
+        );
+        let (from, to) = ((r_lo - w_lo) * s, (r_hi - w_lo + 1) * s);
+        self.gap[r_lo * s..(r_hi + 1) * s].copy_from_slice(&self.scratch_gap[from..to]);
+        self.vel[r_lo * s..(r_hi + 1) * s].copy_from_slice(&self.scratch_vel[from..to]);
+        self.origin[r_lo..=r_hi].fill(sigma);
+    }
+
+    /// The guards whose predictions a change to units `r_lo..=r_hi` moves:
+    /// their impacts, and the release if the change reaches the end.
+    fn guards_of(&self, r_lo: usize, r_hi: usize) -> std::ops::Range<usize> {
+        let n = self.chain.units;
+        r_lo - 1..if r_hi == n { n + 1 } else { r_hi }
+    }
+
+    /// If units at the loaded end are shut, at no relative speed, and
+    /// pushed shut (PHYSICS.md s.4: resting contact), make them the end
+    /// block: their nodes then move as one. Works on the scratch window
+    /// (order 0), which reaches the end; the block stays inside
+    /// `r_lo + 1..` (or starts at the wall) so that it is re-expanded.
+    ///
+    /// Only the end can be pushed shut: an interior shut unit is pulled
+    /// open by its neighbours' tension. With the block `a..=N`, the contact
+    /// force is least in unit `a`, and positive while
+    /// `(N - a + 1) Delta_{a-1} < (F_cr - F) / k`.
+    fn settle_end(&mut self, r_lo: usize, w_lo: usize, t: Time) {
+        let (n, s) = (self.chain.units, self.stride());
+        if self.block.is_some() || self.ghost >= 0.0 {
+            return;
+        }
+        let gap = |i: usize, g: &[f64]| g[(i - w_lo) * s];
+        let node = |i: usize, v: &[f64]| if i == 0 { 0.0 } else { v[(i - w_lo) * s] };
+        let floor = if r_lo == 1 { 1 } else { r_lo + 1 };
+        let mut a = n + 1;
+        while a > floor {
+            let unit = a - 1;
+            let resting = gap(unit, &self.scratch_gap) <= self.shut_below
+                && (node(unit - 1, &self.scratch_vel) - node(unit, &self.scratch_vel)).abs()
+                    <= self.shut_below;
+            if !resting {
+                break;
+            }
+            a = unit;
+        }
+        // Longest block first; if its first unit is not pushed, the rest is.
+        if a >= 2 && a <= n && (n - a + 1) as f64 * gap(a - 1, &self.scratch_gap) > -self.ghost {
+            a += 1;
+        }
+        if a > n {
+            return;
+        }
+        // Shut exactly, and one velocity: their mean, which keeps the
+        // momentum (the speeds differ by round-off only); at rest against
+        // the wall if the block reaches it.
+        let nodes = a - 1..=n;
+        let mean = if a == 1 {
+            0.0
+        } else {
+            nodes
+                .clone()
+                .map(|i| node(i, &self.scratch_vel))
+                .sum::<f64>()
+                / (n - a + 2) as f64
+        };
+        for i in a..=n {
+            self.scratch_gap[(i - w_lo) * s] = 0.0;
+        }
+        for i in nodes.filter(|&i| i > 0) {
+            self.scratch_vel[(i - w_lo) * s] = mean;
+        }
+        self.set_block(Some(a), t);
+    }
+
+    /// Change the end block, keeping the account of the wall's hold.
+    fn set_block(&mut self, block: Option<usize>, t: Time) {
+        let c = &self.chain;
+        if let Some(since) = self.held_since.take() {
+            self.wall_impulse += (c.critical_load - c.load) * t.since(since);
+        }
+        if block == Some(1) {
+            self.held_since = Some(t);
+        }
+        self.block = block;
     }
 }
 
@@ -332,21 +514,31 @@ impl LocalModel for TaylorChain {
     }
 
     fn predict(&self, guard: usize, now: Time) -> Result<Option<Time>, String> {
+        let (n, s) = (self.chain.units, self.stride());
         if guard + 1 == self.guards.len() {
             return Ok(Some(self.start.after(self.span)));
         }
-        let (unit, s) = (guard + 1, self.stride());
-        let origin = self.origin[unit];
-        // An impact tied with the window's end may start a series a hair
-        // past it; the time of a root may round to before `now`.
-        let end = (WINDOW - origin).max(0.0);
-        let from = (self.sigma(now) - origin).clamp(0.0, end);
-        let series = &self.gap[unit * s..(unit + 1) * s];
-        let root = first_fall(series, from, end).map_err(|why| format!("unit {unit}: {why}"))?;
-        Ok(root.map(|tau| {
-            let t = self.start.after((origin + tau) / self.omega);
-            if t < now { now } else { t }
-        }))
+        if guard == n {
+            // The release watches the end block's least contact force,
+            // `(F_cr - F) / k - (N - a + 1) Delta_{a-1}`, through the gap
+            // left of it.
+            let Some(a) = self.block.filter(|&a| a >= 2) else {
+                return Ok(None);
+            };
+            let scale = (n - a + 1) as f64;
+            let mut force = [0.0; MAX_ORDER + 1];
+            for (f, d) in force.iter_mut().zip(&self.gap[(a - 1) * s..a * s]) {
+                *f = -scale * d;
+            }
+            force[0] -= self.ghost;
+            return self.first_root(a - 1, &force[..s], now);
+        }
+        if self.block.is_some_and(|a| guard + 1 >= a) {
+            // Resting in the end block: no impact until it is released.
+            return Ok(None);
+        }
+        let unit = guard + 1;
+        self.first_root(unit, &self.gap[unit * s..(unit + 1) * s], now)
     }
 
     fn fire(&mut self, guard: usize, t: Time) -> Result<Fired, String> {
@@ -357,6 +549,9 @@ impl LocalModel for TaylorChain {
                 unit: None,
                 rel_velocity: None,
             });
+        }
+        if guard == self.chain.units {
+            return Ok(self.release(t));
         }
         Ok(self.impact(guard + 1, t))
     }
@@ -380,33 +575,59 @@ impl LocalModel for TaylorChain {
 /// orders above `2i` of the `i`-th index from that open end are not valid
 /// (they would need states beyond it), and likewise at the right end
 /// unless `ghost` says it is unit N with that constant elongation beyond.
-fn levels(gap: &mut [f64], vel: &mut [f64], count: usize, order: usize, ghost: Option<f64>) {
+///
+/// `block` (with `ghost`): the slice's units from this index on are the end
+/// block in resting contact: shut at every order, their nodes (and the
+/// node on the block's left) moving as one rigid body pushed by the ghost
+/// and pulled by the unit left of it; a block from index 0 includes the
+/// wall and is at rest.
+fn levels(
+    gap: &mut [f64],
+    vel: &mut [f64],
+    count: usize,
+    order: usize,
+    ghost: Option<f64>,
+    block: Option<usize>,
+) {
     let s = order + 1;
     for k in 0..order {
         let inv = 1.0 / (k + 1) as f64;
         let mut left = 0.0; // velocity series of the index on the left, order k
+        let load = match ghost {
+            Some(f) if k == 0 => f,
+            _ => 0.0,
+        };
         for i in 0..count {
             let here = i * s + k;
-            let right = if i + 1 < count {
-                gap[here + s]
-            } else {
-                match ghost {
-                    Some(f) if k == 0 => f,
-                    _ => 0.0,
-                }
-            };
+            let right = if i + 1 < count { gap[here + s] } else { load };
             let u = vel[here];
             gap[here + 1] = (u - left) * inv;
             vel[here + 1] = (right - gap[here]) * inv;
             left = u;
         }
+        if let Some(b) = block.filter(|&b| b < count) {
+            let nodes = (count - b + 1) as f64;
+            let rigid = match b {
+                0 => 0.0,
+                _ => (load - gap[(b - 1) * s + k]) * inv / nodes,
+            };
+            for i in b..count {
+                gap[i * s + k + 1] = 0.0;
+            }
+            for i in b.saturating_sub(1)..count {
+                vel[i * s + k + 1] = rigid;
+            }
+        }
     }
 }
+
+/// Highest series order a window may need.
+const MAX_ORDER: usize = 63;
 
 /// The smallest order whose truncation over a window is certified.
 fn order_for(window: f64) -> usize {
     let x = 2.0 * window;
-    (1..64)
+    (1..=MAX_ORDER)
         .find(|&k| tail(x, k + 1) < CERTIFIED)
         .expect("a window below 1 converges")
 }
