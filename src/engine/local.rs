@@ -21,7 +21,7 @@ use std::sync::atomic::Ordering;
 use std::time::Instant;
 
 use crate::engine::model::Guard;
-use crate::engine::observer::{EventRecord, Observer};
+use crate::engine::observer::{EventRecord, Observer, SETTLE};
 use crate::engine::queue::EventQueue;
 use crate::engine::simulation::{Options, Outcome, Status};
 use crate::engine::zeno::ZenoWatch;
@@ -49,6 +49,15 @@ pub trait LocalModel {
     /// The conserved energy at `t` (not before the last event), if any.
     fn energy(&self, t: Time) -> Option<f64> {
         let _ = t;
+        None
+    }
+
+    /// Called when the events of `guard` accumulate at `t` faster than the
+    /// run can resolve (a Zeno point). A model that knows the limit
+    /// (resting contact) puts its state there and says what it changed;
+    /// `None` ends the run.
+    fn settle(&mut self, guard: usize, t: Time) -> Option<Fired> {
+        let _ = (guard, t);
         None
     }
 
@@ -94,9 +103,15 @@ pub fn simulate_local<M: LocalModel + ?Sized, O: Observer + ?Sized>(
         energy_scale: energy_initial.map_or(1.0, |e| model.energy_scale(e)),
         max_energy_error: energy_initial.map(|_| 0.0),
         evaluations: 0,
+        settles: 0,
+        zeno_reason: None,
     };
     let (status, reason) = match run.event_loop(model, samples, on_sample, observer, started) {
-        Ok(()) => (Status::Completed, None),
+        // A run that settled a Zeno point and went on says so.
+        Ok(()) => match run.zeno_reason.take() {
+            Some(reason) => (Status::Zeno, Some(reason)),
+            None => (Status::Completed, None),
+        },
         Err((status, reason)) => (status, Some(reason)),
     };
     let energy_final = model.energy(run.now);
@@ -107,6 +122,9 @@ pub fn simulate_local<M: LocalModel + ?Sized, O: Observer + ?Sized>(
         if n > 0 {
             *events_by_guard.entry(guards[slot].name).or_insert(0) += n;
         }
+    }
+    if run.settles > 0 {
+        events_by_guard.insert(SETTLE, run.settles);
     }
     Outcome {
         zeno: status == Status::Zeno,
@@ -144,6 +162,9 @@ struct LocalRun<'o> {
     max_energy_error: Option<f64>,
     /// Predictions asked of the model.
     evaluations: u64,
+    /// Zeno accumulations the model settled, and what the last one was.
+    settles: u64,
+    zeno_reason: Option<String>,
 }
 
 impl LocalRun<'_> {
@@ -275,17 +296,46 @@ impl LocalRun<'_> {
         }
         // Internal guards are the model's bookkeeping at times it chooses
         // (a window every so often), not events that could accumulate.
+        let mut fired = fired;
         if !guard.internal && self.zeno.observe(0, slot, t) {
-            return Err((
-                Status::Zeno,
-                format!(
-                    "events of guard `{}` accumulate at t = {:e} faster than the run can resolve ({}); \
-                     the model has no resting mode, so the run stops here",
-                    guard.name,
-                    t.value(),
-                    self.zeno.describe()
-                ),
-            ));
+            let what = format!(
+                "events of guard `{}` accumulate at t = {:e} faster than the run can resolve ({})",
+                guard.name,
+                t.value(),
+                self.zeno.describe()
+            );
+            let Some(settled) = model.settle(slot, t) else {
+                return Err((
+                    Status::Zeno,
+                    format!("{what}; the model has no resting mode, so the run stops here"),
+                ));
+            };
+            self.settles += 1;
+            self.events += 1;
+            let event = EventRecord {
+                seq: self.events,
+                t: t.value(),
+                guard: SETTLE,
+                mode_before: model.mode_name(),
+                mode_after: model.mode_name(),
+                energy_before: None,
+                energy_after: None,
+                names_before: &[],
+                before: &[],
+                names_after: &[],
+                after: &[],
+                unit: settled.unit,
+                rel_velocity: None,
+            };
+            observer
+                .on_event(&event)
+                .map_err(|e| failed(format!("could not write the event log: {e}")))?;
+            self.zeno_reason = Some(format!("{what}; settled into resting contact"));
+            fired = Fired {
+                affects: fired.affects.start.min(settled.affects.start)
+                    ..fired.affects.end.max(settled.affects.end),
+                ..settled
+            };
         }
         if !fired.affects.contains(&slot) {
             self.predict(model, slot)?;

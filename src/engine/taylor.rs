@@ -69,6 +69,9 @@ const MAX_DEPTH: u32 = 80;
 /// stretch must not cost exponential time.
 const MAX_PIECES: u32 = 4096;
 
+/// Longest series [`Piece::classify_shifted`] re-expands.
+const MAX_SHIFTED: usize = 64;
+
 /// The first `s` in `(a, b]` (`0 <= a <= b`) where `p` crosses zero falling
 /// (from positive to `<= 0`), or `Some(a)` if `p(a) <= 0` and `p` is moving
 /// down through zero at `a` already (its first nonzero derivative there is
@@ -187,7 +190,11 @@ enum Verdict {
 impl Piece<'_> {
     fn search(&self, x0: f64, x1: f64, at0: (f64, f64, f64), depth: u32) -> Option<f64> {
         let end = eval(self.c, x1);
-        match self.classify(x1 - x0, at0, end) {
+        let verdict = match self.classify(x1 - x0, at0, end) {
+            Verdict::Unknown => self.classify_shifted(x0, x1 - x0, end),
+            known => known,
+        };
+        match verdict {
             Verdict::Clear => None,
             Verdict::Root => Some(self.refine((x0, at0.0), (x1, end))),
             Verdict::Unknown => {
@@ -239,6 +246,59 @@ impl Piece<'_> {
         } else {
             Verdict::Unknown
         }
+    }
+
+    /// The same questions answered from the series re-expanded at `x0`
+    /// (O(K^2), so only where the cheap bounds failed): on `[0, w]`,
+    /// `p >= c_0 + sum_k min(0, c_k) h^k`, and `p'` lies between `c_1 +
+    /// sum_k min(0, k c_k) h^(k-1)` and the same with `max`. Unlike a bound
+    /// on the third derivative over the whole interval, these follow a
+    /// polynomial that is flat to many orders at `x0` (a unit shut and at
+    /// rest, its neighbours just starting to move).
+    fn classify_shifted(&self, x0: f64, w: f64, end: f64) -> Verdict {
+        let len = self.c.len();
+        if len > MAX_SHIFTED {
+            return Verdict::Unknown;
+        }
+        let mut c = [0.0; MAX_SHIFTED];
+        c[..len].copy_from_slice(self.c);
+        for k in 0..len {
+            for j in (k..len - 1).rev() {
+                c[j] += x0 * c[j + 1];
+            }
+        }
+        let c = &c[..len];
+        let mut low = c[0];
+        let (mut slope_low, mut slope_high) = (
+            c.get(1).copied().unwrap_or(0.0),
+            c.get(1).copied().unwrap_or(0.0),
+        );
+        let mut power = 1.0;
+        for (k, &ck) in c.iter().enumerate().skip(1) {
+            // power = w^(k-1) here.
+            low += ck.min(0.0) * power * w;
+            if k >= 2 {
+                let term = k as f64 * ck * power;
+                slope_low += term.min(0.0);
+                slope_high += term.max(0.0);
+            }
+            power *= w;
+        }
+        let pad = 1e-12;
+        if slope_low > 0.0 && slope_low.abs() > pad * slope_high.abs() {
+            return Verdict::Clear;
+        }
+        if slope_high < 0.0 {
+            return if c[0] > 0.0 && end <= 0.0 {
+                Verdict::Root
+            } else {
+                Verdict::Clear
+            };
+        }
+        if c[0] > 0.0 && low > pad * c[0] {
+            return Verdict::Clear;
+        }
+        Verdict::Unknown
     }
 
     /// The root of a strictly decreasing `p` on `[lo, hi]` with `p(lo) > 0 >=

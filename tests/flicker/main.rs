@@ -4,6 +4,7 @@ mod bouncing_ball;
 mod chain;
 mod chain_cli;
 mod chain_exact;
+mod chain_invariants;
 mod cli;
 mod compare;
 mod convergence;

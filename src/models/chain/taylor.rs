@@ -38,7 +38,11 @@
 //! recursion gives them the block's acceleration. Its contact force is
 //! least in unit `a`; a `release` guard watches it and frees unit `a` when
 //! it would pull. An impact reaching the block breaks it up, and the end
-//! may come to rest again at once.
+//! may come to rest again at once; units chattering shut at the end faster
+//! than the run can resolve are settled into it when the engine's Zeno
+//! watch asks. Contact forces within round-off of zero count as zero both
+//! ways, so a unit on the edge is neither captured nor released over and
+//! over.
 
 use crate::engine::taylor::{eval, first_fall, integral};
 use crate::engine::{Direction, Fired, Guard, LocalModel};
@@ -319,12 +323,8 @@ impl TaylorChain {
                 hi = hi.max(*touched.end());
                 continue;
             }
-            if r_lo == 1 {
-                // Momentum the wall gave, and the wall force's integral so
-                // far on unit 1's series before it is replaced.
-                self.wall_impulse += self.chain.mass * self.omega * wall;
-                self.wall_integral += integral(&self.gap[s..2 * s], sigma - self.origin[1]);
-            }
+            // Momentum the wall gave (flips of node 1 only).
+            self.wall_impulse += self.chain.mass * self.omega * wall;
             for (k, node) in (r_lo - 1..=r_hi).enumerate().filter(|(_, node)| *node > 0) {
                 self.scratch_vel[(node - w_lo) * s] = v[k];
             }
@@ -339,7 +339,7 @@ impl TaylorChain {
                 self.set_block(None, t);
             }
             if r_hi == n {
-                self.settle_end(r_lo, w_lo, t);
+                self.settle_end(r_lo, w_lo, t, self.shut_below);
             }
             self.store_window(r_lo, r_hi, w_lo, count, sigma);
             return Fired {
@@ -420,6 +420,11 @@ impl TaylorChain {
             ghost,
             block,
         );
+        if r_lo == 1 {
+            // The wall force's integral so far on unit 1's series, before
+            // the series is replaced.
+            self.wall_integral += integral(&self.gap[s..2 * s], sigma - self.origin[1]);
+        }
         let (from, to) = ((r_lo - w_lo) * s, (r_hi - w_lo + 1) * s);
         self.gap[r_lo * s..(r_hi + 1) * s].copy_from_slice(&self.scratch_gap[from..to]);
         self.vel[r_lo * s..(r_hi + 1) * s].copy_from_slice(&self.scratch_vel[from..to]);
@@ -443,10 +448,10 @@ impl TaylorChain {
     /// open by its neighbours' tension. With the block `a..=N`, the contact
     /// force is least in unit `a`, and positive while
     /// `(N - a + 1) Delta_{a-1} < (F_cr - F) / k`.
-    fn settle_end(&mut self, r_lo: usize, w_lo: usize, t: Time) {
+    fn settle_end(&mut self, r_lo: usize, w_lo: usize, t: Time, speeds: f64) -> bool {
         let (n, s) = (self.chain.units, self.stride());
         if self.block.is_some() || self.ghost >= 0.0 {
-            return;
+            return false;
         }
         let gap = |i: usize, g: &[f64]| g[(i - w_lo) * s];
         let node = |i: usize, v: &[f64]| if i == 0 { 0.0 } else { v[(i - w_lo) * s] };
@@ -456,18 +461,22 @@ impl TaylorChain {
             let unit = a - 1;
             let resting = gap(unit, &self.scratch_gap) <= self.shut_below
                 && (node(unit - 1, &self.scratch_vel) - node(unit, &self.scratch_vel)).abs()
-                    <= self.shut_below;
+                    <= speeds;
             if !resting {
                 break;
             }
             a = unit;
         }
-        // Longest block first; if its first unit is not pushed, the rest is.
-        if a >= 2 && a <= n && (n - a + 1) as f64 * gap(a - 1, &self.scratch_gap) > -self.ghost {
+        // Longest block first; if its first unit is clearly pulled (beyond
+        // round-off, the same margin the release keeps), the rest is pushed.
+        if a >= 2
+            && a <= n
+            && (n - a + 1) as f64 * gap(a - 1, &self.scratch_gap) + self.ghost > self.force_noise(a)
+        {
             a += 1;
         }
         if a > n {
-            return;
+            return false;
         }
         // Shut exactly, and one velocity: their mean, which keeps the
         // momentum (the speeds differ by round-off only); at rest against
@@ -485,10 +494,48 @@ impl TaylorChain {
         for i in a..=n {
             self.scratch_gap[(i - w_lo) * s] = 0.0;
         }
+        let mut removed = 0.0;
         for i in nodes.filter(|&i| i > 0) {
-            self.scratch_vel[(i - w_lo) * s] = mean;
+            let v = &mut self.scratch_vel[(i - w_lo) * s];
+            removed += *v - mean;
+            *v = mean;
         }
+        // What the wall took when the block stopped against it.
+        self.wall_impulse -= self.chain.mass * self.omega * removed;
         self.set_block(Some(a), t);
+        true
+    }
+
+    /// Round-off in the contact force of a block from unit `a` (scaled, as
+    /// the gaps): forces within it count as zero, so that a unit whose force
+    /// reads about zero is neither captured nor released over and over.
+    fn force_noise(&self, a: usize) -> f64 {
+        self.shut_below * (self.chain.units - a + 2) as f64
+    }
+
+    /// Units chattering shut at the end faster than the run can resolve
+    /// (the engine's Zeno watch): rest them in the end block, their nodes'
+    /// speeds merged (momentum kept, the tiny kinetic energy of their
+    /// relative motion lost), if the end pushes them shut.
+    fn settle_chatter(&mut self, unit: usize, t: Time) -> Option<Fired> {
+        let n = self.chain.units;
+        let sigma = self.sigma(t);
+        if self.block.is_some_and(|a| unit + 1 < a) || self.block.is_none() && unit + self.reach < n
+        {
+            return None;
+        }
+        self.set_block(None, t);
+        let (r_lo, r_hi) = self.reach_around(unit, n);
+        let (w_lo, count) = self.load_window(r_lo, r_hi, sigma);
+        if !self.settle_end(r_lo, w_lo, t, f64::INFINITY) {
+            return None;
+        }
+        self.store_window(r_lo, r_hi, w_lo, count, sigma);
+        Some(Fired {
+            affects: self.guards_of(r_lo, r_hi),
+            unit: Some(unit as u64),
+            rel_velocity: None,
+        })
     }
 
     /// Change the end block, keeping the account of the wall's hold.
@@ -530,7 +577,8 @@ impl LocalModel for TaylorChain {
             for (f, d) in force.iter_mut().zip(&self.gap[(a - 1) * s..a * s]) {
                 *f = -scale * d;
             }
-            force[0] -= self.ghost;
+            // Released once the force is clearly below zero.
+            force[0] -= self.ghost - self.force_noise(a);
             return self.first_root(a - 1, &force[..s], now);
         }
         if self.block.is_some_and(|a| guard + 1 >= a) {
@@ -554,6 +602,12 @@ impl LocalModel for TaylorChain {
             return Ok(self.release(t));
         }
         Ok(self.impact(guard + 1, t))
+    }
+
+    fn settle(&mut self, guard: usize, t: Time) -> Option<Fired> {
+        (guard < self.chain.units)
+            .then(|| self.settle_chatter(guard + 1, t))
+            .flatten()
     }
 
     fn energy(&self, t: Time) -> Option<f64> {
