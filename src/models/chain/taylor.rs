@@ -369,8 +369,9 @@ impl TaylorChain {
     }
 
     /// Units `lo - D ..= hi + D`, and the whole end block with the node on
-    /// its left if that comes within reach (a rigid block passes a change
-    /// on at once).
+    /// its left if the window their series draw on (the spread beyond) comes
+    /// to it: a rigid block passes a change on at once, and the free
+    /// recursion must not be run across it.
     fn reach_around(&self, lo: usize, hi: usize) -> (usize, usize) {
         let n = self.chain.units;
         let (r_lo, r_hi) = (
@@ -378,7 +379,7 @@ impl TaylorChain {
             (hi + self.reach).min(n),
         );
         match self.block {
-            Some(a) if r_hi + 1 >= a => (r_lo.min(a.saturating_sub(1).max(1)), n),
+            Some(a) if r_hi + self.spread + 1 >= a => (r_lo.min(a.saturating_sub(1).max(1)), n),
             _ => (r_lo, r_hi),
         }
     }
