@@ -44,7 +44,7 @@ fn median_of(repeats: usize, mut f: impl FnMut() -> u64) -> (f64, u64) {
 
 fn released(units: usize) -> (Chain, TaylorChain) {
     let chain = Chain::in_scene_units(units, 2.0, 1.0, 0.0, true);
-    let gap = 0.1 * chain.critical_load / chain.stiffness;
+    let gap = 0.1 * chain.unit_length();
     let model = TaylorChain::new(chain.clone(), &vec![gap; units], &vec![0.0; units]).unwrap();
     (chain, model)
 }
@@ -53,7 +53,7 @@ fn released(units: usize) -> (Chain, TaylorChain) {
 /// +-0.05: impacts all along the chain from the start.
 fn rattling(units: usize) -> TaylorChain {
     let chain = Chain::in_scene_units(units, 2.0, 1.0, 1.0, true);
-    let gap = 0.05 * chain.critical_load / chain.stiffness;
+    let gap = 0.05 * chain.unit_length();
     let v: Vec<f64> = (0..units)
         .map(|i| if i % 2 == 0 { 0.05 } else { -0.05 })
         .collect();

@@ -17,7 +17,7 @@ fn main() {
         // Scene units: length 2, wave speed 1; every unit at strain 0.1 under
         // F = 1.1 F_cr, released at t = 0 to F = after * F_cr.
         let chain = Chain::in_scene_units(units, 2.0, 1.0, after, true);
-        let unit_length = chain.critical_load / chain.stiffness;
+        let unit_length = chain.unit_length();
         let gaps = vec![0.1 * unit_length; units];
         let mut model = TaylorChain::new(chain.clone(), &gaps, &vec![0.0; units])
             .expect("a valid initial state");

@@ -137,7 +137,7 @@ impl<'s> Sampler<'s> {
             let n = c.units as f64;
             let cell = self.scene.length / n;
             // Unit length 2l = F_cr / k: strain = Delta / 2l.
-            let unit_length = c.critical_load / c.stiffness;
+            let unit_length = c.unit_length();
             self.profiles.push(Profile {
                 t,
                 x: (0..c.units)
@@ -156,22 +156,14 @@ pub(super) fn run(
     control: &Control,
     observer: &mut dyn Observer,
 ) -> Result<Report, SceneError> {
-    let chain = Chain::in_scene_units(
-        scene.units,
-        scene.length,
-        scene.wave_speed,
-        scene.load_after,
-        scene.constraint,
+    let chain = scene.chain(scene.constraint);
+    let options = control.options(
+        scene.t_end,
+        scene.max_events,
+        scene.method,
+        scene.tolerances,
     );
-    let options = Options {
-        t_end: scene.t_end,
-        max_events: scene.max_events,
-        method: scene.method,
-        tolerances: scene.tolerances,
-        stop: control.stop.clone(),
-        max_wall_seconds: control.max_wall_seconds,
-    };
-    let unit_length = chain.critical_load / chain.stiffness;
+    let unit_length = chain.unit_length();
     let gaps: Vec<f64> = scene.strain.iter().map(|e| e * unit_length).collect();
     let mut report = match scene.method {
         Method::Auto | Method::Exact => run_exact(scene, &chain, &gaps, &options, observer)?,
@@ -181,13 +173,7 @@ pub(super) fn run(
         && scene.units <= CLASSICAL_MAX_UNITS
         && report.outcome.status == Status::Completed
     {
-        let classical = Chain::in_scene_units(
-            scene.units,
-            scene.length,
-            scene.wave_speed,
-            scene.load_after,
-            false,
-        );
+        let classical = scene.chain(false);
         let mut model = TaylorChain::new(classical.clone(), &gaps, &scene.velocity)
             .map_err(|why| SceneError::field("initial", why))?;
         let mut sampler = Sampler::new(scene, &classical);

@@ -14,7 +14,7 @@ use rand::{RngExt, SeedableRng};
 use rand_xorshift::XorShiftRng;
 use rayon::prelude::*;
 
-use crate::engine::{Options, Status, simulate_local};
+use crate::engine::{Method, Options, Status, Tolerances, simulate_local};
 use crate::models::chain::coarse::Coarse;
 use crate::models::chain::{Chain, TaylorChain};
 use crate::runner::Control;
@@ -107,20 +107,13 @@ pub fn run_ensemble(
 ) -> Result<Ensemble, String> {
     check(scene, copies, perturb).map_err(|e| e.reason)?;
     let times = scene.sample_times();
-    let chain = Chain::in_scene_units(
-        scene.units,
-        scene.length,
-        scene.wave_speed,
-        scene.load_after,
-        scene.constraint,
+    let chain = scene.chain(scene.constraint);
+    let options = control.options(
+        scene.t_end,
+        scene.max_events,
+        Method::Exact,
+        Tolerances::default(),
     );
-    let options = Options {
-        t_end: scene.t_end,
-        max_events: scene.max_events,
-        stop: control.stop.clone(),
-        max_wall_seconds: control.max_wall_seconds,
-        ..Options::until(scene.t_end)
-    };
     let runs: Vec<Result<Vec<Sample>, String>> = (0..copies)
         .into_par_iter()
         .map(|copy| run_copy(scene, &chain, &options, &times, perturb, seed, copy))
@@ -153,7 +146,7 @@ fn run_copy(
 ) -> Result<Vec<Sample>, String> {
     let mut rng =
         XorShiftRng::seed_from_u64(seed ^ (copy as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15));
-    let unit_length = chain.critical_load / chain.stiffness;
+    let unit_length = chain.unit_length();
     // Relative to the scene's strain scale, so that units starting shut are
     // perturbed too.
     let scale = scene.strain.iter().fold(0.0, |m: f64, e| m.max(e.abs()));

@@ -1,6 +1,6 @@
 //! Running a mechanism scene in the formulation and method it asks for.
 
-use crate::engine::{Method, Observer, Options, simulate};
+use crate::engine::{Method, Observer, simulate};
 use crate::models::mechanism::strain::FLIGHT;
 use crate::models::mechanism::{AngleMechanism, Charts, StrainMechanism};
 use crate::runner::{Control, Report};
@@ -11,14 +11,12 @@ pub(super) fn run(
     control: &Control,
     observer: &mut dyn Observer,
 ) -> Result<Report, SceneError> {
-    let options = Options {
-        t_end: scene.t_end,
-        max_events: scene.max_events,
-        method: scene.method,
-        tolerances: scene.tolerances,
-        stop: control.stop.clone(),
-        max_wall_seconds: control.max_wall_seconds,
-    };
+    let options = control.options(
+        scene.t_end,
+        scene.max_events,
+        scene.method,
+        scene.tolerances,
+    );
     let (eps, rate) = scene.initial_strain;
     let strain_names = ["strain", "strain_rate"];
     match scene.formulation {

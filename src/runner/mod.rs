@@ -8,7 +8,7 @@ mod mechanism;
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
-use crate::engine::{Observer, Outcome};
+use crate::engine::{Method, Observer, Options, Outcome, Tolerances};
 use crate::scene::{Scene, SceneError};
 
 pub use chain::{CLASSICAL_MAX_UNITS, ChainOutputs, Classical, Profile, TraceRow};
@@ -34,6 +34,26 @@ pub struct Control {
     pub stop: Option<Arc<AtomicBool>>,
     /// Fails the run after this much wall time.
     pub max_wall_seconds: Option<f64>,
+}
+
+impl Control {
+    /// The engine's options for a scene's run under this control.
+    pub fn options(
+        &self,
+        t_end: f64,
+        max_events: u64,
+        method: Method,
+        tolerances: Tolerances,
+    ) -> Options {
+        Options {
+            t_end,
+            max_events,
+            method,
+            tolerances,
+            stop: self.stop.clone(),
+            max_wall_seconds: self.max_wall_seconds,
+        }
+    }
 }
 
 /// Run `scene` under `control`.

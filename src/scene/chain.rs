@@ -27,6 +27,7 @@
 use serde_json::Value;
 
 use crate::engine::{Method, Tolerances};
+use crate::models::chain::Chain;
 use crate::scene::SceneError;
 use crate::scene::fields::{Fields, kind};
 use crate::scene::solver::SolverSpec;
@@ -64,6 +65,18 @@ pub struct ChainScene {
 }
 
 impl ChainScene {
+    /// The scene's chain (PHYSICS.md s.4 scene units, the load after the
+    /// release), with the constraint on or off.
+    pub fn chain(&self, constraint: bool) -> Chain {
+        Chain::in_scene_units(
+            self.units,
+            self.length,
+            self.wave_speed,
+            self.load_after,
+            constraint,
+        )
+    }
+
     /// The times `trace.csv` samples: `linspace(0, t_end, samples)`.
     pub fn sample_times(&self) -> Vec<f64> {
         match self.samples {

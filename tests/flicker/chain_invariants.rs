@@ -17,7 +17,7 @@ fn chain() -> impl Strategy<Value = (Chain, Vec<f64>, Vec<f64>)> {
         let speed = prop::collection::vec(prop_oneof![Just(0.0), -0.3f64..0.3], units);
         (strain, speed).prop_map(move |(strain, speed)| {
             let chain = Chain::in_scene_units(units, 2.0, wave, load, true);
-            let unit = chain.critical_load / chain.stiffness;
+            let unit = chain.unit_length();
             let gaps = strain.iter().map(|e| e * unit).collect();
             let v = speed.iter().map(|s| s * wave).collect();
             (chain, gaps, v)
@@ -70,7 +70,7 @@ proptest! {
         // |F - F_cr| t, or 1 if that is smaller.
         let scale = ((chain.load - chain.critical_load) * 2.0).abs().max(1.0);
         prop_assert!(balance < 1e-12 * scale, "momentum balance {balance:e} (scale {scale})");
-        let unit = chain.critical_load / chain.stiffness;
+        let unit = chain.unit_length();
         prop_assert!(lowest > -1e-13 * unit, "a gap at {lowest:e}");
         prop_assert!(log.events.windows(2).all(|w| w[0].t <= w[1].t));
         prop_assert_eq!(model.guards().len(), chain.units + 2);

@@ -39,7 +39,7 @@ impl Coarse {
     pub fn of(chain: &Chain, length: f64, gaps: &[f64], velocities: &[f64]) -> Self {
         let n = chain.units;
         let cell = length / n as f64;
-        let unit_length = chain.critical_load / chain.stiffness;
+        let unit_length = chain.unit_length();
         let half = ((0.5 * WINDOW_WIDTH / cell).round() as usize).max(1);
         let mut coarse = Coarse {
             x: Vec::with_capacity(n + 1),
@@ -60,20 +60,18 @@ impl Coarse {
             // The window's mass: its inner nodes whole, the two at its ends
             // (nodes lo and hi + 1, 1-based) half each; the wall's node is
             // at rest.
-            let node_velocity = |j: usize| if j == 0 { 0.0 } else { velocities[j - 1] };
-            let weighted: Vec<(f64, f64)> = (lo..=hi + 1)
-                .map(|j| {
+            let weighted = || {
+                (lo..=hi + 1).map(|j| {
                     let w = if j == lo || j == hi + 1 { 0.5 } else { 1.0 };
-                    (w, node_velocity(j))
+                    (w, if j == 0 { 0.0 } else { velocities[j - 1] })
                 })
-                .collect();
-            let mean_velocity = weighted.iter().map(|(w, v)| w * v).sum::<f64>() / count;
+            };
+            let mean_velocity = weighted().map(|(w, v)| w * v).sum::<f64>() / count;
             let elastic: f64 = d
                 .iter()
                 .map(|d| 0.5 * chain.stiffness * (d - mean_gap).powi(2))
                 .sum();
-            let kinetic: f64 = weighted
-                .iter()
+            let kinetic: f64 = weighted()
                 .map(|(w, v)| 0.5 * chain.mass * w * (v - mean_velocity).powi(2))
                 .sum();
             let rattle = elastic + kinetic;
@@ -102,7 +100,7 @@ mod tests {
     #[test]
     fn a_uniform_chain_has_its_own_strain_and_no_hidden_energy() {
         let chain = Chain::in_scene_units(40, 2.0, 1.0, 0.0, true);
-        let unit = chain.critical_load / chain.stiffness;
+        let unit = chain.unit_length();
         let c = Coarse::of(&chain, 2.0, &vec![0.1 * unit; 40], &vec![0.3; 40]);
         assert!(c.strain.iter().all(|e| (e - 0.1).abs() < 1e-15));
         // Windows clear of the wall (whose node is at rest): h = 1 here.
@@ -119,7 +117,7 @@ mod tests {
         // with node velocities -+0.2: mean strain 0.05, behind the front.
         let n = 40;
         let chain = Chain::in_scene_units(n, 2.0, 1.0, 0.0, true);
-        let unit = chain.critical_load / chain.stiffness;
+        let unit = chain.unit_length();
         let gaps: Vec<f64> = (0..n)
             .map(|i| {
                 if i < 20 || i % 2 == 0 {

@@ -98,11 +98,17 @@ impl Chain {
     /// static deformation (Cauchy-Born) a release starts from. The unit
     /// length `2 l` is `critical_load / stiffness` (PHYSICS.md s.4).
     pub fn homogeneous(&self, strain: f64) -> Vec<f64> {
-        let delta = strain * self.critical_load / self.stiffness;
+        let delta = strain * self.unit_length();
         let positions = (1..=self.units).map(|n| delta * n as f64);
         positions
             .chain(std::iter::repeat_n(0.0, self.units))
             .collect()
+    }
+
+    /// The closed length `2 l = F_cr / k` of a unit: a unit's elongation
+    /// over it is its strain.
+    pub fn unit_length(&self) -> f64 {
+        self.critical_load / self.stiffness
     }
 
     /// Elongation of unit `n` (1-based) in state `x`.

@@ -87,6 +87,10 @@ pub struct TaylorChain {
     shut_below: f64,
     scratch_gap: Vec<f64>,
     scratch_vel: Vec<f64>,
+    /// The cascade's view of an impact's reach: which units are shut, and
+    /// the node velocities (kept to spare an allocation per impact).
+    scratch_shut: Vec<bool>,
+    scratch_nodes: Vec<f64>,
     /// `integral of Delta_1 d sigma` over finished series of unit 1, and
     /// the impulses the wall gave: the wall's side of the momentum balance.
     wall_integral: f64,
@@ -175,6 +179,8 @@ impl TaylorChain {
             shut_below: 16.0 * f64::EPSILON * scale,
             scratch_gap: Vec::new(),
             scratch_vel: Vec::new(),
+            scratch_shut: Vec::new(),
+            scratch_nodes: Vec::new(),
             wall_integral: 0.0,
             wall_impulse: 0.0,
             momentum_initial: chain.mass * velocities.iter().sum::<f64>(),
@@ -304,19 +310,24 @@ impl TaylorChain {
             let u_at = |node: usize, v: &[f64]| if node == 0 { 0.0 } else { v[(node - w_lo) * s] };
             let rel_velocity =
                 self.omega * (u_at(unit - 1, &self.scratch_vel) - u_at(unit, &self.scratch_vel));
-            let shut: Vec<bool> = (r_lo..=r_hi)
-                .map(|i| i == unit || self.scratch_gap[(i - w_lo) * s] <= self.shut_below)
-                .collect();
-            let mut v: Vec<f64> = (r_lo - 1..=r_hi)
-                .map(|i| u_at(i, &self.scratch_vel))
-                .collect();
+            let mut shut = std::mem::take(&mut self.scratch_shut);
+            shut.clear();
+            shut.extend(
+                (r_lo..=r_hi)
+                    .map(|i| i == unit || self.scratch_gap[(i - w_lo) * s] <= self.shut_below),
+            );
+            let mut v = std::mem::take(&mut self.scratch_nodes);
+            v.clear();
+            v.extend((r_lo - 1..=r_hi).map(|i| u_at(i, &self.scratch_vel)));
             // Not closing after all (a graze within round-off, or a unit
             // coming to rest shut) changes no velocity, but the unit is
             // still re-expanded from here with its gap clamped to zero, so
             // that its series agrees with the state it was found in.
             let (touched, wall) = cascade(r_lo, &shut, &mut v);
+            self.scratch_shut = shut;
             let touched = touched.unwrap_or(unit..=unit);
             if *touched.start() < lo || *touched.end() > hi {
+                self.scratch_nodes = v;
                 // A packed block passed the impact on: widen the reach and
                 // start again from the state before it.
                 lo = lo.min(*touched.start());
@@ -328,6 +339,7 @@ impl TaylorChain {
             for (k, node) in (r_lo - 1..=r_hi).enumerate().filter(|(_, node)| *node > 0) {
                 self.scratch_vel[(node - w_lo) * s] = v[k];
             }
+            self.scratch_nodes = v;
             for i in touched.clone().chain(std::iter::once(unit)) {
                 let g = &mut self.scratch_gap[(i - w_lo) * s];
                 // Shut means zero: drop the round-off overlap.
