@@ -15,31 +15,19 @@
 //! - at N = 50, the exact path against Dormand-Prince (rtol 1e-12) on the
 //!   chain as an ODE, to t = 3: cost ratio in the same run.
 
-use std::hint::black_box;
-use std::time::Instant;
-
 use flicker::engine::{Method, Options, Tolerances, simulate, simulate_local};
 use flicker::models::chain::{Chain, TaylorChain};
 use flicker::plot::draw::{Curve, Figure, Style};
+
+mod timing;
+
+use timing::median_of;
 
 const REPEATS: usize = 5;
 
 /// Median wall time of `REPEATS` runs of `f`, which returns the impacts.
 fn median_seconds(f: impl FnMut() -> u64) -> (f64, u64) {
     median_of(REPEATS, f)
-}
-
-/// Median wall time of `repeats` runs of `f`.
-fn median_of(repeats: usize, mut f: impl FnMut() -> u64) -> (f64, u64) {
-    let mut times = Vec::new();
-    let mut impacts = 0;
-    for _ in 0..repeats {
-        let start = Instant::now();
-        impacts = black_box(f());
-        times.push(start.elapsed().as_secs_f64());
-    }
-    times.sort_by(f64::total_cmp);
-    (times[repeats / 2], impacts)
 }
 
 fn released(units: usize) -> (Chain, TaylorChain) {

@@ -22,19 +22,15 @@ use flicker::models::mechanism::angle::STRAIN_POSITIVE;
 use flicker::models::mechanism::strain::FLIGHT;
 use flicker::models::mechanism::{AngleMechanism, Charts, ExactOrbit, Mechanism, StrainMechanism};
 
+mod timing;
+
+use timing::median_of;
+
 const REPEATS: usize = 7;
 
 /// Median wall time of `REPEATS` runs of `f`, which returns the impacts it made.
-fn median_seconds(mut f: impl FnMut() -> u64) -> (f64, u64) {
-    let mut times = Vec::new();
-    let mut impacts = 0;
-    for _ in 0..REPEATS {
-        let start = Instant::now();
-        impacts = black_box(f());
-        times.push(start.elapsed().as_secs_f64());
-    }
-    times.sort_by(f64::total_cmp);
-    (times[REPEATS / 2], impacts)
+fn median_seconds(f: impl FnMut() -> u64) -> (f64, u64) {
+    median_of(REPEATS, f)
 }
 
 /// The same closed-form arithmetic as the strain model, with no queue, no
