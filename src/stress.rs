@@ -94,7 +94,7 @@ pub fn settings(scene: &Scene) -> Vec<SolverSpec> {
             ]
         }
         Scene::Mechanism(_) => vec![spec("dopri5", Some(TOLERANCE), None)],
-        Scene::Chain(_) => Vec::new(),
+        Scene::Chain(_) | Scene::Continuum(_) => Vec::new(),
     }
 }
 

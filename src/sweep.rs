@@ -324,7 +324,7 @@ impl Sweep {
                 let impacts = ExactOrbit::new(m.mechanism, eps, rate).impacts_until(m.t_end);
                 (h0 > 0.0 && impacts > 0).then(|| m.mechanism.impact_period(h0))
             }
-            Scene::Chain(_) => None,
+            Scene::Chain(_) | Scene::Continuum(_) => None,
         };
         let status = match (o.status, &o.reason) {
             (Status::Completed, _) | (_, None) => o.status.as_str().to_string(),

@@ -56,6 +56,29 @@ pub fn check(path: &Path) -> Result<Code, Failure> {
                 c.samples
             );
         }
+        Scene::Continuum(c) => {
+            say!(
+                "{}: a valid continuum scene ({} variant, {} initial cells, exact front tracking)",
+                path.display(),
+                c.variant.name(),
+                c.cells.len()
+            );
+            say!(
+                "  length {}, wave speed {}, load {} -> {} (F / F_cr), constraint {}, t_end {}",
+                c.length,
+                c.wave_speed,
+                c.load_before,
+                c.load_after,
+                if c.constraint { "on" } else { "off" },
+                c.t_end
+            );
+            say!(
+                "  {} snapshots of {} points, {} trace samples",
+                c.snapshots.len(),
+                c.resolution,
+                c.samples
+            );
+        }
     }
     Ok(Code::Ok)
 }

@@ -85,6 +85,7 @@ fn applicable(scene: &Scene) -> Vec<String> {
         }
         Scene::Mechanism(_) => &["dopri5"],
         Scene::Chain(_) => &["exact", "linear", "dopri5", "verlet"],
+        Scene::Continuum(_) => &["exact"],
     };
     names.iter().map(|s| s.to_string()).collect()
 }

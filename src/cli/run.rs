@@ -9,7 +9,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use flicker::engine::{Method, Status};
 use flicker::log::JsonlWriter;
-use flicker::log::chain_files;
+use flicker::log::field_files;
 use flicker::log::summary::{summary, write_atomically};
 use flicker::runner::ensemble::{check as check_ensemble, run_ensemble};
 use flicker::runner::{Control, Report, run as run_scene};
@@ -178,11 +178,11 @@ pub fn run(args: RunArgs) -> Result<Code, Failure> {
 
     let log = log_events.then_some(log_path.as_path());
     let mut written = Vec::new();
-    if let Some(chain) = &report.chain {
+    if let Some(chain) = &report.fields {
         let profiles = out.join("profiles.json");
         let trace = out.join("trace.csv");
-        write_atomically(&profiles, &chain_files::profiles(chain))
-            .and_then(|()| chain_files::write_trace(chain, &trace))
+        write_atomically(&profiles, &field_files::profiles(chain))
+            .and_then(|()| field_files::write_trace(chain, &trace))
             .map_err(|e| {
                 Failure::untrusted(format!("{}: cannot be written: {e}", out.display()))
             })?;
@@ -198,14 +198,14 @@ pub fn run(args: RunArgs) -> Result<Code, Failure> {
         let path = out.join("ensemble.csv");
         let found = run_ensemble(chain, copies, ensemble.perturb, ensemble.seed, &control)
             .and_then(|found| {
-                chain_files::write_ensemble(&found, &path)
+                field_files::write_ensemble(&found, &path)
                     .map(|()| found)
                     .map_err(|e| format!("{}: cannot be written: {e}", path.display()))
             });
         match found {
             Ok(found) => {
                 written.push(path);
-                summary["ensemble"] = chain_files::ensemble_summary(&found);
+                summary["ensemble"] = field_files::ensemble_summary(&found);
                 horizon = Some(found);
             }
             Err(why) => {
@@ -276,6 +276,7 @@ fn model_name(scene: &Scene) -> &'static str {
     match scene {
         Scene::Mechanism(_) => "mechanism",
         Scene::Chain(_) => "chain",
+        Scene::Continuum(_) => "continuum",
     }
 }
 
@@ -318,7 +319,11 @@ fn print_report(
         .map(|(n, x)| format!("{n} = {x:e}"))
         .collect();
     say!("  final state: {}", state.join(", "));
-    if let Some(err) = report.chain.as_ref().and_then(|c| c.momentum_balance_error) {
+    if let Some(err) = report
+        .fields
+        .as_ref()
+        .and_then(|c| c.momentum_balance_error)
+    {
         say!("  momentum against the end load's and the wall's impulses: relative error {err:.2e}");
     }
     let files: Vec<String> = std::iter::once(summary)

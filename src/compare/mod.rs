@@ -118,6 +118,7 @@ fn scene_period(scene: &Scene) -> f64 {
     match scene {
         Scene::Mechanism(m) => std::f64::consts::TAU / m.mechanism.omega,
         Scene::Chain(c) => c.length / c.wave_speed,
+        Scene::Continuum(c) => c.length / c.wave_speed,
     }
 }
 

@@ -55,6 +55,12 @@ impl Reference {
                  (its exact and ODE paths are checked against each other in tests/flicker/chain_exact.rs)"
                     .into(),
             )),
+            Scene::Continuum(_) => Err(SceneError::field(
+                "model",
+                "method comparisons measure numerical methods against a closed form; a continuum runs by \
+                 exact front tracking only (`flicker compare-models` compares it with the chain)"
+                    .into(),
+            )),
         }
     }
 }

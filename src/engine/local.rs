@@ -78,6 +78,8 @@ pub struct Fired {
     pub unit: Option<u64>,
     /// The closing speed just before an impact, for the log.
     pub rel_velocity: Option<f64>,
+    /// Where along the model (a continuum's position) it happened, for the log.
+    pub x: Option<f64>,
 }
 
 /// Run `model` from `t = 0` to `options.t_end`, calling `on_sample` with the
@@ -282,6 +284,7 @@ impl LocalRun<'_> {
                 after: &[],
                 unit: fired.unit,
                 rel_velocity: fired.rel_velocity,
+                x: fired.x,
             };
             observer
                 .on_event(&event)
@@ -326,6 +329,7 @@ impl LocalRun<'_> {
                 after: &[],
                 unit: settled.unit,
                 rel_velocity: None,
+                x: settled.x,
             };
             observer
                 .on_event(&event)

@@ -24,6 +24,9 @@ pub struct EventRecord<'a> {
     pub unit: Option<u64>,
     /// The closing speed just before an impact, if the model says.
     pub rel_velocity: Option<f64>,
+    /// Where along a model with extent (a continuum) the event happened,
+    /// if the model says.
+    pub x: Option<f64>,
 }
 
 /// Receives events as they happen. An error stops the run (status `failed`).
@@ -81,6 +84,7 @@ pub struct RecordedEvent {
     pub after: Vec<f64>,
     pub unit: Option<u64>,
     pub rel_velocity: Option<f64>,
+    pub x: Option<f64>,
 }
 
 /// Keeps every event in memory.
@@ -100,6 +104,7 @@ impl Observer for Recorder {
             after: e.after.to_vec(),
             unit: e.unit,
             rel_velocity: e.rel_velocity,
+            x: e.x,
         });
         Ok(())
     }

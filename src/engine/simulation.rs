@@ -450,6 +450,7 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
             after: &self.after,
             unit,
             rel_velocity,
+            x: None,
         };
         observer
             .on_event(&event)

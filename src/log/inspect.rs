@@ -142,6 +142,7 @@ mod tests {
             energy_before: Some(1.0),
             energy_after: Some(1.0 + jump),
             unit: None,
+            x: None,
         }
     }
 

@@ -15,9 +15,10 @@
 //! | `energy_before`, `energy_after` | the model's energy on either side (`null` if it has none) |
 //! | `before`, `after` | the state on either side, as an object of named components (empty for a chain, whose state is too large) |
 //! | `unit` | chains only: the unit that closed (1 = next to the wall); with `rel_velocity` 0 it came to rest shut (resting contact); a `release` line names the unit pulled open from rest |
-//! | `rel_velocity` | chains only: `y'_{n-1} - y'_n` just before the impact (`-y'_1` for unit 1), positive when closing |
+//! | `rel_velocity` | chains: `y'_{n-1} - y'_n` just before the impact (`-y'_1` for unit 1), positive when closing; continua: the speed at which a shut stretch strikes the wall |
+//! | `x` | continua only: where the event happened (the wall at `-length / 2`, the loaded end at `+length / 2`) |
 //!
-//! A chain run also writes `profiles.json` and `trace.csv` ([`chain_files`]).
+//! A chain or continuum run also writes `profiles.json` and `trace.csv` ([`field_files`]).
 //!
 //! ```json
 //! {"seq":1,"t":2.2142,"guard":"impact","mode_before":"flight","mode_after":"flight","energy_before":0.025,"energy_after":0.025,"before":{"strain":0.0,"strain_rate":-0.2236},"after":{"strain":0.0,"strain_rate":0.2236}}
@@ -29,7 +30,7 @@
 //! `t_reached`, `energy_initial`, `energy_final`, `max_energy_error`,
 //! `final_state`, `zeno`, `method` and `wall_seconds`; see [`summary`].
 
-pub mod chain_files;
+pub mod field_files;
 pub mod inspect;
 pub mod reader;
 pub mod summary;

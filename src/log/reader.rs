@@ -18,6 +18,9 @@ pub struct LoggedEvent {
     /// A chain's unit.
     #[serde(default)]
     pub unit: Option<u64>,
+    /// Where along a continuum.
+    #[serde(default)]
+    pub x: Option<f64>,
 }
 
 /// A log that could not be read: which file, which line, why.

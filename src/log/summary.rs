@@ -46,8 +46,8 @@ pub fn summary(report: &Report, model: &str, scene: &Path, log: Option<&Path>) -
         "error_bound": o.error_bound,
         "wall_seconds": o.wall_seconds,
         "log": log.map(|p| p.display().to_string()),
-        "momentum": report.chain.as_ref().map(|c| c.momentum),
-        "momentum_balance_error": report.chain.as_ref().and_then(|c| c.momentum_balance_error),
+        "momentum": report.fields.as_ref().map(|c| c.momentum),
+        "momentum_balance_error": report.fields.as_ref().and_then(|c| c.momentum_balance_error),
     })
 }
 

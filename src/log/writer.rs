@@ -108,6 +108,10 @@ impl<W: Write> Observer for JsonlWriter<W> {
             self.buffer.extend_from_slice(b",\"rel_velocity\":");
             self.number(v);
         }
+        if let Some(x) = e.x {
+            self.buffer.extend_from_slice(b",\"x\":");
+            self.number(x);
+        }
         self.buffer.extend_from_slice(b"}\n");
         if self.buffer.len() >= CHUNK {
             self.out.write_all(&self.buffer)?;
@@ -187,6 +191,7 @@ mod tests {
             after: &[0.0, f64::NAN],
             unit: Some(7),
             rel_velocity: Some(0.5),
+            x: Some(-0.25),
         };
         w.on_event(&event).unwrap();
         w.flush().unwrap();
@@ -201,6 +206,7 @@ mod tests {
         assert_eq!(v["before"]["strain_rate"], -1e-300);
         assert!(v["after"]["strain_rate"].is_null());
         assert_eq!(v["unit"], 7);
+        assert_eq!(v["x"], -0.25);
         assert_eq!(v["rel_velocity"], 0.5);
     }
 }

@@ -1,9 +1,10 @@
 //! Pictures: phase portraits of the mechanism ([`phase`]) and what a run
-//! wrote ([`run`], with a chain's own in [`chain`]), drawn with a bundled font ([`draw`]), so a machine
-//! without system fonts draws text.
+//! wrote ([`run`], with a chain's or a continuum's own in [`fields`]), drawn
+//! with a bundled font ([`draw`]), so a machine without system fonts draws
+//! text.
 
-pub mod chain;
 pub mod draw;
+pub mod fields;
 pub mod phase;
 pub mod run;
 

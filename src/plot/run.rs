@@ -46,7 +46,7 @@ pub fn plot_run(dir: &Path) -> Result<Vec<PathBuf>, String> {
                 continue;
             }
             // A long log is thinned evenly to a picture's worth of points.
-            let stride = points.len().div_ceil(crate::plot::chain::MAX_POINTS);
+            let stride = points.len().div_ceil(crate::plot::fields::MAX_POINTS);
             let points: Vec<(f64, f64)> = points.into_iter().step_by(stride).collect();
             let figure = Figure {
                 title: title.into(),
@@ -76,7 +76,7 @@ pub fn plot_run(dir: &Path) -> Result<Vec<PathBuf>, String> {
             written.push(path);
         }
     }
-    written.extend(crate::plot::chain::plot_chain(dir)?);
+    written.extend(crate::plot::fields::plot_fields(dir)?);
     if written.is_empty() {
         return Err(format!(
             "{}: holds neither events.jsonl nor compare.csv",

@@ -7,58 +7,11 @@ use crate::engine::{
     simulate_local,
 };
 use crate::models::chain::{Chain, TaylorChain};
-use crate::runner::{Control, Report};
+use crate::runner::{
+    CLASSICAL_MAX_UNITS, Classical, Control, FieldOutputs, Profile, Report, TraceRow,
+};
 use crate::scene::{ChainScene, SceneError};
 use crate::time::Time;
-
-/// What a chain run reports besides the engine's outcome.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ChainOutputs {
-    /// Total momentum `sum m v` at the end.
-    pub momentum: f64,
-    /// `|P - P_impulses| / max(|P|, |F - F_cr| t, m c)` at the end, with
-    /// `P_impulses` the momentum the end load and the wall gave (exact path).
-    pub momentum_balance_error: Option<f64>,
-    /// `y_N` at the end.
-    pub right_end: f64,
-    pub profiles: Vec<Profile>,
-    pub trace: Vec<TraceRow>,
-    /// The classical chain (same scene, constraint off) at the same times,
-    /// for the pictures; for constrained chains of up to
-    /// [`CLASSICAL_MAX_UNITS`] units.
-    pub classical: Option<Classical>,
-}
-
-/// The classical chain's profiles and trace.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Classical {
-    pub profiles: Vec<Profile>,
-    pub trace: Vec<TraceRow>,
-}
-
-/// Largest chain the classical companion is computed for: it costs about
-/// as much as the impacting run's flow without its impacts.
-pub const CLASSICAL_MAX_UNITS: usize = 2000;
-
-/// The chain at one time: entry `n` is unit `n + 1` (its centre `x`, its
-/// strain) and node `n + 1` (its displacement and velocity).
-#[derive(Debug, Clone, PartialEq)]
-pub struct Profile {
-    pub t: f64,
-    pub x: Vec<f64>,
-    pub strain: Vec<f64>,
-    pub displacement: Vec<f64>,
-    pub velocity: Vec<f64>,
-}
-
-/// One row of `trace.csv`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct TraceRow {
-    pub t: f64,
-    pub energy: f64,
-    pub momentum: f64,
-    pub right_end: f64,
-}
 
 /// The chain's state at one time, in gaps and velocities.
 struct State {
@@ -186,7 +139,7 @@ pub(super) fn run(
             &mut (),
         );
         // A companion cut short (interrupted) is left out, not shown half.
-        if let Some(outputs) = report.chain.as_mut()
+        if let Some(outputs) = report.fields.as_mut()
             && companion.status == Status::Completed
         {
             outputs.classical = Some(Classical {
@@ -236,7 +189,7 @@ fn run_exact(
         outcome,
         "exact",
         description,
-        ChainOutputs {
+        FieldOutputs {
             momentum,
             momentum_balance_error: Some((momentum - expected).abs() / scale),
             right_end,
@@ -333,7 +286,7 @@ fn run_ode(
         outcome,
         name,
         description,
-        ChainOutputs {
+        FieldOutputs {
             momentum: chain.momentum(&x),
             momentum_balance_error: None,
             right_end: x[n - 1],
@@ -348,14 +301,17 @@ fn report(
     outcome: Outcome,
     method: &'static str,
     description: String,
-    chain: ChainOutputs,
+    fields: FieldOutputs,
 ) -> Report {
     Report {
         outcome,
         method,
         description,
-        final_state: vec![("momentum", chain.momentum), ("right_end", chain.right_end)],
-        chain: Some(chain),
+        final_state: vec![
+            ("momentum", fields.momentum),
+            ("right_end", fields.right_end),
+        ],
+        fields: Some(fields),
     }
 }
 

@@ -49,7 +49,7 @@ pub(super) fn run(
                 method,
                 description,
                 final_state,
-                chain: None,
+                fields: None,
             })
         }
         Formulation::Angle(charts) => {
@@ -78,7 +78,7 @@ pub(super) fn run(
                 method: "dopri5",
                 description: description.into(),
                 final_state: vec![("strain", e), ("strain_rate", r)],
-                chain: None,
+                fields: None,
             })
         }
     }

@@ -2,7 +2,9 @@
 //! describe the result in the scene's own terms.
 
 mod chain;
+mod continuum;
 pub mod ensemble;
+mod fields;
 mod mechanism;
 
 use std::sync::Arc;
@@ -11,7 +13,7 @@ use std::sync::atomic::AtomicBool;
 use crate::engine::{Method, Observer, Options, Outcome, Tolerances};
 use crate::scene::{Scene, SceneError};
 
-pub use chain::{CLASSICAL_MAX_UNITS, ChainOutputs, Classical, Profile, TraceRow};
+pub use fields::{CLASSICAL_MAX_UNITS, Classical, FieldOutputs, Profile, TraceRow};
 
 /// A finished run and what the summary needs to say about it.
 #[derive(Debug, Clone)]
@@ -23,8 +25,8 @@ pub struct Report {
     pub description: String,
     /// The final state in the scene's physical variables.
     pub final_state: Vec<(&'static str, f64)>,
-    /// What a chain run adds: momentum, profiles, the trace.
-    pub chain: Option<ChainOutputs>,
+    /// What a model with extent adds: momentum, profiles, the trace.
+    pub fields: Option<FieldOutputs>,
 }
 
 /// What may stop a run from outside the scene.
@@ -65,5 +67,6 @@ pub fn run(
     match scene {
         Scene::Mechanism(m) => mechanism::run(m, control, observer),
         Scene::Chain(c) => chain::run(c, control, observer),
+        Scene::Continuum(c) => continuum::run(c, control, observer),
     }
 }

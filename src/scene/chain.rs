@@ -29,7 +29,8 @@ use serde_json::Value;
 use crate::engine::{Method, Tolerances};
 use crate::models::chain::Chain;
 use crate::scene::SceneError;
-use crate::scene::fields::{Fields, kind};
+use crate::scene::extent;
+use crate::scene::fields::Fields;
 use crate::scene::solver::SolverSpec;
 
 /// Most units a scene may have.
@@ -38,9 +39,6 @@ pub const MAX_UNITS: u64 = 1_000_000;
 /// Most units the ODE methods are offered for: every step costs O(N) and
 /// scans N guards (the linear propagator a dense 2N x 2N exponential).
 pub const MAX_ODE_UNITS: usize = 2000;
-
-/// Most rows of `trace.csv`.
-const MAX_SAMPLES: u64 = 1_000_000;
 
 #[derive(Debug, Clone, PartialEq)]
 pub struct ChainScene {
@@ -79,13 +77,7 @@ impl ChainScene {
 
     /// The times `trace.csv` samples: `linspace(0, t_end, samples)`.
     pub fn sample_times(&self) -> Vec<f64> {
-        match self.samples {
-            0 => Vec::new(),
-            1 => vec![0.0],
-            n => (0..n)
-                .map(|i| self.t_end * i as f64 / (n - 1) as f64)
-                .collect(),
-        }
+        extent::sample_times(self.t_end, self.samples)
     }
 }
 
@@ -128,45 +120,11 @@ pub(crate) fn validate(mut f: Fields) -> Result<ChainScene, SceneError> {
             ));
         }
     }
-    let (load_before, load_after) = load(f.required("load")?)?;
-    let constraint = match f.optional("constraint") {
-        None => true,
-        Some(Value::Bool(b)) => *b,
-        Some(other) => {
-            return Err(SceneError::field(
-                "constraint",
-                format!("must be true or false, found {}", kind(other)),
-            ));
-        }
-    };
+    let (load_before, load_after) = extent::load(f.required("load")?)?;
+    let constraint = extent::constraint(&mut f)?;
     let t_end = f.number_where("t_end", "> 0", |t| t > 0.0)?;
-    let mut snapshots = match f.optional("snapshots") {
-        None => Vec::new(),
-        Some(v) => numbers(v, "snapshots", None)?,
-    };
-    if let Some(t) = snapshots.iter().find(|t| !(0.0..=t_end).contains(*t)) {
-        return Err(SceneError::field(
-            "snapshots",
-            format!("must lie in [0, t_end = {t_end}] (got {t})"),
-        ));
-    }
-    snapshots.sort_by(f64::total_cmp);
-    snapshots.dedup();
-    let samples = match f.optional("samples") {
-        None => 101,
-        Some(v) => match v.as_u64() {
-            Some(n) if n <= MAX_SAMPLES => n as usize,
-            _ => {
-                return Err(SceneError::field(
-                    "samples",
-                    format!(
-                        "must be a whole number from 0 to {MAX_SAMPLES}, found {}",
-                        kind(v)
-                    ),
-                ));
-            }
-        },
-    };
+    let snapshots = extent::snapshots(&mut f, t_end)?;
+    let samples = extent::samples(&mut f)?;
     let at_rest = load_before - 1.0;
     let (strain, velocity) = match f.optional("initial") {
         None => (vec![at_rest; units], vec![0.0; units]),
@@ -235,55 +193,18 @@ pub fn resolve_solver(spec: &SolverSpec, units: usize) -> Result<(Method, Tolera
     Ok((method, tolerances))
 }
 
-fn load(value: &Value) -> Result<(f64, f64), SceneError> {
-    let mut f = Fields::open(value, "load")?;
-    let before = f.number("before")?;
-    let after = f.number("after")?;
-    f.finish()?;
-    Ok((before, after))
-}
-
 fn initial(value: &Value, units: usize, at_rest: f64) -> Result<(Vec<f64>, Vec<f64>), SceneError> {
     let mut f = Fields::open(value, "initial")?;
     let strain = f
         .optional("strain")
-        .map(|v| numbers(v, "initial.strain", Some(units)))
+        .map(|v| extent::numbers(v, "initial.strain", Some((units, "unit"))))
         .transpose()?
         .unwrap_or_else(|| vec![at_rest; units]);
     let velocity = f
         .optional("velocity")
-        .map(|v| numbers(v, "initial.velocity", Some(units)))
+        .map(|v| extent::numbers(v, "initial.velocity", Some((units, "unit"))))
         .transpose()?
         .unwrap_or_else(|| vec![0.0; units]);
     f.finish()?;
     Ok((strain, velocity))
-}
-
-/// An array of finite numbers at `path`, of length `len` if given.
-fn numbers(value: &Value, path: &str, len: Option<usize>) -> Result<Vec<f64>, SceneError> {
-    let Value::Array(items) = value else {
-        return Err(SceneError::field(
-            path,
-            format!("must be an array of numbers, found {}", kind(value)),
-        ));
-    };
-    if let Some(n) = len
-        && items.len() != n
-    {
-        return Err(SceneError::field(
-            path,
-            format!("must have one entry per unit ({n}), found {}", items.len()),
-        ));
-    }
-    items
-        .iter()
-        .enumerate()
-        .map(|(i, v)| match v.as_f64() {
-            Some(x) if x.is_finite() => Ok(x),
-            _ => Err(SceneError::field(
-                &format!("{path}[{i}]"),
-                format!("must be a finite number, found {}", kind(v)),
-            )),
-        })
-        .collect()
 }

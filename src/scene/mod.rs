@@ -4,9 +4,12 @@
 //! keys; every error names the file, the key's path and the reason, e.g.
 //! `models/x.json: field initial.strain: must be >= 0 (got -0.1)`. Unknown
 //! keys are errors, so a typo never silently falls back to a default.
-//! The keys of each model are documented in its module ([`mechanism`]).
+//! The keys of each model are documented in its module ([`mechanism`],
+//! [`chain`], [`continuum`]).
 
 pub mod chain;
+pub mod continuum;
+pub mod extent;
 pub mod fields;
 pub mod mechanism;
 pub mod solver;
@@ -16,7 +19,9 @@ use std::path::{Path, PathBuf};
 
 use serde_json::Value;
 
+use crate::engine::Method;
 pub use crate::scene::chain::ChainScene;
+pub use crate::scene::continuum::ContinuumScene;
 use crate::scene::fields::{Fields, kind};
 pub use crate::scene::mechanism::{Formulation, Initial, MechanismScene};
 
@@ -25,6 +30,7 @@ pub use crate::scene::mechanism::{Formulation, Initial, MechanismScene};
 pub enum Scene {
     Mechanism(MechanismScene),
     Chain(ChainScene),
+    Continuum(ContinuumScene),
 }
 
 impl Scene {
@@ -33,6 +39,7 @@ impl Scene {
         match self {
             Scene::Mechanism(m) => m.t_end,
             Scene::Chain(c) => c.t_end,
+            Scene::Continuum(c) => c.t_end,
         }
     }
 
@@ -42,6 +49,7 @@ impl Scene {
         let spec = match self {
             Scene::Mechanism(m) => m.solver.overridden_by(flags),
             Scene::Chain(c) => c.solver.overridden_by(flags),
+            Scene::Continuum(_) => flags.clone(),
         };
         self.set_solver(spec)
     }
@@ -58,6 +66,19 @@ impl Scene {
                 (c.method, c.tolerances) = chain::resolve_solver(&spec, c.units)?;
                 mechanism::check_steps(c.method, c.t_end)?;
                 c.solver = spec;
+            }
+            Scene::Continuum(_) => {
+                // Front tracking is exact and the only method offered.
+                let (method, _) = spec.resolve()?;
+                if !matches!(method, Method::Auto | Method::Exact) {
+                    return Err(SceneError::field(
+                        "solver.method",
+                        format!(
+                            "a continuum runs by exact front tracking only, not {}",
+                            method.name()
+                        ),
+                    ));
+                }
             }
         }
         Ok(())
@@ -80,6 +101,10 @@ impl Scene {
             Scene::Chain(c) => {
                 mechanism::check_steps(c.method, t_end)?;
                 // A shortened run takes the snapshots it reaches.
+                c.snapshots.retain(|&t| t <= t_end);
+                c.t_end = t_end;
+            }
+            Scene::Continuum(c) => {
                 c.snapshots.retain(|&t| t <= t_end);
                 c.t_end = t_end;
             }
@@ -154,9 +179,10 @@ pub fn from_value(value: &Value) -> Result<Scene, SceneError> {
     match model.as_str() {
         Some("mechanism") => mechanism::validate(fields).map(Scene::Mechanism),
         Some("chain") => chain::validate(fields).map(Scene::Chain),
+        Some("continuum") => continuum::validate(fields).map(Scene::Continuum),
         Some(other) => Err(SceneError::field(
             "model",
-            format!("unknown model {other:?} (known: \"mechanism\", \"chain\")"),
+            format!("unknown model {other:?} (known: \"mechanism\", \"chain\", \"continuum\")"),
         )),
         None => Err(SceneError::field(
             "model",

@@ -14,6 +14,9 @@ const EXPECTED: &[(&str, Status)] = &[
     ("chain_release_classical.json", Status::Completed),
     ("chain_release_free_end.json", Status::Completed),
     ("chain_release_paper.json", Status::Completed),
+    ("continuum_release_classical.json", Status::Completed),
+    ("continuum_release_free_end.json", Status::Completed),
+    ("continuum_release_paper.json", Status::Completed),
     ("mechanism_angle.json", Status::Completed),
     ("mechanism_angle_plain.json", Status::Failed),
     ("mechanism_chattering.json", Status::Zeno),
@@ -62,7 +65,7 @@ fn every_shipped_scene_runs_to_its_expected_outcome() {
                     "{name}: {:?}",
                     o.max_energy_error
                 );
-                let chain = report.chain.as_ref().unwrap();
+                let chain = report.fields.as_ref().unwrap();
                 assert!(chain.momentum_balance_error.unwrap() < 1e-12, "{name}");
                 assert_eq!(chain.profiles.len(), c.snapshots.len(), "{name}");
                 assert_eq!(chain.trace.len(), c.samples, "{name}");
@@ -71,6 +74,16 @@ fn every_shipped_scene_runs_to_its_expected_outcome() {
                     c.constraint,
                     "{name}: impacts iff constrained"
                 );
+                continue;
+            }
+            Scene::Continuum(c) => {
+                // Exact front tracking: energy and momentum to round-off.
+                assert_eq!(o.t_reached, c.t_end, "{name}");
+                assert!(o.max_energy_error.unwrap() < 1e-12, "{name}");
+                let fields = report.fields.as_ref().unwrap();
+                assert!(fields.momentum_balance_error.unwrap() < 1e-12, "{name}");
+                assert_eq!(fields.profiles.len(), c.snapshots.len(), "{name}");
+                assert_eq!(fields.trace.len(), c.samples, "{name}");
                 continue;
             }
         };

@@ -358,6 +358,7 @@ impl TaylorChain {
                 affects: self.guards_of(r_lo, r_hi),
                 unit: Some(unit as u64),
                 rel_velocity: Some(rel_velocity),
+                x: None,
             };
         }
     }
@@ -377,6 +378,7 @@ impl TaylorChain {
             affects: self.guards_of(r_lo, r_hi),
             unit: Some(a as u64),
             rel_velocity: None,
+            x: None,
         }
     }
 
@@ -548,6 +550,7 @@ impl TaylorChain {
             affects: self.guards_of(r_lo, r_hi),
             unit: Some(unit as u64),
             rel_velocity: None,
+            x: None,
         })
     }
 
@@ -609,6 +612,7 @@ impl LocalModel for TaylorChain {
                 affects: 0..self.guards.len(),
                 unit: None,
                 rel_velocity: None,
+                x: None,
             });
         }
         if guard == self.chain.units {

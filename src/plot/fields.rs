@@ -1,7 +1,10 @@
-//! Pictures of a chain run, from the files `flicker run` wrote: strain and
-//! displacement snapshots beside the classical string (`profiles.json`),
-//! the loaded end's displacement over time (`trace.csv`), and the
-//! space-time map of impacts, unit position against time (`events.jsonl`).
+//! Pictures of a chain or continuum run, from the files `flicker run`
+//! wrote: strain and displacement snapshots beside the classical string
+//! (`profiles.json`), the loaded end's displacement and the energy ratio
+//! `H(t) / H(0) - 1` over time (`trace.csv`; the paper's Figs. 12-14 for a
+//! continuum release), and the space-time map of events, position against
+//! time (`events.jsonl`: a chain's impacts by unit, a continuum's events by
+//! `x`).
 
 use std::path::{Path, PathBuf};
 
@@ -18,9 +21,9 @@ pub const MAX_POINTS: usize = 20_000;
 /// The same for a PNG, whose size does not grow with the points.
 const MAX_PIXEL_POINTS: usize = 2_000_000;
 
-/// Draw the chain pictures the files in `dir` allow; returns the files
-/// written (none if `dir` holds no `profiles.json`).
-pub fn plot_chain(dir: &Path) -> Result<Vec<PathBuf>, String> {
+/// Draw the pictures the files in `dir` allow; returns the files written
+/// (none if `dir` holds no `profiles.json`).
+pub fn plot_fields(dir: &Path) -> Result<Vec<PathBuf>, String> {
     let path = dir.join("profiles.json");
     if !path.exists() {
         return Ok(Vec::new());
@@ -53,7 +56,7 @@ pub fn plot_chain(dir: &Path) -> Result<Vec<PathBuf>, String> {
             figures.push((
                 name,
                 Figure {
-                    title: format!("{label} along the chain (dashed: the classical string)"),
+                    title: format!("{label} along the string (dashed: the classical string)"),
                     x_label: "position x".into(),
                     y_label: label.into(),
                     curves,
@@ -62,30 +65,55 @@ pub fn plot_chain(dir: &Path) -> Result<Vec<PathBuf>, String> {
             ));
         }
     }
-    let mut end = end_displacement(dir)?;
-    end.retain(|c| !c.points.is_empty());
-    let classical: Vec<(f64, f64)> = list(&profiles["classical"]["trace"])
-        .iter()
-        .filter_map(|r| Some((r["t"].as_f64()?, r["right_end"].as_f64()?)))
-        .collect();
-    if !classical.is_empty() {
-        end.push(Curve {
-            label: Some("classical string".into()),
-            points: classical,
-            style: Style::Dashed(1),
-        });
-    }
-    if !end.is_empty() {
-        figures.push((
+    let model = read_trace(dir)?;
+    let classical_trace = list(&profiles["classical"]["trace"]);
+    let classical = |key: &str| -> Vec<(f64, f64)> {
+        classical_trace
+            .iter()
+            .filter_map(|r| Some((r["t"].as_f64()?, r[key].as_f64()?)))
+            .collect()
+    };
+    for (name, title, y_label, ours, theirs) in [
+        (
             "end_displacement",
-            Figure {
-                title: "the loaded end's displacement y_N".into(),
-                x_label: "time t".into(),
-                y_label: "y_N".into(),
-                curves: end,
-                y_limit: None,
-            },
-        ));
+            "the loaded end's displacement",
+            "y at the loaded end",
+            model.right_end,
+            classical("right_end"),
+        ),
+        (
+            "energy_ratio",
+            "energy kept: H(t) / H(0) - 1 (the paper's Fig. 14)",
+            "H(t) / H(0) - 1",
+            ratio(model.energy),
+            ratio(classical("energy")),
+        ),
+    ] {
+        let mut curves = Vec::new();
+        for (label, points, style) in [
+            ("constrained", ours, Style::Line(0)),
+            ("classical string", theirs, Style::Dashed(1)),
+        ] {
+            if !points.is_empty() {
+                curves.push(Curve {
+                    label: Some(label.into()),
+                    points,
+                    style,
+                });
+            }
+        }
+        if !curves.is_empty() {
+            figures.push((
+                name,
+                Figure {
+                    title: title.into(),
+                    x_label: "time t".into(),
+                    y_label: y_label.into(),
+                    curves,
+                    y_limit: None,
+                },
+            ));
+        }
     }
     let centres: Vec<f64> = list(&profiles["snapshots"])
         .first()
@@ -121,30 +149,46 @@ fn pairs(x: &Value, y: &Value) -> Vec<(f64, f64)> {
         .collect()
 }
 
-/// `right_end` against `t` from `trace.csv`, if there is one.
-fn end_displacement(dir: &Path) -> Result<Vec<Curve>, String> {
+/// Energy and end displacement against time, from `trace.csv`.
+#[derive(Default)]
+struct Trace {
+    energy: Vec<(f64, f64)>,
+    right_end: Vec<(f64, f64)>,
+}
+
+/// `trace.csv` in `dir`, if there is one.
+fn read_trace(dir: &Path) -> Result<Trace, String> {
     let path = dir.join("trace.csv");
+    let mut trace = Trace::default();
     if !path.exists() {
-        return Ok(Vec::new());
+        return Ok(trace);
     }
     let mut reader =
         csv::Reader::from_path(&path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let mut points = Vec::new();
     for record in reader.records() {
         let record = record.map_err(|e| format!("{}: {e}", path.display()))?;
         let field = |i: usize| record.get(i).and_then(|x| x.parse::<f64>().ok());
-        if let (Some(t), Some(y)) = (field(0), field(3)) {
-            points.push((t, y));
+        if let Some(t) = field(0) {
+            trace.energy.extend(field(1).map(|e| (t, e)));
+            trace.right_end.extend(field(3).map(|y| (t, y)));
         }
     }
-    Ok(vec![Curve {
-        label: Some("chain".into()),
-        points,
-        style: Style::Line(0),
-    }])
+    Ok(trace)
 }
 
-/// Each impact as a dot at its unit's centre and its time (at most `most`).
+/// `(t, E / E(first) - 1)`, or nothing if the first energy is zero: kept
+/// to round-off, `E / E(first)` alone would be a flat line at 1.
+fn ratio(points: Vec<(f64, f64)>) -> Vec<(f64, f64)> {
+    match points.first() {
+        Some(&(_, e0)) if e0 != 0.0 && e0.is_finite() => {
+            points.into_iter().map(|(t, e)| (t, e / e0 - 1.0)).collect()
+        }
+        _ => Vec::new(),
+    }
+}
+
+/// Each event as a dot at its place (a chain's unit centre, a continuum's
+/// `x`) and its time (at most `most`).
 fn impact_map(dir: &Path, centres: &[f64], most: usize) -> Result<Option<Figure>, String> {
     let log = dir.join("events.jsonl");
     if !log.exists() || centres.is_empty() {
@@ -152,11 +196,11 @@ fn impact_map(dir: &Path, centres: &[f64], most: usize) -> Result<Option<Figure>
     }
     let mut points = Vec::new();
     for_each_event(&log, |e, _| {
-        if let Some(x) = e
+        let unit = e
             .unit
-            .and_then(|u| centres.get((u as usize).wrapping_sub(1)))
-        {
-            points.push((*x, e.t));
+            .and_then(|u| centres.get((u as usize).wrapping_sub(1)).copied());
+        if let Some(x) = e.x.or(unit) {
+            points.push((x, e.t));
         }
     })
     .map_err(|e| e.to_string())?;
@@ -167,13 +211,13 @@ fn impact_map(dir: &Path, centres: &[f64], most: usize) -> Result<Option<Figure>
     let stride = total.div_ceil(most);
     let shown: Vec<(f64, f64)> = points.into_iter().step_by(stride).collect();
     let title = if stride > 1 {
-        format!("impacts in space and time (every {stride}th of {total})")
+        format!("events in space and time (every {stride}th of {total})")
     } else {
-        format!("impacts in space and time ({total})")
+        format!("events in space and time ({total})")
     };
     Ok(Some(Figure {
         title,
-        x_label: "position x of the unit".into(),
+        x_label: "position x".into(),
         y_label: "time t".into(),
         curves: vec![Curve {
             label: None,
