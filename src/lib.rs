@@ -58,6 +58,7 @@
 //! ```
 
 pub mod compare;
+pub mod compare_models;
 pub mod engine;
 pub mod log;
 pub mod models;

@@ -19,6 +19,7 @@ macro_rules! say_raw {
 
 pub mod check;
 pub mod compare;
+pub mod compare_models;
 pub mod events;
 pub mod exit;
 pub mod plot;
@@ -66,6 +67,10 @@ enum Command {
         #[arg(long, value_name = "DIR")]
         out: Option<PathBuf>,
     },
+    /// Run a release scene as the chain at several N and as the continuum,
+    /// and measure each against the densest chain: DIR/compare_models.csv,
+    /// coarse.csv, compare_models.json and pictures.
+    CompareModels(compare_models::CompareModelsArgs),
     /// Run every stress scene in DIR with every method: each verified
     /// against the exact answer or failed with a reason (exit 3 if any is
     /// silently wrong).
@@ -151,6 +156,7 @@ pub fn dispatch(cli: Cli) -> Result<Code, Failure> {
             steps,
             out,
         } => compare::compare(&scene, methods, tolerances, steps, out),
+        Command::CompareModels(args) => compare_models::compare_models(args),
         Command::Stress {
             dir,
             wall,

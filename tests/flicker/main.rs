@@ -7,6 +7,7 @@ mod chain_exact;
 mod chain_invariants;
 mod cli;
 mod compare;
+mod compare_models;
 mod continuum;
 mod convergence;
 mod engine_generic;

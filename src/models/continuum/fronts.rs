@@ -28,6 +28,7 @@
 use std::ops::Range;
 
 use crate::engine::{Direction, Fired, Guard, LocalModel};
+use crate::models::chain::coarse::{Coarse, WINDOW_WIDTH};
 use crate::models::continuum::{Continuum, Piece};
 use crate::time::Time;
 
@@ -214,16 +215,41 @@ impl FrontTracking {
         self.wall_given - self.string.force(self.pieces[0]) * (t - self.wall_since)
     }
 
-    /// The mean strain and velocity over `[a, b]` at `t` (exact integrals).
-    pub fn mean_over(&self, a: f64, b: f64, t: Time) -> (f64, f64) {
-        let (mut strain, mut velocity) = (0.0, 0.0);
-        for (p, lo, hi) in self.extents(t.value()) {
-            let w = (hi.min(b) - lo.max(a)).max(0.0);
-            strain += p.strain * w;
-            velocity += p.velocity * w;
+    /// The coarse-grained fields of PHYSICS.md s.6 at window centres
+    /// `centres` and time `t`, by exact integrals over the pieces: windows
+    /// of [`WINDOW_WIDTH`] clipped at the ends; mean strain and velocity;
+    /// hidden energy = the window's energy less that of its means, per unit
+    /// length (`v^2 / 2 + F_cr eps^2 / 2`: the linear terms cancel).
+    pub fn coarse(&self, centres: &[f64], t: Time) -> Coarse {
+        let (s, extents) = (&self.string, self.extents(t.value()).collect::<Vec<_>>());
+        let mut coarse = Coarse {
+            x: centres.to_vec(),
+            strain: Vec::with_capacity(centres.len()),
+            velocity: Vec::with_capacity(centres.len()),
+            hidden_energy: Vec::with_capacity(centres.len()),
+        };
+        let quadratic =
+            |p: Piece| 0.5 * (p.velocity.powi(2) + s.critical_load() * p.strain.powi(2));
+        for &x in centres {
+            let a = (x - 0.5 * WINDOW_WIDTH).max(s.wall());
+            let b = (x + 0.5 * WINDOW_WIDTH).min(s.end());
+            let (mut strain, mut velocity, mut energy) = (0.0, 0.0, 0.0);
+            for &(p, lo, hi) in &extents {
+                let w = (hi.min(b) - lo.max(a)).max(0.0);
+                strain += p.strain * w;
+                velocity += p.velocity * w;
+                energy += quadratic(p) * w;
+            }
+            let width = b - a;
+            let mean = Piece {
+                strain: strain / width,
+                velocity: velocity / width,
+            };
+            coarse.strain.push(mean.strain);
+            coarse.velocity.push(mean.velocity);
+            coarse.hidden_energy.push(energy / width - quadratic(mean));
         }
-        let width = b - a;
-        (strain / width, velocity / width)
+        coarse
     }
 
     /// Clamp a strain within round-off of zero to zero (under the

@@ -1,0 +1,158 @@
+//! `flicker compare-models`: a release scene as the dense chain at several
+//! N and as each continuum, measured against the densest chain.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use flicker::compare_models::{Model, Release, chart, distance, files, run_all};
+use flicker::engine::Status;
+use flicker::log::summary::write_atomically;
+use flicker::models::continuum::Variant;
+use flicker::runner::Control;
+use flicker::scene;
+
+use crate::cli::exit::{Code, Failure};
+
+/// `flicker compare-models`'s arguments.
+#[derive(Debug, clap::Args)]
+pub struct CompareModelsArgs {
+    /// A chain or continuum scene (a uniform string at rest, released).
+    scene: PathBuf,
+    /// Chain sizes, comma-separated; the largest is the reference.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        value_name = "N,N,..",
+        default_value = "100,200,400,800,1600"
+    )]
+    units: Vec<usize>,
+    /// Sample times over [0, t_end] for the trace and the front.
+    #[arg(long, default_value_t = 121, value_name = "S")]
+    samples: usize,
+    /// Output directory (default: out/<scene name>-models).
+    #[arg(long, value_name = "DIR")]
+    out: Option<PathBuf>,
+}
+
+pub fn compare_models(args: CompareModelsArgs) -> Result<Code, Failure> {
+    let CompareModelsArgs {
+        scene: path,
+        mut units,
+        samples,
+        out,
+    } = args;
+    let scene = scene::load(&path).map_err(Failure::bad_input)?;
+    let release = Release::of(&scene).map_err(|e| Failure::bad_input(e.in_path(&path)))?;
+    units.sort_unstable();
+    units.dedup();
+    if units.is_empty() || units[0] == 0 || *units.last().unwrap() > 100_000 {
+        return Err(Failure::bad_input(
+            "--units: give chain sizes from 1 to 100000",
+        ));
+    }
+    if !(3..=100_000).contains(&samples) {
+        return Err(Failure::bad_input("--samples: from 3 to 100000"));
+    }
+    let out = out.unwrap_or_else(|| {
+        let stem = path
+            .file_stem()
+            .map_or_else(|| "scene".into(), |s| s.to_string_lossy().into_owned());
+        Path::new("out").join(format!("{stem}-models"))
+    });
+    std::fs::create_dir_all(&out).map_err(|e| {
+        Failure::bad_input(format!(
+            "{}: cannot create the output directory: {e}",
+            out.display()
+        ))
+    })?;
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = stop.clone();
+    let _ = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed));
+    let control = Control {
+        stop: Some(stop.clone()),
+        max_wall_seconds: None,
+    };
+    let mut models: Vec<Model> = units.iter().map(|&n| Model::Chain(n)).collect();
+    models.push(Model::Continuum(Variant::Paper));
+    eprintln!(
+        "running {} chains (N = {}) and the continuum to t = {}",
+        units.len(),
+        units
+            .iter()
+            .map(|n| n.to_string())
+            .collect::<Vec<_>>()
+            .join(", "),
+        release.t_end
+    );
+    let tracks = run_all(&release, &models, samples, &control).map_err(Failure::bad_input)?;
+    if let Some(t) = tracks.iter().find(|t| t.status != Status::Completed) {
+        let code = if stop.load(Ordering::Relaxed) {
+            Code::Interrupted
+        } else {
+            Code::Untrusted
+        };
+        say!(
+            "{} stopped: {}",
+            t.label,
+            t.reason.clone().unwrap_or_default()
+        );
+        return Ok(code);
+    }
+    let reference = units.len() - 1;
+    let distances: Vec<_> = tracks
+        .iter()
+        .map(|t| distance(t, &tracks[reference]))
+        .collect();
+    let untrusted = |e: String| Failure::untrusted(format!("{}: {e}", out.display()));
+    files::write_csvs(&tracks, &out).map_err(|e| untrusted(e.to_string()))?;
+    let summary_path = out.join("compare_models.json");
+    write_atomically(
+        &summary_path,
+        &files::summary(&tracks, &tracks[reference], &distances),
+    )
+    .map_err(|e| untrusted(e.to_string()))?;
+    let pictures = chart::draw_all(&tracks, reference, &out).map_err(untrusted)?;
+    say!(
+        "against {} (differences are largest over time and space):",
+        tracks[reference].label
+    );
+    say!(
+        "{:<20} {:>9} {:>10} {:>9} {:>9} {:>8} {:>9} {:>9} {:>9}",
+        "model",
+        "seconds",
+        "events",
+        "right_end",
+        "front",
+        "speed",
+        "strain",
+        "velocity",
+        "hidden"
+    );
+    for (t, d) in tracks.iter().zip(&distances) {
+        let opt = |x: Option<f64>, p: usize| x.map_or("-".into(), |x| format!("{x:.p$}"));
+        say!(
+            "{:<20} {:>9.3} {:>10} {:>9.4} {:>9} {:>8} {:>9.4} {:>9.4} {:>9.2e}",
+            t.label,
+            t.wall_seconds,
+            t.events,
+            d.right_end,
+            opt(d.front, 4),
+            opt(d.front_speed, 3),
+            d.window_strain,
+            d.window_velocity,
+            d.hidden_energy
+        );
+    }
+    let names: Vec<String> = [
+        out.join("compare_models.csv"),
+        out.join("coarse.csv"),
+        summary_path,
+    ]
+    .into_iter()
+    .chain(pictures)
+    .map(|p| p.display().to_string())
+    .collect();
+    say!("wrote {}", names.join(", "));
+    Ok(Code::Ok)
+}

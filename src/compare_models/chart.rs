@@ -1,0 +1,117 @@
+//! The pictures of a model comparison: the loaded end's displacement and
+//! the front over time for every model, and the coarse strain, velocity and
+//! hidden energy along the string at each snapshot (the densest chain
+//! solid, each continuum dashed, one colour per time).
+
+use std::path::{Path, PathBuf};
+
+use crate::compare_models::Track;
+use crate::models::chain::coarse::Coarse;
+use crate::plot::draw::{Curve, Figure, Style};
+
+/// Draw every picture into `dir` (SVG and PNG); `reference` is the index of
+/// the densest chain in `tracks`. Returns the files written.
+pub fn draw_all(tracks: &[Track], reference: usize, dir: &Path) -> Result<Vec<PathBuf>, String> {
+    let over_time = |value: fn(&crate::compare_models::Sample) -> Option<f64>| -> Vec<Curve> {
+        tracks
+            .iter()
+            .enumerate()
+            .map(|(i, track)| Curve {
+                label: Some(track.label.clone()),
+                points: track
+                    .samples
+                    .iter()
+                    .filter_map(|s| Some((s.t, value(s)?)))
+                    .collect(),
+                style: if track.units.is_some() {
+                    Style::Line(i)
+                } else {
+                    Style::Dashed(i)
+                },
+            })
+            .filter(|c| !c.points.is_empty())
+            .collect()
+    };
+    let mut figures = vec![
+        (
+            "right_end".to_string(),
+            Figure {
+                title: "the loaded end's displacement: chains (solid) and continua (dashed)".into(),
+                x_label: "time t".into(),
+                y_label: "y at the loaded end".into(),
+                curves: over_time(|s| Some(s.right_end)),
+                y_limit: None,
+            },
+        ),
+        (
+            "front".to_string(),
+            Figure {
+                title: "the front: leftmost window strain 0.008 below the undisturbed".into(),
+                x_label: "time t".into(),
+                y_label: "front position x".into(),
+                curves: over_time(|s| s.front),
+                y_limit: None,
+            },
+        ),
+    ];
+    let fields: [(&str, &str, fn(&Coarse) -> &[f64]); 3] = [
+        ("window_strain", "window strain", |c| &c.strain),
+        ("window_velocity", "window velocity", |c| &c.velocity),
+        ("hidden_energy", "hidden energy per unit length", |c| {
+            &c.hidden_energy
+        }),
+    ];
+    for (name, label, field) in fields {
+        let mut curves = Vec::new();
+        for (k, track) in tracks.iter().enumerate() {
+            let dense = k == reference;
+            if !(dense || track.units.is_none()) {
+                continue;
+            }
+            for (i, s) in track.snapshots.iter().enumerate() {
+                curves.push(Curve {
+                    label: dense.then(|| format!("t = {}", s.t)),
+                    points: s
+                        .coarse
+                        .x
+                        .iter()
+                        .copied()
+                        .zip(field(&s.coarse).iter().copied())
+                        .collect(),
+                    style: if dense {
+                        Style::Line(i)
+                    } else {
+                        Style::Dashed(i)
+                    },
+                });
+            }
+        }
+        if !curves.is_empty() {
+            figures.push((
+                name.to_string(),
+                Figure {
+                    title: format!(
+                        "{label}: {} (solid) and the continua (dashed)",
+                        tracks[reference].label
+                    ),
+                    x_label: "position x".into(),
+                    y_label: label.into(),
+                    curves,
+                    y_limit: None,
+                },
+            ));
+        }
+    }
+    let mut written = Vec::new();
+    for (name, figure) in figures {
+        if figure.curves.is_empty() {
+            continue;
+        }
+        for extension in ["svg", "png"] {
+            let path = dir.join(format!("{name}.{extension}"));
+            figure.draw(&path)?;
+            written.push(path);
+        }
+    }
+    Ok(written)
+}

@@ -1,0 +1,387 @@
+//! One release scene as the dense chain at several N and as each continuum,
+//! compared by the reproducible quantities of PHYSICS.md s.6-7: the loaded
+//! end's displacement, the front, the coarse-grained strain, velocity and
+//! hidden energy, and the energy, all measured against the densest chain
+//! (the ground truth a continuum must converge to).
+//!
+//! Every model is sampled at the same times, and the coarse fields on the
+//! same window centres ([`CENTRES`] of them from the wall to the loaded
+//! end), so the comparison needs no interpolation: a chain whose N is a
+//! multiple of `CENTRES - 1` has a node at every centre; others take the
+//! nearest node.
+
+pub mod chart;
+pub mod files;
+
+use std::time::Instant;
+
+use rayon::prelude::*;
+
+use crate::engine::{LocalModel, Method, Options, Status, Tolerances, simulate_local};
+use crate::models::chain::TaylorChain;
+use crate::models::chain::coarse::Coarse;
+use crate::models::continuum::{Continuum, FrontTracking, Piece, Variant};
+use crate::runner::Control;
+use crate::scene::{Scene, SceneError};
+use crate::time::Time;
+
+/// Window centres the coarse fields are compared at: every 0.02 on the
+/// paper's string of length 2.
+pub const CENTRES: usize = 101;
+
+/// The release a comparison runs: a uniform string at rest at strain
+/// `load_before - 1`, its end load dropping to `load_after` at `t = 0`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Release {
+    pub length: f64,
+    pub wave_speed: f64,
+    pub load_before: f64,
+    pub load_after: f64,
+    pub constraint: bool,
+    pub t_end: f64,
+    /// Times the coarse profiles are compared at.
+    pub snapshots: Vec<f64>,
+    pub max_events: u64,
+}
+
+impl Release {
+    /// The release a chain or continuum scene describes; scenes with an
+    /// `initial` profile are refused (the models would not start alike).
+    pub fn of(scene: &Scene) -> Result<Self, SceneError> {
+        let uniform = |strains: &[f64], velocities: &[f64], rest: f64| {
+            strains.iter().all(|e| *e == rest) && velocities.iter().all(|v| *v == 0.0)
+        };
+        let refuse = || {
+            SceneError::field(
+                "initial",
+                "the models are compared from the release of a uniform string at rest; leave `initial` out".into(),
+            )
+        };
+        match scene {
+            Scene::Chain(c) => {
+                if !uniform(&c.strain, &c.velocity, c.load_before - 1.0) {
+                    return Err(refuse());
+                }
+                Ok(Release {
+                    length: c.length,
+                    wave_speed: c.wave_speed,
+                    load_before: c.load_before,
+                    load_after: c.load_after,
+                    constraint: c.constraint,
+                    t_end: c.t_end,
+                    snapshots: c.snapshots.clone(),
+                    max_events: c.max_events,
+                })
+            }
+            Scene::Continuum(c) => {
+                let strains: Vec<f64> = c.cells.iter().map(|p| p.strain).collect();
+                let velocities: Vec<f64> = c.cells.iter().map(|p| p.velocity).collect();
+                if !uniform(&strains, &velocities, c.load_before - 1.0) {
+                    return Err(refuse());
+                }
+                Ok(Release {
+                    length: c.length,
+                    wave_speed: c.wave_speed,
+                    load_before: c.load_before,
+                    load_after: c.load_after,
+                    constraint: c.constraint,
+                    t_end: c.t_end,
+                    snapshots: c.snapshots.clone(),
+                    max_events: c.max_events,
+                })
+            }
+            Scene::Mechanism(_) => Err(SceneError::field(
+                "model",
+                "compares a chain with its continuum: give a chain or continuum scene".into(),
+            )),
+        }
+    }
+
+    /// The strain the string starts at, against which the front is found.
+    pub fn undisturbed(&self) -> f64 {
+        self.load_before - 1.0
+    }
+
+    /// The window centres, from the wall to the loaded end.
+    pub fn centres(&self) -> Vec<f64> {
+        (0..CENTRES)
+            .map(|j| -0.5 * self.length + self.length * j as f64 / (CENTRES - 1) as f64)
+            .collect()
+    }
+}
+
+/// One model's run, sampled.
+#[derive(Debug, Clone)]
+pub struct Track {
+    /// `chain N=..` or `continuum (variant)`.
+    pub label: String,
+    pub units: Option<usize>,
+    pub status: Status,
+    pub reason: Option<String>,
+    pub events: u64,
+    pub wall_seconds: f64,
+    pub max_energy_error: Option<f64>,
+    /// At the comparison's sample times, then at its snapshots.
+    pub samples: Vec<Sample>,
+    pub snapshots: Vec<Sample>,
+}
+
+/// A model at one time.
+#[derive(Debug, Clone)]
+pub struct Sample {
+    pub t: f64,
+    pub right_end: f64,
+    pub energy: f64,
+    pub front: Option<f64>,
+    pub coarse: Coarse,
+}
+
+/// The chain of `units` on `release` (exact event-local flow, no log).
+pub fn chain_track(
+    release: &Release,
+    units: usize,
+    times: &[f64],
+    control: &Control,
+) -> Result<Track, String> {
+    let chain = crate::models::chain::Chain::in_scene_units(
+        units,
+        release.length,
+        release.wave_speed,
+        release.load_after,
+        release.constraint,
+    );
+    let gaps = vec![release.undisturbed() * chain.unit_length(); units];
+    let mut model = TaylorChain::new(chain.clone(), &gaps, &vec![0.0; units])?;
+    let centres = release.centres();
+    let cell = release.length / units as f64;
+    let sample = |m: &TaylorChain, t: f64| {
+        let at = Time::new(t);
+        let (gaps, velocities) = m.state_at(at);
+        let all = Coarse::of(&chain, release.length, &gaps, &velocities);
+        let pick = |values: &[f64]| -> Vec<f64> {
+            centres
+                .iter()
+                .map(|x| values[(((x + 0.5 * release.length) / cell).round() as usize).min(units)])
+                .collect()
+        };
+        let coarse = Coarse {
+            x: centres.clone(),
+            strain: pick(&all.strain),
+            velocity: pick(&all.velocity),
+            hidden_energy: pick(&all.hidden_energy),
+        };
+        Sample {
+            t,
+            right_end: gaps.iter().sum(),
+            energy: m.energy(at).unwrap_or(f64::NAN),
+            front: coarse.front(release.undisturbed()),
+            coarse,
+        }
+    };
+    track(
+        format!("chain N={units}"),
+        Some(units),
+        &mut model,
+        release,
+        times,
+        control,
+        sample,
+    )
+}
+
+/// The continuum `variant` on `release`.
+pub fn continuum_track(
+    release: &Release,
+    variant: Variant,
+    times: &[f64],
+    control: &Control,
+) -> Result<Track, String> {
+    let string = Continuum {
+        length: release.length,
+        wave_speed: release.wave_speed,
+        load: release.load_after,
+        constraint: release.constraint,
+        variant,
+    };
+    let start = Piece {
+        strain: release.undisturbed(),
+        velocity: 0.0,
+    };
+    let mut model = FrontTracking::new(string, &[start])?;
+    let centres = release.centres();
+    let sample = |m: &FrontTracking, t: f64| {
+        let at = Time::new(t);
+        let coarse = m.coarse(&centres, at);
+        Sample {
+            t,
+            right_end: m.right_end(at),
+            energy: m.energy(at).unwrap_or(f64::NAN),
+            front: coarse.front(release.undisturbed()),
+            coarse,
+        }
+    };
+    track(
+        format!("continuum ({})", variant.name()),
+        None,
+        &mut model,
+        release,
+        times,
+        control,
+        sample,
+    )
+}
+
+/// Run `model`, sampling at `times` and at the release's snapshots.
+fn track<M: LocalModel>(
+    label: String,
+    units: Option<usize>,
+    model: &mut M,
+    release: &Release,
+    times: &[f64],
+    control: &Control,
+    sample: impl Fn(&M, f64) -> Sample,
+) -> Result<Track, String> {
+    let options: Options = control.options(
+        release.t_end,
+        release.max_events,
+        Method::Exact,
+        Tolerances::default(),
+    );
+    let mut all: Vec<f64> = times.iter().chain(&release.snapshots).copied().collect();
+    all.sort_by(f64::total_cmp);
+    all.dedup();
+    let mut taken = Vec::new();
+    let started = Instant::now();
+    let outcome = simulate_local(
+        model,
+        &options,
+        &all,
+        &mut |m: &M, t| taken.push(sample(m, t)),
+        &mut (),
+    );
+    let wall_seconds = started.elapsed().as_secs_f64();
+    let pick = |wanted: &[f64]| -> Vec<Sample> {
+        taken
+            .iter()
+            .filter(|s| wanted.contains(&s.t))
+            .cloned()
+            .collect()
+    };
+    Ok(Track {
+        label,
+        units,
+        status: outcome.status,
+        reason: outcome.reason,
+        events: outcome.events,
+        wall_seconds,
+        max_energy_error: outcome.max_energy_error,
+        samples: pick(times),
+        snapshots: pick(&release.snapshots),
+    })
+}
+
+/// How far a track is from the reference (the densest chain).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Distance {
+    pub label: String,
+    /// Largest `|right_end - reference|` over the sample times.
+    pub right_end: f64,
+    /// Largest `|front - reference|` where both have a front.
+    pub front: Option<f64>,
+    /// Mean speed of the front over the times it is seen (a straight-line
+    /// fit of position against time), and the reference's.
+    pub front_speed: Option<f64>,
+    /// Largest difference of the coarse strain, velocity and hidden energy
+    /// over the window centres and snapshot times.
+    pub window_strain: f64,
+    pub window_velocity: f64,
+    pub hidden_energy: f64,
+    /// Largest `|energy - reference|` relative to the reference's initial
+    /// energy.
+    pub energy: f64,
+}
+
+/// The distance of `track` from `reference`.
+pub fn distance(track: &Track, reference: &Track) -> Distance {
+    let largest = |pairs: &mut dyn Iterator<Item = f64>| pairs.fold(0.0, f64::max);
+    let paired = || track.samples.iter().zip(&reference.samples);
+    let fields = |field: fn(&Coarse) -> &[f64]| {
+        largest(
+            &mut track
+                .snapshots
+                .iter()
+                .zip(&reference.snapshots)
+                .flat_map(|(a, b)| {
+                    field(&a.coarse)
+                        .iter()
+                        .zip(field(&b.coarse))
+                        .map(|(x, y)| (x - y).abs())
+                        .collect::<Vec<_>>()
+                }),
+        )
+    };
+    let fronts: Vec<f64> = paired()
+        .filter_map(|(a, b)| Some((a.front? - b.front?).abs()))
+        .collect();
+    let e0 = reference
+        .samples
+        .first()
+        .map_or(1.0, |s| s.energy.abs().max(f64::MIN_POSITIVE));
+    Distance {
+        label: track.label.clone(),
+        right_end: largest(&mut paired().map(|(a, b)| (a.right_end - b.right_end).abs())),
+        front: (!fronts.is_empty()).then(|| largest(&mut fronts.into_iter())),
+        front_speed: front_speed(track),
+        window_strain: fields(|c| &c.strain),
+        window_velocity: fields(|c| &c.velocity),
+        hidden_energy: fields(|c| &c.hidden_energy),
+        energy: largest(&mut paired().map(|(a, b)| (a.energy - b.energy).abs() / e0)),
+    }
+}
+
+/// The front's mean speed towards the wall: the slope of a least-squares
+/// line through its positions while it is seen (before it reaches the
+/// wall's window), if seen at three times at least.
+pub fn front_speed(track: &Track) -> Option<f64> {
+    let seen: Vec<(f64, f64)> = track
+        .samples
+        .iter()
+        .filter_map(|s| Some((s.t, s.front?)))
+        .take_while(|&(_, x)| x > track.samples[0].coarse.x[0] + 0.1)
+        .collect();
+    if seen.len() < 3 {
+        return None;
+    }
+    let n = seen.len() as f64;
+    let (mt, mx) = seen
+        .iter()
+        .fold((0.0, 0.0), |(a, b), (t, x)| (a + t / n, b + x / n));
+    let (sxy, sxx) = seen.iter().fold((0.0, 0.0), |(a, b), (t, x)| {
+        (a + (t - mt) * (x - mx), b + (t - mt) * (t - mt))
+    });
+    Some(-sxy / sxx)
+}
+
+/// One model of a comparison.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Model {
+    Chain(usize),
+    Continuum(Variant),
+}
+
+/// Run every model on `release`, in parallel, sampled at `samples` times.
+pub fn run_all(
+    release: &Release,
+    models: &[Model],
+    samples: usize,
+    control: &Control,
+) -> Result<Vec<Track>, String> {
+    let times = crate::scene::extent::sample_times(release.t_end, samples);
+    models
+        .par_iter()
+        .map(|&model| match model {
+            Model::Chain(n) => chain_track(release, n, &times, control),
+            Model::Continuum(v) => continuum_track(release, v, &times, control),
+        })
+        .collect()
+}
