@@ -27,6 +27,9 @@ pub struct CompareModelsArgs {
         default_value = "100,200,400,800,1600"
     )]
     units: Vec<usize>,
+    /// Cells of the homogenized continuum.
+    #[arg(long, default_value_t = flicker::compare_models::DEFAULT_CELLS, value_name = "M")]
+    cells: usize,
     /// Sample times over [0, t_end] for the trace and the front.
     #[arg(long, default_value_t = 121, value_name = "S")]
     samples: usize,
@@ -39,11 +42,16 @@ pub fn compare_models(args: CompareModelsArgs) -> Result<Code, Failure> {
     let CompareModelsArgs {
         scene: path,
         mut units,
+        cells,
         samples,
         out,
     } = args;
     let scene = scene::load(&path).map_err(Failure::bad_input)?;
-    let release = Release::of(&scene).map_err(|e| Failure::bad_input(e.in_path(&path)))?;
+    let mut release = Release::of(&scene).map_err(|e| Failure::bad_input(e.in_path(&path)))?;
+    if !(2..=100_000).contains(&cells) {
+        return Err(Failure::bad_input("--cells: from 2 to 100000"));
+    }
+    release.cells = cells;
     units.sort_unstable();
     units.dedup();
     if units.is_empty() || units[0] == 0 || *units.last().unwrap() > 100_000 {
@@ -75,8 +83,9 @@ pub fn compare_models(args: CompareModelsArgs) -> Result<Code, Failure> {
     };
     let mut models: Vec<Model> = units.iter().map(|&n| Model::Chain(n)).collect();
     models.push(Model::Continuum(Variant::Paper));
+    models.push(Model::Continuum(Variant::Homogenized));
     eprintln!(
-        "running {} chains (N = {}) and the continuum to t = {}",
+        "running {} chains (N = {}) and the continua to t = {}",
         units.len(),
         units
             .iter()
@@ -113,34 +122,40 @@ pub fn compare_models(args: CompareModelsArgs) -> Result<Code, Failure> {
     )
     .map_err(|e| untrusted(e.to_string()))?;
     let pictures = chart::draw_all(&tracks, reference, &out).map_err(untrusted)?;
+    let returned = distances[reference]
+        .returned
+        .map_or("the end".to_string(), |t| format!("t = {t:.3}"));
     say!(
-        "against {} (differences are largest over time and space):",
+        "against {} (largest differences; plateau: relative, behind the front on its way; \
+         end to {returned}, when the reflected wave is back, and to t_end):",
         tracks[reference].label
     );
     say!(
-        "{:<20} {:>9} {:>10} {:>9} {:>9} {:>8} {:>9} {:>9} {:>9}",
+        "{:<24} {:>8} {:>10} {:>7} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8}",
         "model",
         "seconds",
         "events",
-        "right_end",
-        "front",
         "speed",
+        "plateau",
+        "plat. v",
+        "end<ret",
+        "end",
         "strain",
-        "velocity",
         "hidden"
     );
     for (t, d) in tracks.iter().zip(&distances) {
         let opt = |x: Option<f64>, p: usize| x.map_or("-".into(), |x| format!("{x:.p$}"));
         say!(
-            "{:<20} {:>9.3} {:>10} {:>9.4} {:>9} {:>8} {:>9.4} {:>9.4} {:>9.2e}",
+            "{:<24} {:>8.3} {:>10} {:>7} {:>8} {:>8} {:>8.4} {:>8.4} {:>8.4} {:>8.1e}",
             t.label,
             t.wall_seconds,
             t.events,
-            d.right_end,
-            opt(d.front, 4),
             opt(d.front_speed, 3),
+            opt(d.plateau_strain.map(|x| 100.0 * x), 1) + "%",
+            opt(d.plateau_velocity.map(|x| 100.0 * x), 1) + "%",
+            d.right_end_before_return,
+            d.right_end,
             d.window_strain,
-            d.window_velocity,
             d.hidden_energy
         );
     }

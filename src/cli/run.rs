@@ -37,6 +37,11 @@ pub struct RunArgs {
     /// No progress bar.
     #[arg(long)]
     quiet: bool,
+    /// Also draw the run's pictures into the output directory, as
+    /// `flicker plot DIR` does (for a continuum release: the paper's
+    /// Figs. 12-14 beside the classical string).
+    #[arg(long)]
+    plot: bool,
     #[command(flatten)]
     solver: SolverFlags,
     #[command(flatten)]
@@ -84,6 +89,7 @@ pub fn run(args: RunArgs) -> Result<Code, Failure> {
         t_end,
         no_events,
         quiet,
+        plot,
         solver,
         ensemble,
     } = args;
@@ -224,6 +230,11 @@ pub fn run(args: RunArgs) -> Result<Code, Failure> {
         ))
     })?;
     print_report(&report, &scene, &summary_path, log, &written);
+    if plot {
+        let drawn = flicker::plot::run::plot_run(&out).map_err(Failure::untrusted)?;
+        let names: Vec<String> = drawn.iter().map(|p| p.display().to_string()).collect();
+        say!("  drew {}", names.join(", "));
+    }
     if let Some(e) = horizon {
         let last = e.spread.last().copied();
         say!(

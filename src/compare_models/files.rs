@@ -81,8 +81,12 @@ pub fn summary(tracks: &[Track], reference: &Track, distances: &[Distance]) -> V
                 "max_energy_error": t.max_energy_error,
                 "distance": {
                     "right_end": d.right_end,
+                    "right_end_before_return": d.right_end_before_return,
+                    "returned": d.returned,
                     "front": d.front,
                     "front_speed": d.front_speed,
+                    "plateau_strain": d.plateau_strain,
+                    "plateau_velocity": d.plateau_velocity,
                     "window_strain": d.window_strain,
                     "window_velocity": d.window_velocity,
                     "hidden_energy": d.hidden_energy,

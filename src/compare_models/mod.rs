@@ -19,11 +19,19 @@ use rayon::prelude::*;
 
 use crate::engine::{LocalModel, Method, Options, Status, Tolerances, simulate_local};
 use crate::models::chain::TaylorChain;
-use crate::models::chain::coarse::Coarse;
-use crate::models::continuum::{Continuum, FrontTracking, Piece, Variant};
+use crate::models::chain::coarse::{Coarse, WINDOW_WIDTH};
+use crate::models::continuum::{
+    Continuum, FrontTracking, Homogenized, Piece, StringModel, Variant,
+};
 use crate::runner::Control;
 use crate::scene::{Scene, SceneError};
 use crate::time::Time;
+
+/// Fewest windows behind the front for a plateau to be measured.
+pub const PLATEAU_WINDOWS: usize = 10;
+
+/// Cells of the homogenized string unless the caller says otherwise.
+pub const DEFAULT_CELLS: usize = 200;
 
 /// Window centres the coarse fields are compared at: every 0.02 on the
 /// paper's string of length 2.
@@ -42,6 +50,8 @@ pub struct Release {
     /// Times the coarse profiles are compared at.
     pub snapshots: Vec<f64>,
     pub max_events: u64,
+    /// Cells of the homogenized string.
+    pub cells: usize,
 }
 
 impl Release {
@@ -71,6 +81,7 @@ impl Release {
                     t_end: c.t_end,
                     snapshots: c.snapshots.clone(),
                     max_events: c.max_events,
+                    cells: DEFAULT_CELLS,
                 })
             }
             Scene::Continuum(c) => {
@@ -88,6 +99,7 @@ impl Release {
                     t_end: c.t_end,
                     snapshots: c.snapshots.clone(),
                     max_events: c.max_events,
+                    cells: DEFAULT_CELLS,
                 })
             }
             Scene::Mechanism(_) => Err(SceneError::field(
@@ -203,13 +215,36 @@ pub fn continuum_track(
         constraint: release.constraint,
         variant,
     };
-    let start = Piece {
-        strain: release.undisturbed(),
-        velocity: 0.0,
-    };
-    let mut model = FrontTracking::new(string, &[start])?;
+    let label = format!("continuum ({})", variant.name());
+    match variant {
+        Variant::Paper => {
+            let start = Piece {
+                strain: release.undisturbed(),
+                velocity: 0.0,
+            };
+            let mut model = FrontTracking::new(string, &[start])?;
+            string_track(label, &mut model, release, times, control)
+        }
+        Variant::Homogenized => {
+            let mut checkpoints = times.to_vec();
+            checkpoints.extend(&release.snapshots);
+            checkpoints.push(release.t_end);
+            let mut model =
+                Homogenized::new(string, release.undisturbed(), release.cells, &checkpoints)?;
+            string_track(label, &mut model, release, times, control)
+        }
+    }
+}
+
+fn string_track<M: StringModel>(
+    label: String,
+    model: &mut M,
+    release: &Release,
+    times: &[f64],
+    control: &Control,
+) -> Result<Track, String> {
     let centres = release.centres();
-    let sample = |m: &FrontTracking, t: f64| {
+    let sample = |m: &M, t: f64| {
         let at = Time::new(t);
         let coarse = m.coarse(&centres, at);
         Sample {
@@ -220,15 +255,7 @@ pub fn continuum_track(
             coarse,
         }
     };
-    track(
-        format!("continuum ({})", variant.name()),
-        None,
-        &mut model,
-        release,
-        times,
-        control,
-        sample,
-    )
+    track(label, None, model, release, times, control, sample)
 }
 
 /// Run `model`, sampling at `times` and at the release's snapshots.
@@ -286,11 +313,24 @@ pub struct Distance {
     pub label: String,
     /// Largest `|right_end - reference|` over the sample times.
     pub right_end: f64,
-    /// Largest `|front - reference|` where both have a front.
+    /// The same until the wave reflected at the wall is back at the loaded
+    /// end ([`Distance::returned`]).
+    pub right_end_before_return: f64,
+    /// When the reference's end first stops moving towards the wall (its
+    /// first local minimum): the reflected wave is back.
+    pub returned: Option<f64>,
+    /// Largest `|front - reference|` while the reference's front is on
+    /// its way to the wall (more than a window from it).
     pub front: Option<f64>,
-    /// Mean speed of the front over the times it is seen (a straight-line
-    /// fit of position against time), and the reference's.
+    /// Mean speed of the front on its way to the wall (a least-squares
+    /// line of position against time).
     pub front_speed: Option<f64>,
+    /// Relative difference of the plateau's strain and velocity: the mean
+    /// over the windows behind the reference's front (a window clear of
+    /// the front and of the end; at least [`PLATEAU_WINDOWS`] of them) and
+    /// over the sample times while the front is on its way.
+    pub plateau_strain: Option<f64>,
+    pub plateau_velocity: Option<f64>,
     /// Largest difference of the coarse strain, velocity and hidden energy
     /// over the window centres and snapshot times.
     pub window_strain: f64,
@@ -320,9 +360,47 @@ pub fn distance(track: &Track, reference: &Track) -> Distance {
                 }),
         )
     };
-    let fronts: Vec<f64> = paired()
+    let on_its_way = |s: &Sample| s.front.filter(|&x| x > s.coarse.x[0] + WINDOW_WIDTH);
+    // From the release until the reference's front first comes within a
+    // window of the wall (after that a "front" is some later dip).
+    let travelling = || {
+        paired()
+            .skip_while(|(_, r)| r.front.is_none())
+            .take_while(|(_, r)| on_its_way(r).is_some())
+    };
+    let fronts: Vec<f64> = travelling()
         .filter_map(|(a, b)| Some((a.front? - b.front?).abs()))
         .collect();
+    let returned = reference
+        .samples
+        .windows(2)
+        .find(|w| w[1].right_end > w[0].right_end)
+        .map(|w| w[0].t);
+    let before_return = paired()
+        .filter(|(a, _)| returned.is_none_or(|r| a.t <= r))
+        .map(|(a, b)| (a.right_end - b.right_end).abs());
+    let plateau = |field: fn(&Coarse) -> &[f64]| -> Option<f64> {
+        let (mut mine, mut theirs, mut times) = (0.0, 0.0, 0);
+        for (a, b) in travelling() {
+            let (Some(front), Some(&end)) = (on_its_way(b), b.coarse.x.last()) else {
+                continue;
+            };
+            let behind = |c: &Coarse| -> Vec<f64> {
+                c.x.iter()
+                    .zip(field(c))
+                    .filter(|(x, _)| **x > front + WINDOW_WIDTH && **x < end - WINDOW_WIDTH)
+                    .map(|(_, y)| *y)
+                    .collect()
+            };
+            let (m, r) = (behind(&a.coarse), behind(&b.coarse));
+            if r.len() >= PLATEAU_WINDOWS {
+                mine += m.iter().sum::<f64>() / m.len() as f64;
+                theirs += r.iter().sum::<f64>() / r.len() as f64;
+                times += 1;
+            }
+        }
+        (times > 0).then(|| (mine - theirs).abs() / theirs.abs().max(f64::MIN_POSITIVE))
+    };
     let e0 = reference
         .samples
         .first()
@@ -330,8 +408,12 @@ pub fn distance(track: &Track, reference: &Track) -> Distance {
     Distance {
         label: track.label.clone(),
         right_end: largest(&mut paired().map(|(a, b)| (a.right_end - b.right_end).abs())),
+        right_end_before_return: largest(&mut before_return.into_iter()),
+        returned,
         front: (!fronts.is_empty()).then(|| largest(&mut fronts.into_iter())),
         front_speed: front_speed(track),
+        plateau_strain: plateau(|c| &c.strain),
+        plateau_velocity: plateau(|c| &c.velocity),
         window_strain: fields(|c| &c.strain),
         window_velocity: fields(|c| &c.velocity),
         hidden_energy: fields(|c| &c.hidden_energy),
@@ -347,7 +429,7 @@ pub fn front_speed(track: &Track) -> Option<f64> {
         .samples
         .iter()
         .filter_map(|s| Some((s.t, s.front?)))
-        .take_while(|&(_, x)| x > track.samples[0].coarse.x[0] + 0.1)
+        .take_while(|&(_, x)| x > track.samples[0].coarse.x[0] + WINDOW_WIDTH)
         .collect();
     if seen.len() < 3 {
         return None;

@@ -1,9 +1,10 @@
-//! Running a continuum scene: the string by exact front tracking, with
-//! profiles at the snapshot times, the trace at the sample times, and the
-//! classical string (constraint off) beside it.
+//! Running a continuum scene: the paper's string by exact front tracking,
+//! or the homogenized string by finite volumes, with profiles at the
+//! snapshot times, the trace at the sample times, and the classical string
+//! (constraint off) beside it.
 
-use crate::engine::{LocalModel, Observer, Outcome, Status, simulate_local};
-use crate::models::continuum::{Continuum, FrontTracking};
+use crate::engine::{Observer, Outcome, Status, simulate_local};
+use crate::models::continuum::{FrontTracking, Homogenized, StringModel, Variant};
 use crate::runner::{Classical, Control, FieldOutputs, Profile, Report, TraceRow};
 use crate::scene::{ContinuumScene, SceneError};
 use crate::time::Time;
@@ -13,26 +14,22 @@ pub(super) fn run(
     control: &Control,
     observer: &mut dyn Observer,
 ) -> Result<Report, SceneError> {
+    let refuse = |why: String| SceneError::field("initial", why);
     let string = scene.string(scene.constraint);
-    let (outcome, model, sampled) = track(scene, string.clone(), control, observer)?;
-    let end = Time::new(outcome.t_reached);
-    let momentum = model.momentum(end);
-    let expected = model.momentum_by_impulses(end);
-    let scale = momentum
-        .abs()
-        .max((string.end_force() * end.value()).abs())
-        .max(string.length * string.wave_speed * f64::EPSILON);
-    let right_end = model.right_end(end);
-    let mut fields = FieldOutputs {
-        momentum,
-        momentum_balance_error: Some((momentum - expected).abs() / scale),
-        right_end,
-        profiles: sampled.profiles,
-        trace: sampled.trace,
-        classical: None,
+    let (outcome, mut fields) = match scene.variant {
+        Variant::Paper => {
+            let mut model = FrontTracking::new(string.clone(), &scene.cells).map_err(refuse)?;
+            run_model(scene, &mut model, control, observer)
+        }
+        Variant::Homogenized => {
+            let mut model = homogenized(scene)?;
+            run_model(scene, &mut model, control, observer)
+        }
     };
     if scene.constraint && outcome.status == Status::Completed {
-        let (companion, _, sampled) = track(scene, scene.string(false), control, &mut ())?;
+        let mut classical =
+            FrontTracking::new(scene.string(false), &scene.cells).map_err(refuse)?;
+        let (companion, sampled) = sample(scene, &mut classical, control, &mut ());
         // A companion cut short (interrupted) is left out, not shown half.
         if companion.status == Status::Completed {
             fields.classical = Some(Classical {
@@ -43,26 +40,87 @@ pub(super) fn run(
     }
     Ok(Report {
         outcome,
-        method: "exact",
+        method: match scene.variant {
+            Variant::Paper => "exact",
+            Variant::Homogenized => "finite_volume",
+        },
         description: describe(scene),
-        final_state: vec![("momentum", momentum), ("right_end", right_end)],
+        final_state: vec![
+            ("momentum", fields.momentum),
+            ("right_end", fields.right_end),
+        ],
         fields: Some(fields),
     })
 }
 
+/// The homogenized string of `scene`, its steps landing on every sample
+/// and snapshot time.
+fn homogenized(scene: &ContinuumScene) -> Result<Homogenized, SceneError> {
+    let first = scene.cells[0];
+    if scene.cells.iter().any(|&c| c != first) || first.velocity != 0.0 {
+        return Err(SceneError::field(
+            "initial",
+            "the homogenized string starts from a uniform string at rest".into(),
+        ));
+    }
+    let mut checkpoints = scene.sample_times();
+    checkpoints.extend(&scene.snapshots);
+    checkpoints.push(scene.t_end);
+    Homogenized::new(
+        scene.string(scene.constraint),
+        first.strain,
+        scene.resolution,
+        &checkpoints,
+    )
+    .map_err(|why| SceneError::field("initial", why))
+}
+
+/// Run `model` and collect what the summary and the files need.
+fn run_model<M: StringModel>(
+    scene: &ContinuumScene,
+    model: &mut M,
+    control: &Control,
+    observer: &mut dyn Observer,
+) -> (Outcome, FieldOutputs) {
+    let (outcome, sampled) = sample(scene, model, control, observer);
+    let end = Time::new(outcome.t_reached);
+    let string = scene.string(scene.constraint);
+    let momentum = model.momentum(end);
+    let scale = momentum
+        .abs()
+        .max((string.end_force() * end.value()).abs())
+        .max(string.length * string.wave_speed * f64::EPSILON);
+    let fields = FieldOutputs {
+        momentum,
+        momentum_balance_error: Some((momentum - model.momentum_by_impulses(end)).abs() / scale),
+        right_end: model.right_end(end),
+        profiles: sampled.profiles,
+        trace: sampled.trace,
+        classical: None,
+    };
+    (outcome, fields)
+}
+
 /// What the summary says of the description used.
 fn describe(scene: &ContinuumScene) -> String {
-    let mut text = format!(
-        "continuum ({} variant): the {} string by exact front tracking (constant states between fronts at +-c; \
-         crossings, reflections and impacts as events)",
-        scene.variant.name(),
-        if scene.constraint {
-            "incompressible"
-        } else {
-            "classical"
-        },
-    );
-    if scene.constraint && scene.load_after < 1.0 {
+    let what = if scene.constraint {
+        "incompressible"
+    } else {
+        "classical"
+    };
+    let mut text = match scene.variant {
+        Variant::Paper => format!(
+            "continuum (paper variant): the {what} string by exact front tracking (constant states between fronts at +-c; \
+             crossings, reflections and impacts as events)"
+        ),
+        Variant::Homogenized => format!(
+            "continuum (homogenized variant): mass, momentum and energy with the rattling kept, under the single mechanism's \
+             equation of state, by finite volumes on {} cells (Rusanov fluxes, minmod slopes, Heun steps at CFL {})",
+            scene.resolution,
+            crate::models::continuum::homogenized::CFL
+        ),
+    };
+    if scene.variant == Variant::Paper && scene.constraint && scene.load_after < 1.0 {
         text.push_str(&format!(
             "; the end load {} F_cr is below F_cr, so the constraint holds the end at strain 0 as the paper does: \
              the end carries F_cr, {} F_cr more than the scene's load",
@@ -79,15 +137,13 @@ struct Sampled {
     trace: Vec<TraceRow>,
 }
 
-/// Run `string` from the scene's initial cells, sampling as it goes.
-fn track(
+/// Run `model` to the scene's end, sampling as it goes.
+fn sample<M: StringModel>(
     scene: &ContinuumScene,
-    string: Continuum,
+    model: &mut M,
     control: &Control,
     observer: &mut dyn Observer,
-) -> Result<(Outcome, FrontTracking, Sampled), SceneError> {
-    let mut model = FrontTracking::new(string, &scene.cells)
-        .map_err(|why| SceneError::field("initial", why))?;
+) -> (Outcome, Sampled) {
     let options = control.options(
         scene.t_end,
         scene.max_events,
@@ -106,10 +162,10 @@ fn track(
         trace: Vec::new(),
     };
     let outcome = simulate_local(
-        &mut model,
+        model,
         &options,
         &times,
-        &mut |m: &FrontTracking, t| {
+        &mut |m: &M, t| {
             let at = Time::new(t);
             if samples.next_if(|&s| s <= t).is_some() {
                 sampled.trace.push(TraceRow {
@@ -125,12 +181,12 @@ fn track(
         },
         observer,
     );
-    Ok((outcome, model, sampled))
+    (outcome, sampled)
 }
 
 /// The string at `points` (cell centres): strain, displacement and velocity
 /// there.
-fn profile(model: &FrontTracking, points: &[f64], t: Time) -> Profile {
+fn profile<M: StringModel>(model: &M, points: &[f64], t: Time) -> Profile {
     let pieces: Vec<_> = points.iter().map(|&x| model.piece_at(x, t)).collect();
     Profile {
         t: t.value(),

@@ -9,11 +9,14 @@
 //!
 //! - `variant`: `paper` (the default; the wave equation with the
 //!   constraint and energy kept across impacts, run exactly by front
-//!   tracking, [`crate::models::continuum`]).
+//!   tracking, [`crate::models::continuum`]) or `homogenized` (the rattling
+//!   kept as internal energy, by finite volumes,
+//!   [`crate::models::continuum::homogenized`]).
 //! - `length`, `wave_speed`, `load`, `constraint`, `t_end`, `snapshots`,
 //!   `samples`: as in a chain scene ([`crate::scene::chain`]).
-//! - `resolution`: how many points `profiles.json` samples, at the centres
-//!   of equal cells along the string (default 400; front tracking itself
+//! - `resolution`: how many equal cells the string is cut into (default
+//!   400): the homogenized string's finite volumes, and the points at whose
+//!   centres `profiles.json` samples either variant (front tracking itself
 //!   needs none).
 //! - optional: `initial` `{"strain": [..], "velocity": [..]}`, a constant
 //!   state on each of as many equal cells as the arrays have entries
@@ -82,10 +85,11 @@ pub(crate) fn validate(mut f: Fields) -> Result<ContinuumScene, SceneError> {
         None => Variant::Paper,
         Some(v) => match v.as_str() {
             Some("paper") => Variant::Paper,
+            Some("homogenized") => Variant::Homogenized,
             Some(other) => {
                 return Err(SceneError::field(
                     "variant",
-                    format!("unknown variant {other:?} (known: \"paper\")"),
+                    format!("unknown variant {other:?} (known: \"paper\", \"homogenized\")"),
                 ));
             }
             None => {
@@ -106,6 +110,12 @@ pub(crate) fn validate(mut f: Fields) -> Result<ContinuumScene, SceneError> {
     }
     let (load_before, load_after) = extent::load(f.required("load")?)?;
     let constraint = extent::constraint(&mut f)?;
+    if variant == Variant::Homogenized && !constraint {
+        return Err(SceneError::field(
+            "constraint",
+            "the homogenized string keeps the rattling the constraint causes; without it use the paper variant (the classical string)".into(),
+        ));
+    }
     let t_end = f.number_where("t_end", "> 0", |t| t > 0.0)?;
     let snapshots = extent::snapshots(&mut f, t_end)?;
     let samples = extent::samples(&mut f)?;

@@ -68,6 +68,8 @@ fn the_command_writes_its_tables_summary_and_pictures() {
         "40,80",
         "--samples",
         "31",
+        "--cells",
+        "50",
         "--out",
         out.to_str().unwrap(),
     ]);
@@ -75,13 +77,14 @@ fn the_command_writes_its_tables_summary_and_pictures() {
     let summary = read_json(&out.join("compare_models.json"));
     assert_eq!(summary["reference"], "chain N=80");
     let models = summary["models"].as_array().unwrap();
-    assert_eq!(models.len(), 3);
+    assert_eq!(models.len(), 4);
     assert_eq!(models[2]["model"], "continuum (paper)");
+    assert_eq!(models[3]["model"], "continuum (homogenized)");
     let rows = std::fs::read_to_string(out.join("compare_models.csv")).unwrap();
-    assert_eq!(rows.lines().count(), 1 + 3 * 31);
+    assert_eq!(rows.lines().count(), 1 + 4 * 31);
     let coarse = std::fs::read_to_string(out.join("coarse.csv")).unwrap();
-    // Four snapshots of 101 window centres for each of three models.
-    assert_eq!(coarse.lines().count(), 1 + 3 * 4 * 101);
+    // Four snapshots of 101 window centres for each of four models.
+    assert_eq!(coarse.lines().count(), 1 + 4 * 4 * 101);
     for name in ["right_end", "front", "window_strain", "hidden_energy"] {
         assert!(out.join(format!("{name}.svg")).exists(), "{name}");
     }

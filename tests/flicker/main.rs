@@ -13,6 +13,7 @@ mod convergence;
 mod engine_generic;
 mod event_location;
 mod fuzz_regressions;
+mod homogenized;
 mod invariants;
 mod mechanism_angle;
 mod mechanism_strain;

@@ -14,6 +14,8 @@ const EXPECTED: &[(&str, Status)] = &[
     ("chain_release_classical.json", Status::Completed),
     ("chain_release_free_end.json", Status::Completed),
     ("chain_release_paper.json", Status::Completed),
+    ("continuum_homogenized_free_end.json", Status::Completed),
+    ("continuum_homogenized_paper.json", Status::Completed),
     ("continuum_release_classical.json", Status::Completed),
     ("continuum_release_free_end.json", Status::Completed),
     ("continuum_release_paper.json", Status::Completed),

@@ -29,7 +29,7 @@ use std::ops::Range;
 
 use crate::engine::{Direction, Fired, Guard, LocalModel};
 use crate::models::chain::coarse::{Coarse, WINDOW_WIDTH};
-use crate::models::continuum::{Continuum, Piece};
+use crate::models::continuum::{Continuum, Piece, StringModel};
 use crate::time::Time;
 
 /// Guard slot of a front reaching the wall.
@@ -176,80 +176,8 @@ impl FrontTracking {
             .map(move |(i, &p)| (p, edges[i], edges[i + 1]))
     }
 
-    /// The state at position `x` and time `t` (the piece to the right of a
-    /// front exactly at `x`).
-    pub fn piece_at(&self, x: f64, t: Time) -> Piece {
-        let (t, c) = (t.value(), self.string.wave_speed);
-        let i = self.fronts.partition_point(|f| f.at(t, c) <= x);
-        self.pieces[i]
-    }
-
-    /// `y(x, t) = integral of eps from the wall to x`.
-    pub fn displacement_at(&self, x: f64, t: Time) -> f64 {
-        self.extents(t.value())
-            .map(|(p, a, b)| p.strain * (b.min(x) - a).max(0.0))
-            .sum()
-    }
-
-    /// The loaded end's displacement `y(L/2, t)`.
-    pub fn right_end(&self, t: Time) -> f64 {
-        self.displacement_at(self.string.end(), t)
-    }
-
-    /// Total momentum `integral of v`.
-    pub fn momentum(&self, t: Time) -> f64 {
-        self.extents(t.value())
-            .map(|(p, a, b)| p.velocity * (b - a))
-            .sum()
-    }
-
-    /// The momentum the end force and the wall (its pull and its impacts)
-    /// have given since `t = 0`, added to the initial momentum: what
-    /// [`FrontTracking::momentum`] must equal.
-    pub fn momentum_by_impulses(&self, t: Time) -> f64 {
-        let t = t.value();
-        self.momentum_initial + self.string.end_force() * t + self.wall_given_until(t)
-    }
-
     fn wall_given_until(&self, t: f64) -> f64 {
         self.wall_given - self.string.force(self.pieces[0]) * (t - self.wall_since)
-    }
-
-    /// The coarse-grained fields of PHYSICS.md s.6 at window centres
-    /// `centres` and time `t`, by exact integrals over the pieces: windows
-    /// of [`WINDOW_WIDTH`] clipped at the ends; mean strain and velocity;
-    /// hidden energy = the window's energy less that of its means, per unit
-    /// length (`v^2 / 2 + F_cr eps^2 / 2`: the linear terms cancel).
-    pub fn coarse(&self, centres: &[f64], t: Time) -> Coarse {
-        let (s, extents) = (&self.string, self.extents(t.value()).collect::<Vec<_>>());
-        let mut coarse = Coarse {
-            x: centres.to_vec(),
-            strain: Vec::with_capacity(centres.len()),
-            velocity: Vec::with_capacity(centres.len()),
-            hidden_energy: Vec::with_capacity(centres.len()),
-        };
-        let quadratic =
-            |p: Piece| 0.5 * (p.velocity.powi(2) + s.critical_load() * p.strain.powi(2));
-        for &x in centres {
-            let a = (x - 0.5 * WINDOW_WIDTH).max(s.wall());
-            let b = (x + 0.5 * WINDOW_WIDTH).min(s.end());
-            let (mut strain, mut velocity, mut energy) = (0.0, 0.0, 0.0);
-            for &(p, lo, hi) in &extents {
-                let w = (hi.min(b) - lo.max(a)).max(0.0);
-                strain += p.strain * w;
-                velocity += p.velocity * w;
-                energy += quadratic(p) * w;
-            }
-            let width = b - a;
-            let mean = Piece {
-                strain: strain / width,
-                velocity: velocity / width,
-            };
-            coarse.strain.push(mean.strain);
-            coarse.velocity.push(mean.velocity);
-            coarse.hidden_energy.push(energy / width - quadratic(mean));
-        }
-        coarse
     }
 
     /// Clamp a strain within round-off of zero to zero (under the
@@ -513,5 +441,74 @@ impl LocalModel for FrontTracking {
             end += p.strain * (b - a);
         }
         Some(energy - s.end_force() * end)
+    }
+}
+
+impl StringModel for FrontTracking {
+    /// The state at position `x` and time `t` (the piece to the right of a
+    /// front exactly at `x`).
+    fn piece_at(&self, x: f64, t: Time) -> Piece {
+        let (t, c) = (t.value(), self.string.wave_speed);
+        let i = self.fronts.partition_point(|f| f.at(t, c) <= x);
+        self.pieces[i]
+    }
+
+    /// `y(x, t) = integral of eps from the wall to x`.
+    fn displacement_at(&self, x: f64, t: Time) -> f64 {
+        self.extents(t.value())
+            .map(|(p, a, b)| p.strain * (b.min(x) - a).max(0.0))
+            .sum()
+    }
+
+    /// Total momentum `integral of v`.
+    fn momentum(&self, t: Time) -> f64 {
+        self.extents(t.value())
+            .map(|(p, a, b)| p.velocity * (b - a))
+            .sum()
+    }
+
+    /// The momentum the end force and the wall (its pull and its impacts)
+    /// have given since `t = 0`, added to the initial momentum: what
+    /// [`StringModel::momentum`] must equal.
+    fn momentum_by_impulses(&self, t: Time) -> f64 {
+        let t = t.value();
+        self.momentum_initial + self.string.end_force() * t + self.wall_given_until(t)
+    }
+
+    /// The coarse-grained fields of PHYSICS.md s.6 at window centres
+    /// `centres` and time `t`, by exact integrals over the pieces: windows
+    /// of [`WINDOW_WIDTH`] clipped at the ends; mean strain and velocity;
+    /// hidden energy = the window's energy less that of its means, per unit
+    /// length (`v^2 / 2 + F_cr eps^2 / 2`: the linear terms cancel).
+    fn coarse(&self, centres: &[f64], t: Time) -> Coarse {
+        let (s, extents) = (&self.string, self.extents(t.value()).collect::<Vec<_>>());
+        let mut coarse = Coarse {
+            x: centres.to_vec(),
+            strain: Vec::with_capacity(centres.len()),
+            velocity: Vec::with_capacity(centres.len()),
+            hidden_energy: Vec::with_capacity(centres.len()),
+        };
+        let quadratic =
+            |p: Piece| 0.5 * (p.velocity.powi(2) + s.critical_load() * p.strain.powi(2));
+        for &x in centres {
+            let a = (x - 0.5 * WINDOW_WIDTH).max(s.wall());
+            let b = (x + 0.5 * WINDOW_WIDTH).min(s.end());
+            let (mut strain, mut velocity, mut energy) = (0.0, 0.0, 0.0);
+            for &(p, lo, hi) in &extents {
+                let w = (hi.min(b) - lo.max(a)).max(0.0);
+                strain += p.strain * w;
+                velocity += p.velocity * w;
+                energy += quadratic(p) * w;
+            }
+            let width = b - a;
+            let mean = Piece {
+                strain: strain / width,
+                velocity: velocity / width,
+            };
+            coarse.strain.push(mean.strain);
+            coarse.velocity.push(mean.velocity);
+            coarse.hidden_energy.push(energy / width - quadratic(mean));
+        }
+        coarse
     }
 }

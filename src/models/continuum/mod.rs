@@ -19,20 +19,51 @@
 //! ([`Continuum::end_force`]); the scene's load is what it leaves out.
 
 pub mod fronts;
+pub mod homogenized;
+pub mod hugoniot;
+pub mod rattle;
 
 pub use fronts::FrontTracking;
+pub use homogenized::Homogenized;
+
+use crate::engine::LocalModel;
+use crate::models::chain::coarse::Coarse;
+use crate::time::Time;
+
+/// What a run observes of a string, whichever description carries it.
+pub trait StringModel: LocalModel {
+    /// The state at `x` (the mean state, for a homogenized string).
+    fn piece_at(&self, x: f64, t: Time) -> Piece;
+    /// `y(x, t)`, the integral of the strain from the wall to `x`.
+    fn displacement_at(&self, x: f64, t: Time) -> f64;
+    /// Total momentum.
+    fn momentum(&self, t: Time) -> f64;
+    /// The initial momentum plus what the end force and the wall have
+    /// given since: what [`StringModel::momentum`] must equal.
+    fn momentum_by_impulses(&self, t: Time) -> f64;
+    /// The coarse-grained fields of PHYSICS.md s.6 at window centres.
+    fn coarse(&self, centres: &[f64], t: Time) -> Coarse;
+    /// The loaded end's displacement.
+    fn right_end(&self, t: Time) -> f64 {
+        self.displacement_at(f64::INFINITY, t)
+    }
+}
 
 /// Which continuum.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Variant {
     /// The paper's: the wave equation, the constraint, energy kept.
     Paper,
+    /// Mass, momentum and energy with the rattling kept, under the single
+    /// mechanism's equation of state ([`homogenized`]).
+    Homogenized,
 }
 
 impl Variant {
     pub fn name(self) -> &'static str {
         match self {
             Variant::Paper => "paper",
+            Variant::Homogenized => "homogenized",
         }
     }
 }
