@@ -17,6 +17,7 @@ macro_rules! say_raw {
     }};
 }
 
+pub mod advise;
 pub mod check;
 pub mod compare;
 pub mod compare_models;
@@ -71,6 +72,9 @@ enum Command {
     /// and measure each against the densest chain: DIR/compare_models.csv,
     /// coarse.csv, compare_models.json and pictures.
     CompareModels(compare_models::CompareModelsArgs),
+    /// Say whether a chain scene needs its chain, or a continuum
+    /// reproduces it within a tolerance, and at what cost (measured).
+    Advise(advise::AdviseArgs),
     /// Run every stress scene in DIR with every method: each verified
     /// against the exact answer or failed with a reason (exit 3 if any is
     /// silently wrong).
@@ -157,6 +161,7 @@ pub fn dispatch(cli: Cli) -> Result<Code, Failure> {
             out,
         } => compare::compare(&scene, methods, tolerances, steps, out),
         Command::CompareModels(args) => compare_models::compare_models(args),
+        Command::Advise(args) => advise::advise(args),
         Command::Stress {
             dir,
             wall,

@@ -184,13 +184,18 @@ impl LocalRun<'_> {
         }
         let mut samples = samples.iter().copied().filter(|&s| s <= t_end).peekable();
         let mut turn: u64 = 0;
+        let mut reported = 0.0;
         loop {
             turn = turn.wrapping_add(1);
-            if turn.is_multiple_of(1024) {
+            // Often enough for a model whose events are heavy (a step of a
+            // whole string), rarely enough not to show in a light one's.
+            if turn.is_multiple_of(CHECK_EVERY) {
                 self.check_outside(started)?;
-            }
-            if turn.is_multiple_of(PROGRESS_EVERY) {
-                observer.on_progress(self.now.value(), self.events);
+                let elapsed = started.elapsed().as_secs_f64();
+                if elapsed - reported >= PROGRESS_SECONDS {
+                    observer.on_progress(self.now.value(), self.events);
+                    reported = elapsed;
+                }
             }
             let next = self.queue.peek().filter(|(_, t)| t.value() <= t_end);
             if let Some(&s) = samples.peek()
@@ -385,5 +390,9 @@ fn failed(reason: String) -> Stop {
     (Status::Failed, reason)
 }
 
-/// Turns of the loop between two progress reports.
-const PROGRESS_EVERY: u64 = 1 << 14;
+/// Turns of the loop between two looks outside (a signal, the wall-time
+/// budget, the progress display).
+const CHECK_EVERY: u64 = 16;
+
+/// Wall time between two progress reports.
+const PROGRESS_SECONDS: f64 = 0.2;

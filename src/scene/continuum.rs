@@ -33,6 +33,10 @@ use crate::scene::fields::{Fields, kind};
 /// Most cells an `initial` profile may have, and most profile points.
 pub const MAX_CELLS: u64 = 1_000_000;
 
+/// Most finite volumes of the homogenized string (a step over them all is
+/// one event, so this keeps an event to milliseconds).
+pub const MAX_FINITE_VOLUMES: usize = 20_000;
+
 #[derive(Debug, Clone, PartialEq)]
 pub struct ContinuumScene {
     pub variant: Variant,
@@ -156,6 +160,14 @@ pub(crate) fn validate(mut f: Fields) -> Result<ContinuumScene, SceneError> {
             field,
             format!(
                 "{from}, below zero, which the constraint forbids (use \"constraint\": false for the classical string)"
+            ),
+        ));
+    }
+    if variant == Variant::Homogenized && resolution > MAX_FINITE_VOLUMES {
+        return Err(SceneError::field(
+            "resolution",
+            format!(
+                "the homogenized string runs on at most {MAX_FINITE_VOLUMES} cells (got {resolution}); its cost grows as the square of the cells"
             ),
         ));
     }

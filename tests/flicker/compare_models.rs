@@ -106,3 +106,40 @@ fn scenes_that_cannot_be_compared_are_refused() {
     ]);
     assert_eq!(o.status.code(), Some(2));
 }
+
+#[test]
+fn advise_weighs_a_chain_scene_against_its_continua() {
+    // The paper's reading at N = 200: the chain itself is cheap, and
+    // neither continuum keeps the end within 0.001 of it.
+    let o = flicker(&[
+        "advise",
+        &models("chain_release_paper.json"),
+        "--tolerance",
+        "0.001",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        text.contains("continuum (homogenized): loaded end within"),
+        "{text}"
+    );
+    assert!(
+        text.contains("advice: no continuum reproduces this scene within 0.001; run the chain"),
+        "{text}"
+    );
+    // A tolerance the paper's continuum meets (its end stays within 0.1
+    // of the chain's) turns the advice, with the cost ratio measured.
+    let o = flicker(&[
+        "advise",
+        &models("chain_release_paper.json"),
+        "--tolerance",
+        "0.1",
+    ]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        text.contains("advice: continuum (paper) reproduces"),
+        "{text}"
+    );
+    let o = flicker(&["advise", &models("continuum_release_paper.json")]);
+    assert_eq!(o.status.code(), Some(2));
+}

@@ -39,12 +39,13 @@
 /// and internal energy `g` (per unit length, over `F_cr`) makes, or why
 /// there is none.
 pub fn centre(e: f64, g: f64) -> Result<f64, String> {
-    centre_near(e, g, None)
+    centre_near(e, g, None).map(|(c, _)| c)
 }
 
 /// [`centre`], by Newton's method from `hint` (a nearby state's centre)
-/// when it converges there, else from a bracket.
-fn centre_near(e: f64, g: f64, hint: Option<f64>) -> Result<f64, String> {
+/// when it converges there (with the derivatives Newton used), else from a
+/// bracket.
+fn centre_near(e: f64, g: f64, hint: Option<f64>) -> Result<(f64, Option<Parts>), String> {
     if !(e.is_finite() && g.is_finite() && e > 0.0) {
         return Err(format!(
             "no unit has mean strain {e:e} and energy {g:e}: the mean strain must be positive"
@@ -58,10 +59,10 @@ fn centre_near(e: f64, g: f64, hint: Option<f64>) -> Result<f64, String> {
     }
     // An oscillation of amplitude at most e about e never reaches zero.
     if hidden <= 0.5 * e * e {
-        return Ok(e);
+        return Ok((e, None));
     }
-    if let Some(c) = hint.and_then(|h| newton(e, g, h)) {
-        return Ok(c);
+    if let Some((c, parts)) = hint.and_then(|h| newton(e, g, h)) {
+        return Ok((c, Some(parts)));
     }
     let mean = |c: f64| c + amplitude(c, e, g) * arc_mean(c, amplitude(c, e, g)) - e;
     // mean(e) > 0 (the arc lies above its centre); far below, the arc
@@ -79,7 +80,7 @@ fn centre_near(e: f64, g: f64, hint: Option<f64>) -> Result<f64, String> {
             ));
         }
     }
-    Ok(root(mean, lo, f_lo, hi, mean(hi)))
+    Ok((root(mean, lo, f_lo, hi, mean(hi)), None))
 }
 
 /// A root of `f` in `[lo, hi]`, where `f(lo)` and `f(hi)` differ in sign,
@@ -124,7 +125,9 @@ pub(crate) fn root(
 
 /// Newton's iteration for the centre from `c`, if it settles within a few
 /// steps on an impacting orbit (`c < e`).
-fn newton(e: f64, g: f64, mut c: f64) -> Option<f64> {
+/// With the derivatives at the last iterate but one: a step below `1e-8`
+/// leaves an error of its square, and derivatives good to `1e-8`.
+fn newton(e: f64, g: f64, mut c: f64) -> Option<(f64, Parts)> {
     for _ in 0..8 {
         if !(c < e) {
             return None;
@@ -132,8 +135,8 @@ fn newton(e: f64, g: f64, mut c: f64) -> Option<f64> {
         let p = Parts::at(c, e, g)?;
         let step = p.f / p.f_c;
         c -= step;
-        if step.abs() <= 1e-12 * (1.0 + c.abs()) {
-            return (c < e).then_some(c);
+        if step.abs() <= 1e-8 * (1.0 + c.abs()) {
+            return (c < e).then_some((c, p));
         }
     }
     None
@@ -157,9 +160,10 @@ impl Parts {
         if !(sin_phi > 1e-6) {
             return None;
         }
-        let phi = (-c / a).clamp(-1.0, 1.0).acos();
-        let s = phi.sin() / phi;
-        let s_phi = (phi * phi.cos() - phi.sin()) / (phi * phi);
+        let cos_phi = (-c / a).clamp(-1.0, 1.0);
+        let phi = cos_phi.acos();
+        let s = sin_phi / phi;
+        let s_phi = (phi * cos_phi - sin_phi) / (phi * phi);
         let (phi_c, phi_a) = (1.0 / (a * sin_phi), -c / (a * a * sin_phi));
         let (a_c, a_e, a_g) = ((c - e) / a, -(1.0 + c) / a, 1.0 / a);
         let f_a = s + a * s_phi * phi_a;
@@ -210,8 +214,9 @@ pub struct Law {
 /// differences near the ends of the arc's range; never below the elastic
 /// speed, as a bound for the flux.
 pub fn law(e: f64, g: f64, hint: Option<f64>) -> Result<Law, String> {
-    let c = centre_near(e, g, hint)?;
-    let slope = match (c < e).then(|| Parts::at(c, e, g)).flatten() {
+    let (c, parts) = centre_near(e, g, hint)?;
+    let parts = parts.or_else(|| (c < e).then(|| Parts::at(c, e, g)).flatten());
+    let slope = match parts {
         Some(p) => (-p.f_e - (1.0 + c) * p.f_g) / p.f_c,
         None if c < e => slope_by_differences(e, g, 1.0 + c)?,
         None => 1.0,

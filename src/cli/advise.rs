@@ -1,0 +1,127 @@
+//! `flicker advise`: whether a chain scene needs its chain, or a continuum
+//! reproduces its coarse behaviour within a tolerance, and at what cost,
+//! from measured runs.
+//!
+//! The chain is run at a probe size (the scene's N, at most
+//! [`PROBE_UNITS`]) and each continuum beside it; each continuum's
+//! distance from the probe is measured (the loaded end's displacement over
+//! the whole run, the front's speed and the plateau behind it). The
+//! chain's cost at the scene's N is the probe's, scaled by `N^2`: the
+//! number of impacts grows as `N^2` per unit time while the exact flow's
+//! cost per impact does not grow (issue 4's measured figures), so this is
+//! an estimate, said to be one.
+
+use std::path::PathBuf;
+
+use flicker::compare_models::{Release, Track, chain_track, continuum_track, distance};
+use flicker::engine::Status;
+use flicker::models::continuum::Variant;
+use flicker::runner::Control;
+use flicker::scene::{self, Scene};
+
+use crate::cli::exit::{Code, Failure};
+
+/// Largest chain run to probe a scene.
+pub const PROBE_UNITS: usize = 400;
+
+/// `flicker advise`'s arguments.
+#[derive(Debug, clap::Args)]
+pub struct AdviseArgs {
+    /// A chain scene (a uniform string at rest, released).
+    scene: PathBuf,
+    /// Largest difference of the loaded end's displacement from the chain
+    /// that still counts as reproduced, in the scene's length units.
+    #[arg(long, default_value_t = 0.01, value_name = "D")]
+    tolerance: f64,
+}
+
+pub fn advise(args: AdviseArgs) -> Result<Code, Failure> {
+    let scene = scene::load(&args.scene).map_err(Failure::bad_input)?;
+    let Scene::Chain(chain) = &scene else {
+        return Err(Failure::bad_input(format!(
+            "{}: advise weighs a chain scene against its continua; this is not a chain scene",
+            args.scene.display()
+        )));
+    };
+    if !(args.tolerance.is_finite() && args.tolerance > 0.0) {
+        return Err(Failure::bad_input("--tolerance: a number > 0"));
+    }
+    let release = Release::of(&scene).map_err(|e| Failure::bad_input(e.in_path(&args.scene)))?;
+    let probe = chain.units.min(PROBE_UNITS);
+    // One after another, so that each is timed alone.
+    let times = flicker::scene::extent::sample_times(release.t_end, 121);
+    let control = Control::default();
+    let tracks: Vec<Track> = [
+        chain_track(&release, probe, &times, &control),
+        continuum_track(&release, Variant::Paper, &times, &control),
+        continuum_track(&release, Variant::Homogenized, &times, &control),
+    ]
+    .into_iter()
+    .collect::<Result<_, _>>()
+    .map_err(Failure::bad_input)?;
+    if let Some(t) = tracks.iter().find(|t| t.status != Status::Completed) {
+        say!(
+            "{} stopped: {}",
+            t.label,
+            t.reason.clone().unwrap_or_default()
+        );
+        return Ok(Code::Untrusted);
+    }
+    let reference = &tracks[0];
+    let scale = (chain.units as f64 / probe as f64).powi(2);
+    let chain_seconds = reference.wall_seconds * scale;
+    say!(
+        "{}: chain of {} units; probed with the chain at N = {probe} ({:.3} s, {} impacts){}",
+        args.scene.display(),
+        chain.units,
+        reference.wall_seconds,
+        reference.events,
+        if scale > 1.0 {
+            format!(
+                "; at N = {} it would take about {chain_seconds:.1} s (x N^2)",
+                chain.units
+            )
+        } else {
+            String::new()
+        }
+    );
+    let mut best: Option<(&str, f64)> = None;
+    for track in &tracks[1..] {
+        let d = distance(track, reference);
+        let within = d.right_end <= args.tolerance;
+        let ratio = chain_seconds / track.wall_seconds.max(1e-6);
+        say!(
+            "  {}: loaded end within {:.4} of the chain until the reflected wave is back ({}), {:.4} over the run \
+             ({} the tolerance {}); front speed {} against {}; {}",
+            track.label,
+            d.right_end_before_return,
+            d.returned.map_or("-".into(), |t| format!("t = {t:.3}")),
+            d.right_end,
+            if within { "within" } else { "outside" },
+            args.tolerance,
+            d.front_speed.map_or("-".into(), |s| format!("{s:.3}")),
+            distance(reference, reference)
+                .front_speed
+                .map_or("-".into(), |s| format!("{s:.3}")),
+            if ratio >= 1.0 {
+                format!("{ratio:.1}x cheaper")
+            } else {
+                format!("{:.1}x dearer", 1.0 / ratio)
+            }
+        );
+        if within && best.is_none_or(|(_, r)| ratio > r) {
+            best = Some((track.label.as_str(), ratio));
+        }
+    }
+    match best {
+        Some((label, ratio)) => say!(
+            "advice: {label} reproduces this scene's loaded end within {} at {ratio:.1}x less cost; run it for coarse results (the chain for unit-level ones)",
+            args.tolerance
+        ),
+        None => say!(
+            "advice: no continuum reproduces this scene within {}; run the chain",
+            args.tolerance
+        ),
+    }
+    Ok(Code::Ok)
+}
