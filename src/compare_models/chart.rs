@@ -1,12 +1,14 @@
 //! The pictures of a model comparison: the loaded end's displacement and
 //! the front over time for every model, and the coarse strain, velocity and
 //! hidden energy along the string at each snapshot (the densest chain
-//! solid, each continuum dashed, one colour per time).
+//! solid, the paper's continuum dashed, the homogenized string as circles; one
+//! colour per model over time, per time along the string).
 
 use std::path::{Path, PathBuf};
 
-use crate::compare_models::Track;
+use crate::compare_models::{Model, Track};
 use crate::models::chain::coarse::Coarse;
+use crate::models::continuum::Variant;
 use crate::plot::draw::{Curve, Figure, Style};
 
 /// Draw every picture into `dir` (SVG and PNG); `reference` is the index of
@@ -23,11 +25,7 @@ pub fn draw_all(tracks: &[Track], reference: usize, dir: &Path) -> Result<Vec<Pa
                     .iter()
                     .filter_map(|s| Some((s.t, value(s)?)))
                     .collect(),
-                style: if track.units.is_some() {
-                    Style::Line(i)
-                } else {
-                    Style::Dashed(i)
-                },
+                style: style(track.model, i),
             })
             .filter(|c| !c.points.is_empty())
             .collect()
@@ -36,7 +34,9 @@ pub fn draw_all(tracks: &[Track], reference: usize, dir: &Path) -> Result<Vec<Pa
         (
             "right_end".to_string(),
             Figure {
-                title: "the loaded end's displacement: chains (solid) and continua (dashed)".into(),
+                title:
+                    "the loaded end: chains (solid), paper's continuum (dashed), homogenized (circles)"
+                        .into(),
                 x_label: "time t".into(),
                 y_label: "y at the loaded end".into(),
                 curves: over_time(|s| Some(s.right_end)),
@@ -91,7 +91,7 @@ pub fn draw_all(tracks: &[Track], reference: usize, dir: &Path) -> Result<Vec<Pa
                 name.to_string(),
                 Figure {
                     title: format!(
-                        "{label}: {} (solid) and the continua (dashed)",
+                        "{label}: {} (solid), paper's continuum (dashed), homogenized (circles)",
                         tracks[reference].label
                     ),
                     x_label: "position x".into(),
@@ -114,4 +114,14 @@ pub fn draw_all(tracks: &[Track], reference: usize, dir: &Path) -> Result<Vec<Pa
         }
     }
     Ok(written)
+}
+
+/// Chains solid, the paper's continuum dashed, the homogenized string as
+/// circles, in palette colour `i`.
+fn style(model: Model, i: usize) -> Style {
+    match model {
+        Model::Chain(_) => Style::Line(i),
+        Model::Continuum(Variant::Paper) => Style::Dashed(i),
+        Model::Continuum(Variant::Homogenized) => Style::Circles(i),
+    }
 }

@@ -128,6 +128,7 @@ pub struct Track {
     /// `chain N=..` or `continuum (variant)`.
     pub label: String,
     pub units: Option<usize>,
+    pub model: Model,
     pub status: Status,
     pub reason: Option<String>,
     pub events: u64,
@@ -192,7 +193,7 @@ pub fn chain_track(
     };
     track(
         format!("chain N={units}"),
-        Some(units),
+        Model::Chain(units),
         &mut model,
         release,
         times,
@@ -223,7 +224,7 @@ pub fn continuum_track(
                 velocity: 0.0,
             };
             let mut model = FrontTracking::new(string, &[start])?;
-            string_track(label, &mut model, release, times, control)
+            string_track(label, variant, &mut model, release, times, control)
         }
         Variant::Homogenized => {
             let mut checkpoints = times.to_vec();
@@ -231,13 +232,14 @@ pub fn continuum_track(
             checkpoints.push(release.t_end);
             let mut model =
                 Homogenized::new(string, release.undisturbed(), release.cells, &checkpoints)?;
-            string_track(label, &mut model, release, times, control)
+            string_track(label, variant, &mut model, release, times, control)
         }
     }
 }
 
 fn string_track<M: StringModel>(
     label: String,
+    variant: Variant,
     model: &mut M,
     release: &Release,
     times: &[f64],
@@ -255,13 +257,21 @@ fn string_track<M: StringModel>(
             coarse,
         }
     };
-    track(label, None, model, release, times, control, sample)
+    track(
+        label,
+        Model::Continuum(variant),
+        model,
+        release,
+        times,
+        control,
+        sample,
+    )
 }
 
 /// Run `model`, sampling at `times` and at the release's snapshots.
 fn track<M: LocalModel>(
     label: String,
-    units: Option<usize>,
+    kind: Model,
     model: &mut M,
     release: &Release,
     times: &[f64],
@@ -296,7 +306,11 @@ fn track<M: LocalModel>(
     };
     Ok(Track {
         label,
-        units,
+        units: match kind {
+            Model::Chain(n) => Some(n),
+            Model::Continuum(_) => None,
+        },
+        model: kind,
         status: outcome.status,
         reason: outcome.reason,
         events: outcome.events,

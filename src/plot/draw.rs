@@ -23,9 +23,13 @@ pub enum Style {
     Dashed(usize),
     /// The same, as dots.
     Dots(usize),
+    /// The same, as larger open circles (a third series beside a solid
+    /// and a dashed one).
+    Circles(usize),
 }
 
-/// Colours of [`Style::Line`], [`Style::Dashed`] and [`Style::Dots`].
+/// Colours of [`Style::Line`], [`Style::Dashed`], [`Style::Dots`] and
+/// [`Style::Circles`].
 pub const PALETTE: [RGBColor; 6] = [
     RGBColor(31, 119, 180),
     RGBColor(214, 39, 40),
@@ -180,6 +184,16 @@ impl Figure {
                     let colour = PALETTE[i % PALETTE.len()];
                     chart
                         .draw_series(points.iter().map(|p| Circle::new(*p, 1, colour.filled())))
+                        .map_err(err)?;
+                }
+                Style::Circles(i) => {
+                    let colour = PALETTE[i % PALETTE.len()];
+                    chart
+                        .draw_series(
+                            points
+                                .iter()
+                                .map(|p| Circle::new(*p, 3, colour.stroke_width(1))),
+                        )
                         .map_err(err)?;
                 }
             }
