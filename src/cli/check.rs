@@ -58,10 +58,16 @@ pub fn check(path: &Path) -> Result<Code, Failure> {
         }
         Scene::Continuum(c) => {
             say!(
-                "{}: a valid continuum scene ({} variant, {} initial cells, exact front tracking)",
+                "{}: a valid continuum scene ({} variant, {} initial cells, {})",
                 path.display(),
                 c.variant.name(),
-                c.cells.len()
+                c.cells.len(),
+                match c.variant {
+                    flicker::models::continuum::Variant::Paper =>
+                        "exact front tracking".to_string(),
+                    flicker::models::continuum::Variant::Homogenized =>
+                        format!("finite volumes on {} cells", c.resolution),
+                }
             );
             say!(
                 "  length {}, wave speed {}, load {} -> {} (F / F_cr), constraint {}, t_end {}",

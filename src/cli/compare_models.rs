@@ -48,8 +48,9 @@ pub fn compare_models(args: CompareModelsArgs) -> Result<Code, Failure> {
     } = args;
     let scene = scene::load(&path).map_err(Failure::bad_input)?;
     let mut release = Release::of(&scene).map_err(|e| Failure::bad_input(e.in_path(&path)))?;
-    if !(2..=100_000).contains(&cells) {
-        return Err(Failure::bad_input("--cells: from 2 to 100000"));
+    let most = flicker::scene::continuum::MAX_FINITE_VOLUMES;
+    if !(2..=most).contains(&cells) {
+        return Err(Failure::bad_input(format!("--cells: from 2 to {most}")));
     }
     release.cells = cells;
     units.sort_unstable();
@@ -83,7 +84,10 @@ pub fn compare_models(args: CompareModelsArgs) -> Result<Code, Failure> {
     };
     let mut models: Vec<Model> = units.iter().map(|&n| Model::Chain(n)).collect();
     models.push(Model::Continuum(Variant::Paper));
-    models.push(Model::Continuum(Variant::Homogenized));
+    match release.without_homogenized() {
+        None => models.push(Model::Continuum(Variant::Homogenized)),
+        Some(why) => say!("{why}"),
+    }
     eprintln!(
         "running {} chains (N = {}) and the continua to t = {}",
         units.len(),

@@ -78,11 +78,7 @@ pub fn draw_all(tracks: &[Track], reference: usize, dir: &Path) -> Result<Vec<Pa
                         .copied()
                         .zip(field(&s.coarse).iter().copied())
                         .collect(),
-                    style: if dense {
-                        Style::Line(i)
-                    } else {
-                        Style::Dashed(i)
-                    },
+                    style: style(track.model, i),
                 });
             }
         }

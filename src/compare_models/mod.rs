@@ -114,6 +114,22 @@ impl Release {
         self.load_before - 1.0
     }
 
+    /// Why the homogenized string does not describe this release, if it
+    /// does not: it keeps the rattling the constraint causes, from a
+    /// stretched string.
+    pub fn without_homogenized(&self) -> Option<String> {
+        if !self.constraint {
+            Some("the homogenized string is left out: it describes the constrained string (this one's constraint is off)".into())
+        } else if self.undisturbed() <= 0.0 {
+            Some(format!(
+                "the homogenized string is left out: it starts from a stretched string (this one starts at strain {})",
+                self.undisturbed()
+            ))
+        } else {
+            None
+        }
+    }
+
     /// The window centres, from the wall to the loaded end.
     pub fn centres(&self) -> Vec<f64> {
         (0..CENTRES)
@@ -217,6 +233,10 @@ pub fn continuum_track(
         variant,
     };
     let label = format!("continuum ({})", variant.name());
+    // Energies are compared with the scene's load: where the paper's
+    // continuum holds its end with more (F_cr), its own energy counts that
+    // force's potential instead, which the scene's does not.
+    let held = string.end_force() - string.load * string.critical_load();
     match variant {
         Variant::Paper => {
             let start = Piece {
@@ -224,7 +244,7 @@ pub fn continuum_track(
                 velocity: 0.0,
             };
             let mut model = FrontTracking::new(string, &[start])?;
-            string_track(label, variant, &mut model, release, times, control)
+            string_track(label, variant, held, &mut model, release, times, control)
         }
         Variant::Homogenized => {
             let mut checkpoints = times.to_vec();
@@ -232,14 +252,16 @@ pub fn continuum_track(
             checkpoints.push(release.t_end);
             let mut model =
                 Homogenized::new(string, release.undisturbed(), release.cells, &checkpoints)?;
-            string_track(label, variant, &mut model, release, times, control)
+            string_track(label, variant, 0.0, &mut model, release, times, control)
         }
     }
 }
 
+/// `held`: the force the model's end carries beyond the scene's load.
 fn string_track<M: StringModel>(
     label: String,
     variant: Variant,
+    held: f64,
     model: &mut M,
     release: &Release,
     times: &[f64],
@@ -249,10 +271,11 @@ fn string_track<M: StringModel>(
     let sample = |m: &M, t: f64| {
         let at = Time::new(t);
         let coarse = m.coarse(&centres, at);
+        let right_end = m.right_end(at);
         Sample {
             t,
-            right_end: m.right_end(at),
-            energy: m.energy(at).unwrap_or(f64::NAN),
+            right_end,
+            energy: m.energy(at).map_or(f64::NAN, |e| e + held * right_end),
             front: coarse.front(release.undisturbed()),
             coarse,
         }

@@ -72,7 +72,7 @@ fn homogenized(scene: &ContinuumScene) -> Result<Homogenized, SceneError> {
         scene.resolution,
         &checkpoints,
     )
-    .map_err(|why| SceneError::field("initial", why))
+    .map_err(|why| SceneError::field("load.before", why))
 }
 
 /// Run `model` and collect what the summary and the files need.
@@ -187,15 +187,12 @@ fn sample<M: StringModel>(
 /// The string at `points` (cell centres): strain, displacement and velocity
 /// there.
 fn profile<M: StringModel>(model: &M, points: &[f64], t: Time) -> Profile {
-    let pieces: Vec<_> = points.iter().map(|&x| model.piece_at(x, t)).collect();
+    let along = model.profile(points, t);
     Profile {
         t: t.value(),
         x: points.to_vec(),
-        strain: pieces.iter().map(|p| p.strain).collect(),
-        displacement: points
-            .iter()
-            .map(|&x| model.displacement_at(x, t))
-            .collect(),
-        velocity: pieces.iter().map(|p| p.velocity).collect(),
+        strain: along.iter().map(|(p, _)| p.strain).collect(),
+        displacement: along.iter().map(|&(_, y)| y).collect(),
+        velocity: along.iter().map(|(p, _)| p.velocity).collect(),
     }
 }

@@ -74,7 +74,7 @@ impl Scene {
                     return Err(SceneError::field(
                         "solver.method",
                         format!(
-                            "a continuum runs by exact front tracking only, not {}",
+                            "a continuum runs by its own method only (exact front tracking, or finite volumes for the homogenized string), not {}",
                             method.name()
                         ),
                     ));

@@ -40,8 +40,10 @@ pub const IMPACT: usize = 1;
 /// have slot `FIRST_CROSSING + i`, and the end the last slot.
 const FIRST_CROSSING: usize = 2;
 
-/// Fronts an impact may add beyond those the run starts with (each adds at
-/// most one).
+/// Fronts impacts may add beyond those the run starts with (each adds at
+/// most two: one leaving the wall, one more where the bounced stretch's
+/// far edge splits), so room for 32 impacts; a run that needs more stops
+/// and says so.
 const RESERVE: usize = 64;
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -510,5 +512,25 @@ impl StringModel for FrontTracking {
             coarse.hidden_energy.push(energy / width - quadratic(mean));
         }
         coarse
+    }
+
+    fn profile(&self, points: &[f64], t: Time) -> Vec<(Piece, f64)> {
+        let edges: Vec<f64> = self.edges(t.value()).collect();
+        let (mut i, mut below) = (0, 0.0);
+        points
+            .iter()
+            .map(|&x| {
+                // The piece right of an edge exactly at x, as piece_at.
+                while i + 1 < self.pieces.len() && edges[i + 1] <= x {
+                    below += self.pieces[i].strain * (edges[i + 1] - edges[i]);
+                    i += 1;
+                }
+                let p = self.pieces[i];
+                (
+                    p,
+                    below + p.strain * (x.min(edges[i + 1]) - edges[i]).max(0.0),
+                )
+            })
+            .collect()
     }
 }

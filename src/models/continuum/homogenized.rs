@@ -297,10 +297,30 @@ impl Homogenized {
         let first = self.fluxes(&self.cells)?;
         let mut dt = (CFL * self.width() / first.fastest).min(until - self.at);
         let mut halvings = 0;
-        let (two, second) = loop {
+        let (next, second) = loop {
             let one = self.euler(&self.cells, &first, dt);
-            match self.fluxes(&one) {
-                Ok(second) => break (self.euler(&one, &second, dt), second),
+            let step = self.fluxes(&one).and_then(|second| {
+                let two = self.euler(&one, &second, dt);
+                let next: Vec<Cell> = self
+                    .cells
+                    .iter()
+                    .zip(&two)
+                    .map(|(c, b)| Cell {
+                        strain: 0.5 * (c.strain + b.strain),
+                        velocity: 0.5 * (c.velocity + b.velocity),
+                        energy: 0.5 * (c.energy + b.energy),
+                    })
+                    .collect();
+                match next.iter().position(|&c| !self.admissible(c)) {
+                    None => Ok((next, second)),
+                    Some(i) => Err(format!(
+                        "cell {i} would leave the law's range (mean strain {:e})",
+                        next[i].strain
+                    )),
+                }
+            });
+            match step {
+                Ok(done) => break done,
                 Err(why) if halvings == MAX_HALVINGS => {
                     return Err(format!("{why} (with the step halved {MAX_HALVINGS} times)"));
                 }
@@ -310,11 +330,7 @@ impl Homogenized {
                 }
             }
         };
-        for (c, b) in self.cells.iter_mut().zip(&two) {
-            c.strain = 0.5 * (c.strain + b.strain);
-            c.velocity = 0.5 * (c.velocity + b.velocity);
-            c.energy = 0.5 * (c.energy + b.energy);
-        }
+        self.cells = next;
         self.wall_given -= 0.5 * (first.wall_force + second.wall_force) * dt;
         self.hints = second.centres.into_iter().map(Some).collect();
         self.at = if self.at + dt >= until {
@@ -324,6 +340,15 @@ impl Homogenized {
         };
         self.steps += 1;
         Ok(())
+    }
+
+    /// Whether the law can read `cell`: a positive mean strain and an
+    /// energy not below the elastic energy of its mean (no negative
+    /// rattling), as [`rattle::centre`] requires.
+    fn admissible(&self, cell: Cell) -> bool {
+        let g = (cell.energy - 0.5 * cell.velocity * cell.velocity) / self.string.critical_load();
+        let e = cell.strain;
+        e > 0.0 && g - e - 0.5 * e * e >= -1e-12 * g.abs().max(e) && g.is_finite()
     }
 
     fn cell_index(&self, x: f64) -> usize {
@@ -439,5 +464,22 @@ impl StringModel for Homogenized {
                 .push(energy / width - 0.5 * v * v - f * (0.5 * e * e + e));
         }
         coarse
+    }
+
+    fn profile(&self, points: &[f64], t: Time) -> Vec<(Piece, f64)> {
+        let h = self.width();
+        let (mut i, mut below) = (0, 0.0);
+        points
+            .iter()
+            .map(|&x| {
+                let at = self.cell_index(x);
+                while i < at {
+                    below += self.cells[i].strain * h;
+                    i += 1;
+                }
+                let part = (x - self.string.wall() - at as f64 * h).clamp(0.0, h);
+                (self.piece_at(x, t), below + self.cells[at].strain * part)
+            })
+            .collect()
     }
 }

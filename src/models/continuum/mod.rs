@@ -47,6 +47,9 @@ pub trait StringModel: LocalModel {
     fn right_end(&self, t: Time) -> f64 {
         self.displacement_at(f64::INFINITY, t)
     }
+    /// The state and the displacement at each of `points` (in increasing
+    /// order), in one pass along the string.
+    fn profile(&self, points: &[f64], t: Time) -> Vec<(Piece, f64)>;
 }
 
 /// Which continuum.
