@@ -13,7 +13,7 @@
 //! and the state behind must carry the force its equation of state
 //! ([`super::rattle`]) gives. At the end `sigma_B` is the load, at the wall
 //! `v_B = 0`; either leaves one unknown, the strain behind, found on
-//! `(0, e_A)` by [`rattle::root`]. States are `[e, v, E]` with `E`
+//! `(0, e_A)` by regula falsi. States are `[e, v, E]` with `E`
 //! the energy per unit length, forces over `F_cr`, speeds over `c_b`
 //! (scene units with `c_b = 1`: the caller scales).
 
