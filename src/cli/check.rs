@@ -41,14 +41,12 @@ pub fn check(path: &Path) -> Result<Code, Failure> {
                 c.units,
                 c.method.name()
             );
-            say!(
-                "  length {}, wave speed {}, load {} -> {} (F / F_cr), constraint {}, t_end {}",
+            string_line(
                 c.length,
                 c.wave_speed,
-                c.load_before,
-                c.load_after,
-                if c.constraint { "on" } else { "off" },
-                c.t_end
+                (c.load_before, c.load_after),
+                c.constraint,
+                c.t_end,
             );
             say!(
                 "  {} snapshots, {} trace samples",
@@ -69,14 +67,12 @@ pub fn check(path: &Path) -> Result<Code, Failure> {
                         format!("finite volumes on {} cells", c.resolution),
                 }
             );
-            say!(
-                "  length {}, wave speed {}, load {} -> {} (F / F_cr), constraint {}, t_end {}",
+            string_line(
                 c.length,
                 c.wave_speed,
-                c.load_before,
-                c.load_after,
-                if c.constraint { "on" } else { "off" },
-                c.t_end
+                (c.load_before, c.load_after),
+                c.constraint,
+                c.t_end,
             );
             say!(
                 "  {} snapshots of {} points, {} trace samples",
@@ -109,4 +105,18 @@ fn regime(m: Mechanism, h0: f64, t_end: f64) -> String {
     } else {
         "a loose oscillation about the buckled strain, no impact".into()
     }
+}
+
+/// The line `check` prints of a chain's or a continuum's string.
+fn string_line(
+    length: f64,
+    wave_speed: f64,
+    (before, after): (f64, f64),
+    constraint: bool,
+    t_end: f64,
+) {
+    say!(
+        "  length {length}, wave speed {wave_speed}, load {before} -> {after} (F / F_cr), constraint {}, t_end {t_end}",
+        if constraint { "on" } else { "off" }
+    );
 }

@@ -52,12 +52,7 @@ pub fn compare(
     );
     let (reference, rows) = run_compare(&scene, &plan, &mut |row| eprintln!("{}", line(row)))
         .map_err(|e| Failure::bad_input(e.in_path(scene_path)))?;
-    std::fs::create_dir_all(&out).map_err(|e| {
-        Failure::bad_input(format!(
-            "{}: cannot create the output directory: {e}",
-            out.display()
-        ))
-    })?;
+    crate::cli::setup::output_folder(&out)?;
     let csv = out.join("compare.csv");
     write_csv(&rows, &csv).map_err(|e| Failure::untrusted(format!("{}: {e}", csv.display())))?;
     let title = format!(

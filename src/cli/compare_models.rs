@@ -2,8 +2,7 @@
 //! N and as each continuum, measured against the densest chain.
 
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::Ordering;
 
 use flicker::compare_models::{Model, Release, chart, distance, files, run_all};
 use flicker::engine::Status;
@@ -69,15 +68,8 @@ pub fn compare_models(args: CompareModelsArgs) -> Result<Code, Failure> {
             .map_or_else(|| "scene".into(), |s| s.to_string_lossy().into_owned());
         Path::new("out").join(format!("{stem}-models"))
     });
-    std::fs::create_dir_all(&out).map_err(|e| {
-        Failure::bad_input(format!(
-            "{}: cannot create the output directory: {e}",
-            out.display()
-        ))
-    })?;
-    let stop = Arc::new(AtomicBool::new(false));
-    let flag = stop.clone();
-    let _ = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed));
+    crate::cli::setup::output_folder(&out)?;
+    let stop = crate::cli::setup::stop_flag();
     let control = Control {
         stop: Some(stop.clone()),
         max_wall_seconds: None,

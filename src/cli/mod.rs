@@ -26,6 +26,7 @@ pub mod exit;
 pub mod plot;
 pub mod progress;
 pub mod run;
+pub mod setup;
 pub mod stress;
 pub mod sweep;
 

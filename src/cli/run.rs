@@ -4,8 +4,7 @@
 use std::fs::File;
 use std::io::BufWriter;
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::Ordering;
 
 use flicker::engine::{Method, Status};
 use flicker::log::JsonlWriter;
@@ -131,19 +130,9 @@ pub fn run(args: RunArgs) -> Result<Code, Failure> {
         }
     };
     let out = out.unwrap_or_else(|| default_out(scene_path));
-    std::fs::create_dir_all(&out).map_err(|e| {
-        Failure::bad_input(format!(
-            "{}: cannot create the output directory: {e}",
-            out.display()
-        ))
-    })?;
-    let stop = Arc::new(AtomicBool::new(false));
-    let flag = stop.clone();
-    // A second handler cannot be installed in the same process; a run
-    // without one still works, it just cannot be interrupted cleanly.
-    let _ = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed));
+    crate::cli::setup::output_folder(&out)?;
     let control = Control {
-        stop: Some(stop),
+        stop: Some(crate::cli::setup::stop_flag()),
         max_wall_seconds: None,
     };
 
