@@ -85,6 +85,7 @@ fn every_logged_event_passes_the_event_schema() {
         "mechanism_angle.json",
         "mechanism_chattering.json",
         "chain_cradle.json",
+        "continuum_release_paper.json",
     ] {
         let out = dir.path().join(scene);
         let scene = Path::new(env!("CARGO_MANIFEST_DIR"))
