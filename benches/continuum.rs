@@ -7,22 +7,26 @@
 //! N = 800 and 1600 (one run at 1600), with the chain's time over each
 //! continuum's.
 
-use flicker::engine::{Options, simulate_local};
+use flicker::engine::{LocalModel, Options, Outcome, simulate_local};
 use flicker::models::chain::{Chain, TaylorChain};
-use flicker::models::continuum::{Continuum, FrontTracking, Homogenized, Piece, Variant};
+use flicker::models::continuum::{Continuum, FrontTracking, Homogenized, Piece};
 
 mod timing;
 
 use timing::median_of;
 
-fn string(load: f64, variant: Variant) -> Continuum {
+fn string(load: f64) -> Continuum {
     Continuum {
         length: 2.0,
         wave_speed: 1.0,
         load,
         constraint: true,
-        variant,
     }
+}
+
+/// `model` run to t = 3, no samples, no log.
+fn to_the_end(model: &mut impl LocalModel) -> Outcome {
+    simulate_local(model, &Options::until(3.0), &[], &mut |_, _| {}, &mut ())
 }
 
 fn paper(load: f64) -> u64 {
@@ -30,42 +34,19 @@ fn paper(load: f64) -> u64 {
         strain: 0.1,
         velocity: 0.0,
     };
-    let mut model = FrontTracking::new(string(load, Variant::Paper), &[start]).unwrap();
-    simulate_local(
-        &mut model,
-        &Options::until(3.0),
-        &[],
-        &mut |_, _| {},
-        &mut (),
-    )
-    .events
+    to_the_end(&mut FrontTracking::new(string(load), &[start]).unwrap()).events
 }
 
 fn homogenized(load: f64, cells: usize) -> u64 {
-    let mut model =
-        Homogenized::new(string(load, Variant::Homogenized), 0.1, cells, &[3.0]).unwrap();
-    simulate_local(
-        &mut model,
-        &Options::until(3.0),
-        &[],
-        &mut |_, _| {},
-        &mut (),
-    );
+    let mut model = Homogenized::new(string(load), 0.1, cells, &[3.0]).unwrap();
+    to_the_end(&mut model);
     model.steps()
 }
 
 fn chain(load: f64, units: usize) -> u64 {
     let chain = Chain::in_scene_units(units, 2.0, 1.0, load, true);
     let gap = 0.1 * chain.unit_length();
-    let mut model = TaylorChain::new(chain, &vec![gap; units], &vec![0.0; units]).unwrap();
-    simulate_local(
-        &mut model,
-        &Options::until(3.0),
-        &[],
-        &mut |_, _| {},
-        &mut (),
-    )
-    .events
+    to_the_end(&mut TaylorChain::new(chain, &vec![gap; units], &vec![0.0; units]).unwrap()).events
 }
 
 fn main() {

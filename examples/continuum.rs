@@ -10,9 +10,7 @@
 
 use flicker::engine::{LocalModel, Options, simulate_local};
 use flicker::models::chain::{Chain, TaylorChain};
-use flicker::models::continuum::{
-    Continuum, FrontTracking, Homogenized, Piece, StringModel, Variant,
-};
+use flicker::models::continuum::{Continuum, FrontTracking, Homogenized, Piece, StringModel};
 use flicker::time::Time;
 
 /// The loaded end's displacement at `times`, the wall time and the largest
@@ -39,19 +37,18 @@ fn end_displacement<M: LocalModel>(
 
 fn main() {
     let times: Vec<f64> = (0..=6).map(|i| 0.1 * i as f64).collect();
-    let string = |variant| Continuum {
+    let string = Continuum {
         length: 2.0,
         wave_speed: 1.0,
         load: 0.0,
         constraint: true,
-        variant,
     };
     let start = Piece {
         strain: 0.1,
         velocity: 0.0,
     };
-    let mut paper = FrontTracking::new(string(Variant::Paper), &[start]).unwrap();
-    let mut homogenized = Homogenized::new(string(Variant::Homogenized), 0.1, 200, &times).unwrap();
+    let mut paper = FrontTracking::new(string.clone(), &[start]).unwrap();
+    let mut homogenized = Homogenized::new(string, 0.1, 200, &times).unwrap();
     let chain = Chain::in_scene_units(400, 2.0, 1.0, 0.0, true);
     let gaps = vec![0.1 * chain.unit_length(); 400];
     let mut dense = TaylorChain::new(chain, &gaps, &vec![0.0; 400]).unwrap();

@@ -14,7 +14,9 @@
 
 use std::path::PathBuf;
 
-use flicker::compare_models::{Release, Track, chain_track, continuum_track, distance};
+use flicker::compare_models::{
+    Track, chain_track, continuum_track, distance, release, without_homogenized,
+};
 use flicker::engine::Status;
 use flicker::models::continuum::Variant;
 use flicker::runner::Control;
@@ -24,6 +26,9 @@ use crate::cli::exit::{Code, Failure};
 
 /// Largest chain run to probe a scene.
 pub const PROBE_UNITS: usize = 400;
+
+/// Times the models are compared at.
+const SAMPLES: usize = 121;
 
 /// `flicker advise`'s arguments.
 #[derive(Debug, clap::Args)]
@@ -47,22 +52,17 @@ pub fn advise(args: AdviseArgs) -> Result<Code, Failure> {
     if !(args.tolerance.is_finite() && args.tolerance > 0.0) {
         return Err(Failure::bad_input("--tolerance: a number > 0"));
     }
-    let release = Release::of(&scene).map_err(|e| Failure::bad_input(e.in_path(&args.scene)))?;
+    let mut release = release(&scene).map_err(|e| Failure::bad_input(e.in_path(&args.scene)))?;
+    release.samples = SAMPLES;
     let probe = chain.units.min(PROBE_UNITS);
     // One after another, so that each is timed alone.
-    let times = flicker::scene::extent::sample_times(release.t_end, 121);
     let control = Control::default();
     let mut runs = vec![
-        chain_track(&release, probe, &times, &control),
-        continuum_track(&release, Variant::Paper, &times, &control),
+        chain_track(&release, probe, &control),
+        continuum_track(&release, Variant::Paper, &control),
     ];
-    match release.without_homogenized() {
-        None => runs.push(continuum_track(
-            &release,
-            Variant::Homogenized,
-            &times,
-            &control,
-        )),
+    match without_homogenized(&release) {
+        None => runs.push(continuum_track(&release, Variant::Homogenized, &control)),
         Some(why) => say!("{why}"),
     }
     let tracks: Vec<Track> = runs

@@ -4,7 +4,9 @@
 use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
 
-use flicker::compare_models::{Model, Release, chart, distance, files, run_all};
+use flicker::compare_models::{
+    Model, chart, distance, files, release as release_of, run_all, without_homogenized,
+};
 use flicker::engine::Status;
 use flicker::log::summary::write_atomically;
 use flicker::models::continuum::Variant;
@@ -46,12 +48,12 @@ pub fn compare_models(args: CompareModelsArgs) -> Result<Code, Failure> {
         out,
     } = args;
     let scene = scene::load(&path).map_err(Failure::bad_input)?;
-    let mut release = Release::of(&scene).map_err(|e| Failure::bad_input(e.in_path(&path)))?;
+    let mut release = release_of(&scene).map_err(|e| Failure::bad_input(e.in_path(&path)))?;
     let most = flicker::scene::continuum::MAX_FINITE_VOLUMES;
     if !(2..=most).contains(&cells) {
         return Err(Failure::bad_input(format!("--cells: from 2 to {most}")));
     }
-    release.cells = cells;
+    release.resolution = cells;
     units.sort_unstable();
     units.dedup();
     if units.is_empty() || units[0] == 0 || *units.last().unwrap() > 100_000 {
@@ -76,7 +78,7 @@ pub fn compare_models(args: CompareModelsArgs) -> Result<Code, Failure> {
     };
     let mut models: Vec<Model> = units.iter().map(|&n| Model::Chain(n)).collect();
     models.push(Model::Continuum(Variant::Paper));
-    match release.without_homogenized() {
+    match without_homogenized(&release) {
         None => models.push(Model::Continuum(Variant::Homogenized)),
         Some(why) => say!("{why}"),
     }
@@ -90,7 +92,8 @@ pub fn compare_models(args: CompareModelsArgs) -> Result<Code, Failure> {
             .join(", "),
         release.t_end
     );
-    let tracks = run_all(&release, &models, samples, &control).map_err(Failure::bad_input)?;
+    release.samples = samples;
+    let tracks = run_all(&release, &models, &control).map_err(Failure::bad_input)?;
     if let Some(t) = tracks.iter().find(|t| t.status != Status::Completed) {
         let code = if stop.load(Ordering::Relaxed) {
             Code::Interrupted

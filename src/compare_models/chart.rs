@@ -65,7 +65,7 @@ pub fn draw_all(tracks: &[Track], reference: usize, dir: &Path) -> Result<Vec<Pa
         let mut curves = Vec::new();
         for (k, track) in tracks.iter().enumerate() {
             let dense = k == reference;
-            if !(dense || track.units.is_none()) {
+            if !(dense || track.units().is_none()) {
                 continue;
             }
             for (i, s) in track.snapshots.iter().enumerate() {

@@ -27,7 +27,7 @@ pub fn write_csvs(tracks: &[Track], dir: &Path) -> io::Result<()> {
         for s in &track.samples {
             w.write_record([
                 track.label.clone(),
-                optional(track.units),
+                optional(track.units()),
                 s.t.to_string(),
                 s.right_end.to_string(),
                 optional(s.front),
@@ -52,7 +52,7 @@ pub fn write_csvs(tracks: &[Track], dir: &Path) -> io::Result<()> {
             for j in 0..c.x.len() {
                 w.write_record([
                     track.label.clone(),
-                    optional(track.units),
+                    optional(track.units()),
                     s.t.to_string(),
                     c.x[j].to_string(),
                     c.strain[j].to_string(),
@@ -73,7 +73,7 @@ pub fn summary(tracks: &[Track], reference: &Track, distances: &[Distance]) -> V
         .map(|(t, d)| {
             json!({
                 "model": t.label,
-                "units": t.units,
+                "units": t.units(),
                 "status": t.status.as_str(),
                 "reason": t.reason,
                 "events": t.events,

@@ -18,13 +18,11 @@ use std::time::Instant;
 use rayon::prelude::*;
 
 use crate::engine::{LocalModel, Method, Options, Status, Tolerances, simulate_local};
-use crate::models::chain::TaylorChain;
 use crate::models::chain::coarse::{Coarse, WINDOW_WIDTH};
-use crate::models::continuum::{
-    Continuum, FrontTracking, Homogenized, Piece, StringModel, Variant,
-};
-use crate::runner::Control;
-use crate::scene::{Scene, SceneError};
+use crate::models::chain::{Chain, TaylorChain};
+use crate::models::continuum::{Piece, StringModel, Variant};
+use crate::runner::{self, Control};
+use crate::scene::{ContinuumScene, Scene, SceneError};
 use crate::time::Time;
 
 /// Fewest windows behind the front for a plateau to be measured.
@@ -37,105 +35,85 @@ pub const DEFAULT_CELLS: usize = 200;
 /// paper's string of length 2.
 pub const CENTRES: usize = 101;
 
-/// The release a comparison runs: a uniform string at rest at strain
-/// `load_before - 1`, its end load dropping to `load_after` at `t = 0`.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Release {
-    pub length: f64,
-    pub wave_speed: f64,
-    pub load_before: f64,
-    pub load_after: f64,
-    pub constraint: bool,
-    pub t_end: f64,
-    /// Times the coarse profiles are compared at.
-    pub snapshots: Vec<f64>,
-    pub max_events: u64,
-    /// Cells of the homogenized string.
-    pub cells: usize,
-}
-
-impl Release {
-    /// The release a chain or continuum scene describes; scenes with an
-    /// `initial` profile are refused (the models would not start alike).
-    pub fn of(scene: &Scene) -> Result<Self, SceneError> {
-        let uniform = |strains: &[f64], velocities: &[f64], rest: f64| {
-            strains.iter().all(|e| *e == rest) && velocities.iter().all(|v| *v == 0.0)
-        };
-        let refuse = || {
-            SceneError::field(
-                "initial",
-                "the models are compared from the release of a uniform string at rest; leave `initial` out".into(),
-            )
-        };
-        match scene {
-            Scene::Chain(c) => {
-                if !uniform(&c.strain, &c.velocity, c.load_before - 1.0) {
-                    return Err(refuse());
-                }
-                Ok(Release {
-                    length: c.length,
-                    wave_speed: c.wave_speed,
-                    load_before: c.load_before,
-                    load_after: c.load_after,
-                    constraint: c.constraint,
-                    t_end: c.t_end,
-                    snapshots: c.snapshots.clone(),
-                    max_events: c.max_events,
-                    cells: DEFAULT_CELLS,
-                })
-            }
-            Scene::Continuum(c) => {
-                let strains: Vec<f64> = c.cells.iter().map(|p| p.strain).collect();
-                let velocities: Vec<f64> = c.cells.iter().map(|p| p.velocity).collect();
-                if !uniform(&strains, &velocities, c.load_before - 1.0) {
-                    return Err(refuse());
-                }
-                Ok(Release {
-                    length: c.length,
-                    wave_speed: c.wave_speed,
-                    load_before: c.load_before,
-                    load_after: c.load_after,
-                    constraint: c.constraint,
-                    t_end: c.t_end,
-                    snapshots: c.snapshots.clone(),
-                    max_events: c.max_events,
-                    cells: DEFAULT_CELLS,
-                })
-            }
-            Scene::Mechanism(_) => Err(SceneError::field(
+/// The release a chain or continuum scene describes, as a continuum scene
+/// (the chain's string without its units), its homogenized string on
+/// [`DEFAULT_CELLS`]. Scenes with an `initial` profile are refused: the
+/// models would not start alike.
+pub fn release(scene: &Scene) -> Result<ContinuumScene, SceneError> {
+    let refuse = || {
+        SceneError::field(
+            "initial",
+            "the models are compared from the release of a uniform string at rest; leave `initial` out".into(),
+        )
+    };
+    let (c, uniform) = match scene {
+        Scene::Continuum(c) => (c.clone(), c.cells.len() == 1),
+        Scene::Chain(c) => {
+            let rest = c.load_before - 1.0;
+            let uniform =
+                c.strain.iter().all(|e| *e == rest) && c.velocity.iter().all(|v| *v == 0.0);
+            let string = ContinuumScene {
+                variant: Variant::Paper,
+                length: c.length,
+                wave_speed: c.wave_speed,
+                load_before: c.load_before,
+                load_after: c.load_after,
+                constraint: c.constraint,
+                t_end: c.t_end,
+                snapshots: c.snapshots.clone(),
+                samples: c.samples,
+                resolution: DEFAULT_CELLS,
+                cells: vec![Piece {
+                    strain: rest,
+                    velocity: 0.0,
+                }],
+                max_events: c.max_events,
+                description: None,
+            };
+            (string, uniform)
+        }
+        Scene::Mechanism(_) => {
+            return Err(SceneError::field(
                 "model",
                 "compares a chain with its continuum: give a chain or continuum scene".into(),
-            )),
+            ));
         }
+    };
+    if !uniform || c.cells[0].velocity != 0.0 {
+        return Err(refuse());
     }
+    Ok(ContinuumScene {
+        resolution: DEFAULT_CELLS,
+        ..c
+    })
+}
 
-    /// The strain the string starts at, against which the front is found.
-    pub fn undisturbed(&self) -> f64 {
-        self.load_before - 1.0
-    }
+/// The strain the string starts at, against which the front is found.
+fn undisturbed(release: &ContinuumScene) -> f64 {
+    release.cells[0].strain
+}
 
-    /// Why the homogenized string does not describe this release, if it
-    /// does not: it keeps the rattling the constraint causes, from a
-    /// stretched string.
-    pub fn without_homogenized(&self) -> Option<String> {
-        if !self.constraint {
-            Some("the homogenized string is left out: it describes the constrained string (this one's constraint is off)".into())
-        } else if self.undisturbed() <= 0.0 {
-            Some(format!(
-                "the homogenized string is left out: it starts from a stretched string (this one starts at strain {})",
-                self.undisturbed()
-            ))
-        } else {
-            None
-        }
+/// Why the homogenized string does not describe `release`, if it does
+/// not: it keeps the rattling the constraint causes, from a stretched
+/// string.
+pub fn without_homogenized(release: &ContinuumScene) -> Option<String> {
+    if !release.constraint {
+        Some("the homogenized string is left out: it describes the constrained string (this one's constraint is off)".into())
+    } else if undisturbed(release) <= 0.0 {
+        Some(format!(
+            "the homogenized string is left out: it starts from a stretched string (this one starts at strain {})",
+            undisturbed(release)
+        ))
+    } else {
+        None
     }
+}
 
-    /// The window centres, from the wall to the loaded end.
-    pub fn centres(&self) -> Vec<f64> {
-        (0..CENTRES)
-            .map(|j| -0.5 * self.length + self.length * j as f64 / (CENTRES - 1) as f64)
-            .collect()
-    }
+/// The window centres, from the wall to the loaded end.
+fn centres(release: &ContinuumScene) -> Vec<f64> {
+    (0..CENTRES)
+        .map(|j| -0.5 * release.length + release.length * j as f64 / (CENTRES - 1) as f64)
+        .collect()
 }
 
 /// One model's run, sampled.
@@ -143,16 +121,25 @@ impl Release {
 pub struct Track {
     /// `chain N=..` or `continuum (variant)`.
     pub label: String,
-    pub units: Option<usize>,
     pub model: Model,
     pub status: Status,
     pub reason: Option<String>,
     pub events: u64,
     pub wall_seconds: f64,
     pub max_energy_error: Option<f64>,
-    /// At the comparison's sample times, then at its snapshots.
+    /// At the release's sample times, then at its snapshots.
     pub samples: Vec<Sample>,
     pub snapshots: Vec<Sample>,
+}
+
+impl Track {
+    /// The chain's units, for a chain.
+    pub fn units(&self) -> Option<usize> {
+        match self.model {
+            Model::Chain(n) => Some(n),
+            Model::Continuum(_) => None,
+        }
+    }
 }
 
 /// A model at one time.
@@ -167,21 +154,20 @@ pub struct Sample {
 
 /// The chain of `units` on `release` (exact event-local flow, no log).
 pub fn chain_track(
-    release: &Release,
+    release: &ContinuumScene,
     units: usize,
-    times: &[f64],
     control: &Control,
 ) -> Result<Track, String> {
-    let chain = crate::models::chain::Chain::in_scene_units(
+    let chain = Chain::in_scene_units(
         units,
         release.length,
         release.wave_speed,
         release.load_after,
         release.constraint,
     );
-    let gaps = vec![release.undisturbed() * chain.unit_length(); units];
+    let gaps = vec![undisturbed(release) * chain.unit_length(); units];
     let mut model = TaylorChain::new(chain.clone(), &gaps, &vec![0.0; units])?;
-    let centres = release.centres();
+    let centres = centres(release);
     let cell = release.length / units as f64;
     let sample = |m: &TaylorChain, t: f64| {
         let at = Time::new(t);
@@ -203,7 +189,7 @@ pub fn chain_track(
             t,
             right_end: gaps.iter().sum(),
             energy: m.energy(at).unwrap_or(f64::NAN),
-            front: coarse.front(release.undisturbed()),
+            front: coarse.front(undisturbed(release)),
             coarse,
         }
     };
@@ -212,47 +198,32 @@ pub fn chain_track(
         Model::Chain(units),
         &mut model,
         release,
-        times,
         control,
         sample,
     )
 }
 
-/// The continuum `variant` on `release`.
+/// The continuum `variant` on `release`, built as `flicker run` builds it.
 pub fn continuum_track(
-    release: &Release,
+    release: &ContinuumScene,
     variant: Variant,
-    times: &[f64],
     control: &Control,
 ) -> Result<Track, String> {
-    let string = Continuum {
-        length: release.length,
-        wave_speed: release.wave_speed,
-        load: release.load_after,
-        constraint: release.constraint,
-        variant,
-    };
     let label = format!("continuum ({})", variant.name());
     // Energies are compared with the scene's load: where the paper's
     // continuum holds its end with more (F_cr), its own energy counts that
     // force's potential instead, which the scene's does not.
+    let string = release.string(release.constraint);
     let held = string.end_force() - string.load * string.critical_load();
+    let refused = |e: SceneError| e.to_string();
     match variant {
         Variant::Paper => {
-            let start = Piece {
-                strain: release.undisturbed(),
-                velocity: 0.0,
-            };
-            let mut model = FrontTracking::new(string, &[start])?;
-            string_track(label, variant, held, &mut model, release, times, control)
+            let mut model = runner::front_tracking(release, release.constraint).map_err(refused)?;
+            string_track(label, variant, held, &mut model, release, control)
         }
         Variant::Homogenized => {
-            let mut checkpoints = times.to_vec();
-            checkpoints.extend(&release.snapshots);
-            checkpoints.push(release.t_end);
-            let mut model =
-                Homogenized::new(string, release.undisturbed(), release.cells, &checkpoints)?;
-            string_track(label, variant, 0.0, &mut model, release, times, control)
+            let mut model = runner::homogenized(release).map_err(refused)?;
+            string_track(label, variant, 0.0, &mut model, release, control)
         }
     }
 }
@@ -263,11 +234,10 @@ fn string_track<M: StringModel>(
     variant: Variant,
     held: f64,
     model: &mut M,
-    release: &Release,
-    times: &[f64],
+    release: &ContinuumScene,
     control: &Control,
 ) -> Result<Track, String> {
-    let centres = release.centres();
+    let centres = centres(release);
     let sample = |m: &M, t: f64| {
         let at = Time::new(t);
         let coarse = m.coarse(&centres, at);
@@ -276,7 +246,7 @@ fn string_track<M: StringModel>(
             t,
             right_end,
             energy: m.energy(at).map_or(f64::NAN, |e| e + held * right_end),
-            front: coarse.front(release.undisturbed()),
+            front: coarse.front(undisturbed(release)),
             coarse,
         }
     };
@@ -285,19 +255,17 @@ fn string_track<M: StringModel>(
         Model::Continuum(variant),
         model,
         release,
-        times,
         control,
         sample,
     )
 }
 
-/// Run `model`, sampling at `times` and at the release's snapshots.
+/// Run `model`, sampling at the release's sample and snapshot times.
 fn track<M: LocalModel>(
     label: String,
     kind: Model,
     model: &mut M,
-    release: &Release,
-    times: &[f64],
+    release: &ContinuumScene,
     control: &Control,
     sample: impl Fn(&M, f64) -> Sample,
 ) -> Result<Track, String> {
@@ -307,15 +275,13 @@ fn track<M: LocalModel>(
         Method::Exact,
         Tolerances::default(),
     );
-    let mut all: Vec<f64> = times.iter().chain(&release.snapshots).copied().collect();
-    all.sort_by(f64::total_cmp);
-    all.dedup();
+    let times = release.sample_times();
     let mut taken = Vec::new();
     let started = Instant::now();
     let outcome = simulate_local(
         model,
         &options,
-        &all,
+        &release.due_times(),
         &mut |m: &M, t| taken.push(sample(m, t)),
         &mut (),
     );
@@ -329,17 +295,13 @@ fn track<M: LocalModel>(
     };
     Ok(Track {
         label,
-        units: match kind {
-            Model::Chain(n) => Some(n),
-            Model::Continuum(_) => None,
-        },
         model: kind,
         status: outcome.status,
         reason: outcome.reason,
         events: outcome.events,
         wall_seconds,
         max_energy_error: outcome.max_energy_error,
-        samples: pick(times),
+        samples: pick(&times),
         snapshots: pick(&release.snapshots),
     })
 }
@@ -347,7 +309,6 @@ fn track<M: LocalModel>(
 /// How far a track is from the reference (the densest chain).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Distance {
-    pub label: String,
     /// Largest `|right_end - reference|` over the sample times.
     pub right_end: f64,
     /// The same until the wave reflected at the wall is back at the loaded
@@ -443,7 +404,6 @@ pub fn distance(track: &Track, reference: &Track) -> Distance {
         .first()
         .map_or(1.0, |s| s.energy.abs().max(f64::MIN_POSITIVE));
     Distance {
-        label: track.label.clone(),
         right_end: largest(&mut paired().map(|(a, b)| (a.right_end - b.right_end).abs())),
         right_end_before_return: largest(&mut before_return.into_iter()),
         returned,
@@ -488,19 +448,18 @@ pub enum Model {
     Continuum(Variant),
 }
 
-/// Run every model on `release`, in parallel, sampled at `samples` times.
+/// Run every model on `release`, in parallel, sampled at its sample and
+/// snapshot times.
 pub fn run_all(
-    release: &Release,
+    release: &ContinuumScene,
     models: &[Model],
-    samples: usize,
     control: &Control,
 ) -> Result<Vec<Track>, String> {
-    let times = crate::scene::extent::sample_times(release.t_end, samples);
     models
         .par_iter()
         .map(|&model| match model {
-            Model::Chain(n) => chain_track(release, n, &times, control),
-            Model::Continuum(v) => continuum_track(release, v, &times, control),
+            Model::Chain(n) => chain_track(release, n, control),
+            Model::Continuum(v) => continuum_track(release, v, control),
         })
         .collect()
 }

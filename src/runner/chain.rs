@@ -41,15 +41,6 @@ impl<'s> Sampler<'s> {
         }
     }
 
-    /// Every time due (snapshots and samples merged), in order.
-    fn times(&self) -> Vec<f64> {
-        let mut times: Vec<f64> = self.scene.snapshots.clone();
-        times.extend(self.scene.sample_times());
-        times.sort_by(f64::total_cmp);
-        times.dedup();
-        times
-    }
-
     /// Record what is due at `t` from the exact flow.
     fn sample(&mut self, model: &TaylorChain, t: f64) {
         self.at(t, || {
@@ -130,7 +121,7 @@ pub(super) fn run(
         let mut model = TaylorChain::new(classical.clone(), &gaps, &scene.velocity)
             .map_err(|why| SceneError::field("initial", why))?;
         let mut sampler = Sampler::new(scene, &classical);
-        let times = sampler.times();
+        let times = scene.due_times();
         let companion = simulate_local(
             &mut model,
             &options,
@@ -162,7 +153,7 @@ fn run_exact(
         .map_err(|why| SceneError::field("initial", why))?;
     let (order, reach) = model.order_and_reach();
     let mut sampler = Sampler::new(scene, chain);
-    let times = sampler.times();
+    let times = scene.due_times();
     let outcome = simulate_local(
         &mut model,
         options,
@@ -220,7 +211,7 @@ fn run_ode(
         .chain(scene.velocity.iter().copied())
         .collect();
     let mut sampler = Sampler::new(scene, chain);
-    let mut stops = sampler.times();
+    let mut stops = scene.due_times();
     stops.push(scene.t_end);
     let energy_initial = chain.energy(0, &x).unwrap_or(0.0);
     let scale = chain.energy_scale(energy_initial);

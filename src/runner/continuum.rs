@@ -14,11 +14,9 @@ pub(super) fn run(
     control: &Control,
     observer: &mut dyn Observer,
 ) -> Result<Report, SceneError> {
-    let refuse = |why: String| SceneError::field("initial", why);
-    let string = scene.string(scene.constraint);
     let (outcome, mut fields) = match scene.variant {
         Variant::Paper => {
-            let mut model = FrontTracking::new(string.clone(), &scene.cells).map_err(refuse)?;
+            let mut model = front_tracking(scene, scene.constraint)?;
             run_model(scene, &mut model, control, observer)
         }
         Variant::Homogenized => {
@@ -27,8 +25,7 @@ pub(super) fn run(
         }
     };
     if scene.constraint && outcome.status == Status::Completed {
-        let mut classical =
-            FrontTracking::new(scene.string(false), &scene.cells).map_err(refuse)?;
+        let mut classical = front_tracking(scene, false)?;
         let (companion, sampled) = sample(scene, &mut classical, control, &mut ());
         // A companion cut short (interrupted) is left out, not shown half.
         if companion.status == Status::Completed {
@@ -53,9 +50,18 @@ pub(super) fn run(
     })
 }
 
+/// The paper's string of `scene`, with the constraint on or off.
+pub fn front_tracking(
+    scene: &ContinuumScene,
+    constraint: bool,
+) -> Result<FrontTracking, SceneError> {
+    FrontTracking::new(scene.string(constraint), &scene.cells)
+        .map_err(|why| SceneError::field("initial", why))
+}
+
 /// The homogenized string of `scene`, its steps landing on every sample
 /// and snapshot time.
-fn homogenized(scene: &ContinuumScene) -> Result<Homogenized, SceneError> {
+pub fn homogenized(scene: &ContinuumScene) -> Result<Homogenized, SceneError> {
     let first = scene.cells[0];
     if scene.cells.iter().any(|&c| c != first) || first.velocity != 0.0 {
         return Err(SceneError::field(
@@ -63,8 +69,7 @@ fn homogenized(scene: &ContinuumScene) -> Result<Homogenized, SceneError> {
             "the homogenized string starts from a uniform string at rest".into(),
         ));
     }
-    let mut checkpoints = scene.sample_times();
-    checkpoints.extend(&scene.snapshots);
+    let mut checkpoints = scene.due_times();
     checkpoints.push(scene.t_end);
     Homogenized::new(
         scene.string(scene.constraint),
@@ -152,10 +157,7 @@ fn sample<M: StringModel>(
     );
     let mut snapshots = scene.snapshots.iter().copied().peekable();
     let mut samples = scene.sample_times().into_iter().peekable();
-    let mut times: Vec<f64> = scene.snapshots.clone();
-    times.extend(scene.sample_times());
-    times.sort_by(f64::total_cmp);
-    times.dedup();
+    let times = scene.due_times();
     let points = scene.profile_points();
     let mut sampled = Sampled {
         profiles: Vec::new(),

@@ -13,6 +13,7 @@ use std::sync::atomic::AtomicBool;
 use crate::engine::{Method, Observer, Options, Outcome, Tolerances};
 use crate::scene::{Scene, SceneError};
 
+pub use continuum::{front_tracking, homogenized};
 pub use fields::{CLASSICAL_MAX_UNITS, Classical, FieldOutputs, Profile, TraceRow};
 
 /// A finished run and what the summary needs to say about it.

@@ -79,6 +79,11 @@ impl ChainScene {
     pub fn sample_times(&self) -> Vec<f64> {
         extent::sample_times(self.t_end, self.samples)
     }
+
+    /// Every time the run samples (snapshots and trace rows).
+    pub fn due_times(&self) -> Vec<f64> {
+        extent::due_times(&self.snapshots, self.sample_times())
+    }
 }
 
 pub(crate) fn validate(mut f: Fields) -> Result<ChainScene, SceneError> {

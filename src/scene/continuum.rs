@@ -66,13 +66,17 @@ impl ContinuumScene {
             wave_speed: self.wave_speed,
             load: self.load_after,
             constraint,
-            variant: self.variant,
         }
     }
 
     /// The times `trace.csv` samples: `linspace(0, t_end, samples)`.
     pub fn sample_times(&self) -> Vec<f64> {
         extent::sample_times(self.t_end, self.samples)
+    }
+
+    /// Every time the run samples (snapshots and trace rows).
+    pub fn due_times(&self) -> Vec<f64> {
+        extent::due_times(&self.snapshots, self.sample_times())
     }
 
     /// The centres of the `resolution` cells `profiles.json` samples.

@@ -74,6 +74,16 @@ pub fn sample_times(t_end: f64, samples: usize) -> Vec<f64> {
     }
 }
 
+/// Every time a run samples: its snapshots and sample times merged, in
+/// order, without repeats.
+pub fn due_times(snapshots: &[f64], samples: Vec<f64>) -> Vec<f64> {
+    let mut times = samples;
+    times.extend(snapshots);
+    times.sort_by(f64::total_cmp);
+    times.dedup();
+    times
+}
+
 /// An array of finite numbers at `path`, of length `len` (one per `what`)
 /// if given.
 pub fn numbers(

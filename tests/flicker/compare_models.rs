@@ -4,16 +4,17 @@
 //! reading an end that moves too slowly), and scenes it cannot compare
 //! refused.
 
-use flicker::compare_models::{Model, Release, distance, run_all};
+use flicker::compare_models::{Model, distance, release as release_of, run_all};
 use flicker::models::continuum::Variant;
 use flicker::runner::Control;
 use flicker::scene;
+use flicker::scene::ContinuumScene;
 
 use crate::support::{flicker, models, read_json};
 
-fn release(name: &str) -> Release {
+fn release(name: &str) -> ContinuumScene {
     let scene = scene::load(std::path::Path::new(&models(name))).unwrap();
-    Release::of(&scene).unwrap()
+    release_of(&scene).unwrap()
 }
 
 #[test]
@@ -25,7 +26,8 @@ fn the_paper_continuum_front_runs_at_c_and_its_free_end_lags_the_chain() {
         Model::Chain(100),
         Model::Continuum(Variant::Paper),
     ];
-    let tracks = run_all(&free, &models, 41, &Control::default()).unwrap();
+    free.samples = 41;
+    let tracks = run_all(&free, &models, &Control::default()).unwrap();
     let reference = &tracks[1];
     let d: Vec<_> = tracks.iter().map(|t| distance(t, reference)).collect();
     assert_eq!(d[1].right_end, 0.0);

@@ -4,7 +4,7 @@
 //! round-off, and compression the paper's continuum cannot carry refused.
 
 use flicker::engine::{LocalModel, Options, Recorder, Status, simulate_local};
-use flicker::models::continuum::{Continuum, FrontTracking, Piece, StringModel, Variant};
+use flicker::models::continuum::{Continuum, FrontTracking, Piece, StringModel};
 use flicker::scene::{self, Scene};
 use flicker::time::Time;
 
@@ -16,7 +16,6 @@ fn string(load: f64, constraint: bool, wave_speed: f64) -> Continuum {
         wave_speed,
         load,
         constraint,
-        variant: Variant::Paper,
     }
 }
 

@@ -15,7 +15,6 @@ fn string(load: f64) -> Continuum {
         wave_speed: 1.0,
         load,
         constraint: true,
-        variant: Variant::Homogenized,
     }
 }
 
@@ -136,15 +135,16 @@ fn a_homogenized_scene_runs_and_says_what_it_used() {
 fn against_the_traction_free_chain_it_meets_the_figures_the_issue_sets() {
     // Chain N = 200 (its own plateau within 0.2% of N = 1600's) and the
     // homogenized string on 100 cells, to just past the wave's return.
-    use flicker::compare_models::{Model, Release, distance, run_all};
+    use flicker::compare_models::{Model, distance, release, run_all};
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("models/continuum_release_free_end.json");
-    let mut release = Release::of(&scene::load(&path).unwrap()).unwrap();
+    let mut release = release(&scene::load(&path).unwrap()).unwrap();
     release.t_end = 0.7;
     release.snapshots = vec![0.3];
-    release.cells = 100;
+    release.samples = 57;
+    release.resolution = 100;
     let models = [Model::Chain(200), Model::Continuum(Variant::Homogenized)];
-    let tracks = run_all(&release, &models, 57, &Default::default()).unwrap();
+    let tracks = run_all(&release, &models, &Default::default()).unwrap();
     let d = distance(&tracks[1], &tracks[0]);
     let (ours, chain) = (
         d.front_speed.unwrap(),

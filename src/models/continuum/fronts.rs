@@ -156,11 +156,6 @@ impl FrontTracking {
         &self.string
     }
 
-    /// Number of fronts now.
-    pub fn front_count(&self) -> usize {
-        self.fronts.len()
-    }
-
     /// The edges of the pieces at `t`: the wall, every front, the end.
     fn edges(&self, t: f64) -> impl Iterator<Item = f64> + '_ {
         let c = self.string.wave_speed;
@@ -171,11 +166,10 @@ impl FrontTracking {
 
     /// Each piece with its extent `[a, b]` at `t`.
     fn extents(&self, t: f64) -> impl Iterator<Item = (Piece, f64, f64)> + '_ {
-        let edges: Vec<f64> = self.edges(t).collect();
         self.pieces
             .iter()
-            .enumerate()
-            .map(move |(i, &p)| (p, edges[i], edges[i + 1]))
+            .zip(self.edges(t).zip(self.edges(t).skip(1)))
+            .map(|(&p, (a, b))| (p, a, b))
     }
 
     fn wall_given_until(&self, t: f64) -> f64 {

@@ -28,8 +28,13 @@
 //! carries the cells to `t_{k+1}`, the next step or the next checkpoint
 //! given at construction, whichever is sooner, and schedules itself there.
 //! The cells are therefore always at the time of the next pending step, so
-//! a sample taken at a checkpoint sees them exactly at its time; the
-//! observations of this model are meant for checkpoints only.
+//! a sample taken at a checkpoint sees them exactly at its time (the engine
+//! takes a sample before the events due at its time). The observations of
+//! this model are of the cells at that time and meant for checkpoints only;
+//! its energy elsewhere is `None`, so an audit or a trace off a checkpoint
+//! shows a gap rather than a value of another time. (Steps land where the
+//! model is told, not where the engine samples: a time-stepped model has
+//! its state only at its steps.)
 
 use std::ops::Range;
 
@@ -401,7 +406,10 @@ impl LocalModel for Homogenized {
         })
     }
 
-    fn energy(&self, _: Time) -> Option<f64> {
+    fn energy(&self, t: Time) -> Option<f64> {
+        if t.value() != self.at {
+            return None;
+        }
         let h = self.width();
         let stored: f64 = self.cells.iter().map(|c| c.energy * h).sum();
         let load = self.string.load * self.string.critical_load();

@@ -82,7 +82,6 @@ pub struct Continuum {
     pub load: f64,
     /// Whether `eps >= 0` is enforced (`false`: the classical string).
     pub constraint: bool,
-    pub variant: Variant,
 }
 
 /// A constant state of the string.
@@ -174,7 +173,6 @@ mod tests {
             wave_speed: 2.0,
             load: 0.5,
             constraint: false,
-            variant: Variant::Paper,
         }
     }
 
