@@ -90,10 +90,14 @@ pub fn settings(scene: &Scene) -> Vec<SolverSpec> {
                 spec("exact", None, None),
                 spec("linear", None, None),
                 spec("dopri5", Some(TOLERANCE), None),
+                spec("dop853", Some(TOLERANCE), None),
                 spec("verlet", None, Some(period * STEP_FRACTION)),
             ]
         }
-        Scene::Mechanism(_) => vec![spec("dopri5", Some(TOLERANCE), None)],
+        Scene::Mechanism(_) => vec![
+            spec("dopri5", Some(TOLERANCE), None),
+            spec("dop853", Some(TOLERANCE), None),
+        ],
         Scene::Chain(_) | Scene::Continuum(_) => Vec::new(),
     }
 }

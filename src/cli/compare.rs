@@ -76,10 +76,10 @@ pub fn compare(
 fn applicable(scene: &Scene) -> Vec<String> {
     let names: &[&str] = match scene {
         Scene::Mechanism(m) if m.formulation == Formulation::Strain => {
-            &["exact", "linear", "dopri5", "verlet"]
+            &["exact", "linear", "dopri5", "dop853", "verlet"]
         }
-        Scene::Mechanism(_) => &["dopri5"],
-        Scene::Chain(_) => &["exact", "linear", "dopri5", "verlet"],
+        Scene::Mechanism(_) => &["dopri5", "dop853"],
+        Scene::Chain(_) => &["exact", "linear", "dopri5", "dop853", "verlet"],
         Scene::Continuum(_) => &["exact"],
     };
     names.iter().map(|s| s.to_string()).collect()

@@ -66,14 +66,14 @@ pub struct EnsembleFlags {
 /// Flags that override a scene's `solver`.
 #[derive(Debug, clap::Args)]
 pub struct SolverFlags {
-    /// Method: exact, linear, dopri5 or verlet (default: the scene's, else
+    /// Method: exact, linear, dopri5, dop853 or verlet (default: the scene's, else
     /// the cheapest exact description of the model).
     #[arg(long, value_name = "M")]
     method: Option<String>,
-    /// Relative tolerance (dopri5).
+    /// Relative tolerance (dopri5, dop853).
     #[arg(long, value_name = "R", allow_negative_numbers = true)]
     rtol: Option<f64>,
-    /// Absolute tolerance (dopri5).
+    /// Absolute tolerance (dopri5, dop853).
     #[arg(long, value_name = "A", allow_negative_numbers = true)]
     atol: Option<f64>,
     /// Fixed step (verlet).

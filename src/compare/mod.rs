@@ -59,7 +59,7 @@ pub fn compare(
     let mut rows = Vec::new();
     for method in &plan.methods {
         let settings: Vec<SolverSpec> = match method.as_str() {
-            "dopri5" => plan
+            "dopri5" | "dop853" => plan
                 .tolerances
                 .iter()
                 .map(|&tol| spec(method, Some(tol), None))

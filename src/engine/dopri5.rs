@@ -11,7 +11,11 @@
 // Stage sums read several arrays at one index: an index loop says it plainly.
 #![allow(clippy::needless_range_loop)]
 
+use crate::engine::adaptive::{StepFailure, Tolerances, initial_step, shrink};
 use crate::engine::model::{HybridModel, Mode};
+
+/// The order of the error estimate in the step size.
+const ORDER: i32 = 5;
 
 const A21: f64 = 1.0 / 5.0;
 const A31: f64 = 3.0 / 40.0;
@@ -45,36 +49,6 @@ const D4: f64 = -10690763975.0 / 1880347072.0;
 const D5: f64 = 701980252875.0 / 199316789632.0;
 const D6: f64 = -1453857185.0 / 822651844.0;
 const D7: f64 = 69997945.0 / 29380423.0;
-
-/// Relative and absolute error tolerances of an adaptive step.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Tolerances {
-    pub rtol: f64,
-    pub atol: f64,
-}
-
-impl Default for Tolerances {
-    /// Tight enough that the angle formulation agrees with the exact strain
-    /// flow to about 1e-9 over a hundred impacts.
-    fn default() -> Self {
-        Tolerances {
-            rtol: 1e-12,
-            atol: 1e-12,
-        }
-    }
-}
-
-/// Why a step could not be taken.
-#[derive(Debug, Clone, PartialEq)]
-pub enum StepFailure {
-    /// The error control asked for a step below `h_min`: the solution is
-    /// (nearly) singular here.
-    Collapsed { h: f64 },
-    /// The right-hand side returned a non-finite value.
-    NonFinite,
-    /// The method cannot integrate this mode (said why).
-    NotApplicable(String),
-}
 
 /// The dense output of one accepted step, as a function of `tau in [0, h]`.
 #[derive(Debug, Clone, Default)]
@@ -177,7 +151,21 @@ impl Dopri5 {
         }
         let mut h = match (self.fsal, self.h_next) {
             (true, Some(h)) => h,
-            _ => self.initial_step(model, mode, y0, h_max),
+            _ => {
+                let [f0, f1, ..] = &mut self.k;
+                self.evaluations += 1;
+                initial_step(
+                    model,
+                    mode,
+                    self.tol,
+                    ORDER,
+                    y0,
+                    f0,
+                    &mut self.scratch,
+                    f1,
+                    h_max,
+                )
+            }
         }
         .min(h_max);
         loop {
@@ -190,13 +178,13 @@ impl Dopri5 {
                 continue;
             }
             if err <= 1.0 {
-                let grow = (0.9 * shrink(err)).min(5.0);
+                let grow = (0.9 * shrink(err, ORDER)).min(5.0);
                 self.h_next = Some(h * grow.max(1.0));
                 self.local_error = self.trial_error;
                 self.finish(y0, h);
                 return Ok(());
             }
-            h *= (0.9 * shrink(err)).max(0.2);
+            h *= (0.9 * shrink(err, ORDER)).max(0.2);
         }
     }
 
@@ -247,7 +235,7 @@ impl Dopri5 {
                     + E5 * k[4][i]
                     + E6 * k[5][i]
                     + E7 * k[6][i]);
-            let scale = self.tol.atol + self.tol.rtol * y0[i].abs().max(self.y1[i].abs());
+            let scale = self.tol.scale(y0[i].abs().max(self.y1[i].abs()));
             sum += (e / scale).powi(2);
             self.trial_error = self.trial_error.max(e.abs());
         }
@@ -281,49 +269,4 @@ impl Dopri5 {
         self.k.swap(0, 6);
         self.fsal = true;
     }
-
-    /// Hairer's starting step: the size at which an Euler step's change and
-    /// its second-derivative estimate both stay within tolerance.
-    fn initial_step<M: HybridModel + ?Sized>(
-        &mut self,
-        model: &M,
-        mode: Mode,
-        y0: &[f64],
-        h_max: f64,
-    ) -> f64 {
-        let tol = self.tol;
-        let scale = |y: f64| tol.atol + tol.rtol * y.abs();
-        let n = y0.len() as f64;
-        let norm = |v: &dyn Fn(usize) -> f64| {
-            ((0..y0.len()).map(|i| v(i).powi(2)).sum::<f64>() / n).sqrt()
-        };
-        let d0 = norm(&|i| y0[i] / scale(y0[i]));
-        let d1 = norm(&|i| self.k[0][i] / scale(y0[i]));
-        let h0 = if d0 < 1e-5 || d1 < 1e-5 {
-            1e-6
-        } else {
-            0.01 * d0 / d1
-        }
-        .min(h_max);
-        for i in 0..y0.len() {
-            self.scratch[i] = y0[i] + h0 * self.k[0][i];
-        }
-        let y = std::mem::take(&mut self.scratch);
-        self.eval(model, mode, &y, 1);
-        self.scratch = y;
-        let d2 = norm(&|i| (self.k[1][i] - self.k[0][i]) / scale(y0[i])) / h0;
-        let h1 = if d1.max(d2) <= 1e-15 {
-            (h0 * 1e-3).max(1e-6)
-        } else {
-            (0.01 / d1.max(d2)).powf(0.2)
-        };
-        (100.0 * h0).min(h1).min(h_max)
-    }
-}
-
-/// `err^(-1/5)`, the step-size factor of a fifth-order method. Step control
-/// needs two digits, not sixteen: single precision halves its cost, which
-/// matters when the right-hand side is cheap.
-fn shrink(err: f64) -> f64 {
-    f64::from((err as f32).powf(-0.2))
 }

@@ -5,7 +5,9 @@
 //! [`Motion`] is what it means for one mode: the model's exact flow, a
 //! frozen state, or steps of the chosen integrator.
 
-use crate::engine::dopri5::{Dopri5, StepFailure, Tolerances};
+use crate::engine::adaptive::{StepFailure, Tolerances};
+use crate::engine::dop853::Dop853;
+use crate::engine::dopri5::Dopri5;
 use crate::engine::linear::Linear;
 use crate::engine::locate::Interpolant;
 use crate::engine::model::{Flow, HybridModel, Mode};
@@ -23,6 +25,8 @@ pub enum Method {
     Linear,
     /// Dormand-Prince 5(4) with these tolerances.
     Dopri5(Tolerances),
+    /// Dormand and Prince's 8th-order pair DOP853 with these tolerances.
+    Dop853(Tolerances),
     /// Stormer-Verlet with this fixed step.
     Verlet { step: f64 },
 }
@@ -35,6 +39,7 @@ impl Method {
             Method::Exact => "exact",
             Method::Linear => "linear",
             Method::Dopri5(_) => "dopri5",
+            Method::Dop853(_) => "dop853",
             Method::Verlet { .. } => "verlet",
         }
     }
@@ -65,9 +70,13 @@ pub fn motion<M: HybridModel + ?Sized>(
         (_, Method::Linear) if model.linear(mode).is_none() => Err(format!(
             "mode `{name}` is not a linear flow x' = A x + b, so the linear propagator cannot run it"
         )),
-        (_, Method::Dopri5(_) | Method::Verlet { .. }) if !model.has_rhs(mode) => Err(format!(
-            "mode `{name}` gives no right-hand side to integrate"
-        )),
+        (_, Method::Dopri5(_) | Method::Dop853(_) | Method::Verlet { .. })
+            if !model.has_rhs(mode) =>
+        {
+            Err(format!(
+                "mode `{name}` gives no right-hand side to integrate"
+            ))
+        }
         (_, Method::Verlet { .. }) if !model.second_order(mode) => Err(format!(
             "mode `{name}` is not of the form q'' = a(q) (its acceleration depends on the velocity), which Stormer-Verlet needs"
         )),
@@ -81,6 +90,7 @@ pub fn motion<M: HybridModel + ?Sized>(
 #[allow(clippy::large_enum_variant)]
 pub enum Integrator {
     Dopri5(Dopri5),
+    Dop853(Dop853),
     Verlet(Verlet),
     Linear(Linear),
 }
@@ -93,6 +103,7 @@ impl Integrator {
             Method::Verlet { step } => Integrator::Verlet(Verlet::new(dimension, step)),
             Method::Linear => Integrator::Linear(Linear::new(dimension)),
             Method::Dopri5(tol) => Integrator::Dopri5(Dopri5::new(dimension, tol)),
+            Method::Dop853(tol) => Integrator::Dop853(Dop853::new(dimension, tol)),
             Method::Auto | Method::Exact => Integrator::Dopri5(Dopri5::new(dimension, tolerances)),
         }
     }
@@ -101,6 +112,7 @@ impl Integrator {
     pub fn name(&self) -> &'static str {
         match self {
             Integrator::Dopri5(_) => "Dormand-Prince",
+            Integrator::Dop853(_) => "DOP853",
             Integrator::Verlet(_) => "Stormer-Verlet",
             Integrator::Linear(_) => "linear propagator",
         }
@@ -110,6 +122,7 @@ impl Integrator {
     pub fn restart(&mut self) {
         match self {
             Integrator::Dopri5(m) => m.restart(),
+            Integrator::Dop853(m) => m.restart(),
             Integrator::Verlet(m) => m.restart(),
             Integrator::Linear(m) => m.restart(),
         }
@@ -126,6 +139,7 @@ impl Integrator {
     ) -> Result<(), StepFailure> {
         match self {
             Integrator::Dopri5(m) => m.step(model, mode, y0, h_max, h_min),
+            Integrator::Dop853(m) => m.step(model, mode, y0, h_max, h_min),
             Integrator::Verlet(m) => m.step(model, mode, y0, h_max, h_min),
             Integrator::Linear(m) => m.step(model, mode, y0, h_max, h_min),
         }
@@ -135,6 +149,7 @@ impl Integrator {
     pub fn h(&self) -> f64 {
         match self {
             Integrator::Dopri5(m) => m.dense().h,
+            Integrator::Dop853(m) => m.dense().h,
             Integrator::Verlet(m) => m.h(),
             Integrator::Linear(m) => m.h(),
         }
@@ -144,6 +159,7 @@ impl Integrator {
     pub fn eval(&self, tau: f64, x: &mut [f64]) {
         match self {
             Integrator::Dopri5(m) => m.dense().eval(tau, x),
+            Integrator::Dop853(m) => m.dense().eval(tau, x),
             Integrator::Verlet(m) => m.eval(tau, x),
             Integrator::Linear(m) => m.eval(tau, x),
         }
@@ -153,6 +169,7 @@ impl Integrator {
     pub fn end(&self, x: &mut [f64]) {
         match self {
             Integrator::Dopri5(m) => m.dense().end(x),
+            Integrator::Dop853(m) => m.dense().end(x),
             Integrator::Verlet(m) => m.end(x),
             Integrator::Linear(m) => m.end(x),
         }
@@ -161,8 +178,33 @@ impl Integrator {
     /// What kind of function of the step time the dense output is.
     pub fn interpolant(&self) -> Interpolant {
         match self {
-            Integrator::Dopri5(_) | Integrator::Verlet(_) => Interpolant::Polynomial,
+            Integrator::Dopri5(_) => Interpolant::Polynomial { degree: 4 },
+            Integrator::Dop853(_) => Interpolant::Polynomial { degree: 7 },
+            // A cubic Hermite interpolant is a quartic with a zero top coefficient.
+            Integrator::Verlet(_) => Interpolant::Polynomial { degree: 4 },
             Integrator::Linear(_) => Interpolant::Other,
+        }
+    }
+
+    /// Sharpen a crossing at `tau` into the last step where the method's
+    /// dense output is less accurate than its steps (DOP853, see
+    /// [`Dop853::sharpen`]); `None` for the others and where sharpening
+    /// declines, leaving the dense output's crossing as it was.
+    #[allow(clippy::too_many_arguments)]
+    pub fn sharpen<M: HybridModel + ?Sized>(
+        &mut self,
+        model: &M,
+        mode: Mode,
+        y0: &[f64],
+        tau: f64,
+        reach: f64,
+        guard: &dyn Fn(&[f64]) -> f64,
+        crossed: &dyn Fn(f64) -> bool,
+        x: &mut [f64],
+    ) -> Option<f64> {
+        match self {
+            Integrator::Dop853(m) => m.sharpen(model, mode, y0, tau, reach, guard, crossed, x),
+            _ => None,
         }
     }
 
@@ -170,6 +212,7 @@ impl Integrator {
     pub fn local_error(&self) -> f64 {
         match self {
             Integrator::Dopri5(m) => m.local_error(),
+            Integrator::Dop853(m) => m.local_error(),
             Integrator::Verlet(m) => m.local_error(),
             Integrator::Linear(m) => m.local_error(),
         }
@@ -179,6 +222,7 @@ impl Integrator {
     pub fn evaluations(&self) -> u64 {
         match self {
             Integrator::Dopri5(m) => m.evaluations,
+            Integrator::Dop853(m) => m.evaluations,
             Integrator::Verlet(m) => m.evaluations,
             Integrator::Linear(m) => m.evaluations(),
         }

@@ -12,7 +12,7 @@ use std::cell::Cell;
 
 use nalgebra::{DMatrix, DVector};
 
-use crate::engine::dopri5::StepFailure;
+use crate::engine::adaptive::StepFailure;
 use crate::engine::model::{HybridModel, Mode};
 
 #[derive(Debug, Clone)]

@@ -1,10 +1,12 @@
 //! Finding the first crossing of a guard inside one integration step.
 //!
-//! The step's dense output is a quartic polynomial in the normalised step
-//! time `s in [0, 1]`. What is guaranteed:
+//! The step's dense output is a polynomial in the normalised step time
+//! `s in [0, 1]` (a quartic for Dormand-Prince and Stormer-Verlet, degree
+//! seven for DOP853). What is guaranteed:
 //!
-//! - **Affine guards** (declared with [`Guard::affine`]) are quartics in `s`
-//!   too. We recover that quartic from five samples and isolate every one of
+//! - **Affine guards** (declared with [`Guard::affine`]) are polynomials of
+//!   the same degree in `s`. We recover one from `degree + 1` equispaced
+//!   samples and isolate every one of
 //!   its real roots in `[0, 1]` by recursion on derivatives: between two
 //!   consecutive critical points a polynomial is monotone, so each sign
 //!   change there is exactly one root. A guard that dips through zero and
@@ -75,6 +77,12 @@ pub fn scan_step(
             margin: f64::INFINITY,
         };
     }
+    // Fits of a fixed size, so their loops unroll: a quartic takes
+    // polynomials up to degree four, a septic the rest.
+    let (septic, depth) = match interpolant {
+        Interpolant::Polynomial { degree } => (degree > 4, MAX_DEPTH),
+        Interpolant::Other => (false, 0),
+    };
     let piece = Piece {
         a: 0.0,
         b: 1.0,
@@ -82,20 +90,20 @@ pub fn scan_step(
         g_a: g0,
         check_start,
     };
-    let depth = if interpolant == Interpolant::Polynomial {
-        MAX_DEPTH
+    if septic {
+        scan_piece::<8>(guard.direction, piece, resolution, &mut g, depth)
     } else {
-        0
-    };
-    scan_piece(guard.direction, piece, resolution, &mut g, depth)
+        scan_piece::<5>(guard.direction, piece, resolution, &mut g, depth)
+    }
 }
 
 /// What the step's dense output is, as far as event location cares.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Interpolant {
-    /// A polynomial of degree four or less in the step time: a quartic
-    /// through five samples of an affine guard is the guard itself.
-    Polynomial,
+    /// A polynomial of at most this degree (at most seven) in the step
+    /// time: the polynomial through `degree + 1` samples of an affine guard
+    /// is the guard itself.
+    Polynomial { degree: usize },
     /// Anything else (the exact linear propagator): pieces are halved until
     /// a quartic fits.
     Other,
@@ -112,17 +120,22 @@ struct Piece {
     check_start: bool,
 }
 
+/// The highest degree of dense output the scan takes.
+const MAX_DEGREE: usize = 7;
+/// The fraction of a piece's guard values below which a guard leaving zero
+/// has not visibly moved (see [`fires_at_start`]).
+const VISIBLE: f64 = 1e-10;
 /// Halvings allowed when the interpolant is not a polynomial.
 const MAX_DEPTH: u32 = 24;
 /// A quartic fits a polynomial interpolant to round-off; a worse fit means
 /// the interpolant is something else (the exact linear propagator).
 const FIT_TOLERANCE: f64 = 1e-13;
 
-/// Scan one piece with the quartic through five samples of it. Where the
-/// quartic misses the guard at the midpoints by more than round-off and
-/// comes that close to zero, a crossing could hide in the misfit: halve the
-/// piece and scan both halves.
-fn scan_piece(
+/// Scan one piece with the polynomial of degree `N - 1` through `N`
+/// equispaced samples of it. Where it misses the guard between the samples by more
+/// than round-off and comes that close to zero, a crossing could hide in
+/// the misfit: halve the piece and scan both halves.
+fn scan_piece<const N: usize>(
     direction: Direction,
     piece: Piece,
     resolution: f64,
@@ -137,10 +150,17 @@ fn scan_piece(
         check_start,
     } = piece;
     let w = b - a;
-    let samples: [f64; 5] = [g_a, g(a + 0.25 * w), g(a + 0.5 * w), g(a + 0.75 * w), g(b)];
-    let poly = quartic_through(&samples);
+    let degree = N - 1;
+    let step = 1.0 / degree as f64;
+    let samples: [f64; N] = std::array::from_fn(|k| match k {
+        0 => g_a,
+        k if k == degree => g(b),
+        k => g(a + k as f64 * step * w),
+    });
+    let fitted = polynomial_through(&samples);
+    let poly = &fitted[..];
     // Most steps: the guard stays clearly on one side, which a bound on the
-    // quartic's variation shows without finding its turning points.
+    // polynomial's variation shows without finding its turning points.
     let variation: f64 = poly[1..].iter().map(|c| c.abs()).sum();
     if depth >= MAX_DEPTH && !check_start && start.signum() == poly[0].signum() {
         let clearance = poly[0].abs() - variation;
@@ -156,25 +176,25 @@ fn scan_piece(
             };
         }
     }
-    let turning = critical_points(&poly);
+    let turning = critical_points(poly);
     if depth < MAX_DEPTH {
         let scale = samples
             .iter()
             .fold(f64::MIN_POSITIVE, |m, v| m.max(v.abs()));
-        let misfit = [0.125, 0.375, 0.625, 0.875]
-            .iter()
-            .map(|u| (g(a + u * w) - horner(&poly, *u)).abs())
+        let misfit = (0..degree)
+            .map(|k| (k as f64 + 0.5) * step)
+            .map(|u| (g(a + u * w) - horner(poly, u)).abs())
             .fold(0.0, f64::max);
         let nearest = turning
             .iter()
             .chain(&[0.0, 1.0])
-            .map(|u| horner(&poly, *u).abs())
+            .map(|u| horner(poly, *u).abs())
             .fold(f64::INFINITY, f64::min);
         let crosses = samples.windows(2).any(|p| p[0].signum() != p[1].signum());
         if misfit > FIT_TOLERANCE * scale && (crosses || nearest <= 8.0 * misfit) {
             let mid = 0.5 * (a + b);
             let g_mid = g(mid);
-            let left = scan_piece(
+            let left = scan_piece::<N>(
                 direction,
                 Piece { b: mid, ..piece },
                 resolution,
@@ -194,29 +214,29 @@ fn scan_piece(
                 g_a: g_mid,
                 check_start: false,
             };
-            let right = scan_piece(direction, right_piece, resolution, g, depth + 1);
+            let right = scan_piece::<N>(direction, right_piece, resolution, g, depth + 1);
             return StepScan {
                 crossing: right.crossing,
                 margin: left.margin.min(right.margin),
             };
         }
     }
-    // Only a quartic that fits can say which way the guard leaves zero.
-    if check_start && fires_at_start(direction, &poly) {
+    // Only a polynomial that fits can say which way the guard leaves zero.
+    if check_start && fires_at_start(direction, poly, &samples) {
         return StepScan {
             crossing: Some(a),
             margin: f64::INFINITY,
         };
     }
-    let mut cuts = [b; 4];
+    let mut cuts = [b; MAX_DEGREE];
     for (cut, u) in cuts.iter_mut().zip(turning.iter()) {
         *cut = a + u * w;
     }
     let crossing = scan_from(direction, a, &cuts[..=turning.len()], start, g, &|s| {
-        horner(&poly, (s - a) / w)
+        horner(poly, (s - a) / w)
     });
     let local = crossing.map(|s| (s - a) / w);
-    let margin = margin(direction, &poly, local, turning.as_slice());
+    let margin = margin(direction, poly, local, turning.as_slice());
     StepScan {
         crossing,
         margin: if margin > resolution {
@@ -228,28 +248,21 @@ fn scan_piece(
 }
 
 /// See [`StepScan::margin`].
-fn margin(direction: Direction, poly: &[f64; 5], crossing: Option<f64>, turning: &[f64]) -> f64 {
+fn margin(direction: Direction, poly: &[f64], crossing: Option<f64>, turning: &[f64]) -> f64 {
     // `inward` is the sign of the side a crossing goes to.
     let inward = match direction {
         Direction::Falling => -1.0,
         Direction::Rising => 1.0,
         Direction::Either => return f64::INFINITY,
     };
-    let d1: Vec<f64> = poly
-        .iter()
-        .enumerate()
-        .skip(1)
-        .map(|(k, c)| k as f64 * c)
-        .collect();
-    let d2: Vec<f64> = d1
-        .iter()
-        .enumerate()
-        .skip(1)
-        .map(|(k, c)| k as f64 * c)
-        .collect();
     match crossing {
         Some(s) => {
-            let (slope, curvature) = (horner(&d1, s), horner(&d2, s));
+            let d1 = derivative(poly);
+            let d2 = derivative(&d1[..poly.len() - 1]);
+            let (slope, curvature) = (
+                horner(&d1[..poly.len() - 1], s),
+                horner(&d2[..poly.len().saturating_sub(2)], s),
+            );
             if curvature * inward < 0.0 {
                 slope * slope / (2.0 * curvature.abs())
             } else {
@@ -369,7 +382,13 @@ fn refine_polynomial(mut a: f64, mut b: f64, p: &dyn Fn(f64) -> f64) -> f64 {
 }
 
 /// A directed guard on or past zero at `s = 0`, moving further its way.
-fn fires_at_start(direction: Direction, poly: &[f64]) -> bool {
+///
+/// Which way it moves is read where the polynomial first leaves its start
+/// by more than [`VISIBLE`] of the samples' size: a rate too small to show
+/// before the curvature takes over is noise of the fit (the samples are
+/// differences of states far larger than the guard) or an excursion far
+/// below anything the step resolves.
+fn fires_at_start(direction: Direction, poly: &[f64], samples: &[f64]) -> bool {
     let sign = match direction {
         Direction::Falling => -1.0,
         Direction::Rising => 1.0,
@@ -378,28 +397,36 @@ fn fires_at_start(direction: Direction, poly: &[f64]) -> bool {
     if poly[0] * sign < 0.0 {
         return false;
     }
-    let leading = poly[1..].iter().copied().find(|c| *c != 0.0).unwrap_or(0.0);
-    leading * sign > 0.0
+    let floor = VISIBLE * samples.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    let mut s = f64::EPSILON;
+    while s <= 1.0 {
+        let moved = horner(poly, s) - poly[0];
+        if moved.abs() > floor {
+            return moved * sign > 0.0;
+        }
+        s *= 2.0;
+    }
+    false
 }
 
-/// Monomial coefficients (lowest first) of the quartic through values at
-/// `s = 0, 1/4, 1/2, 3/4, 1`.
-fn quartic_through(v: &[f64; 5]) -> [f64; 5] {
+/// Monomial coefficients (lowest first) of the polynomial of degree
+/// `N - 1` through values `v` at equispaced `s` from 0 to 1.
+fn polynomial_through<const N: usize>(v: &[f64; N]) -> [f64; N] {
     // Newton divided differences on the equispaced nodes, then expanded.
-    let nodes = [0.0, 0.25, 0.5, 0.75, 1.0];
+    let node = |i: usize| i as f64 / (N - 1) as f64;
     let mut d = *v;
-    for level in 1..5 {
-        for i in (level..5).rev() {
-            d[i] = (d[i] - d[i - 1]) / (nodes[i] - nodes[i - level]);
+    for level in 1..N {
+        for i in (level..N).rev() {
+            d[i] = (d[i] - d[i - 1]) / (node(i) - node(i - level));
         }
     }
-    let mut poly = [0.0; 5];
-    for i in (0..5).rev() {
-        // poly = poly * (s - nodes[i]) + d[i]
-        let mut next = [0.0; 5];
-        for k in 0..4 {
+    let mut poly = [0.0; N];
+    for i in (0..N).rev() {
+        // poly = poly * (s - node(i)) + d[i]
+        let mut next = [0.0; N];
+        for k in 0..N - 1 {
             next[k + 1] += poly[k];
-            next[k] -= nodes[i] * poly[k];
+            next[k] -= node(i) * poly[k];
         }
         next[0] += d[i];
         poly = next;
@@ -407,16 +434,25 @@ fn quartic_through(v: &[f64; 5]) -> [f64; 5] {
     poly
 }
 
+/// The coefficients of `poly'` (one fewer than `poly`'s, zero-padded).
+fn derivative(poly: &[f64]) -> [f64; MAX_DEGREE] {
+    let mut d = [0.0; MAX_DEGREE];
+    for k in 1..poly.len().min(MAX_DEGREE + 1) {
+        d[k - 1] = k as f64 * poly[k];
+    }
+    d
+}
+
 fn horner(poly: &[f64], s: f64) -> f64 {
     poly.iter().rev().fold(0.0, |acc, c| acc * s + c)
 }
 
-/// At most four sorted values in `(0, 1)`: the roots or turning points of
-/// a polynomial of degree four or less, kept without allocating.
+/// At most seven sorted values in `(0, 1)`: the roots or turning points of
+/// a polynomial of degree seven or less, kept without allocating.
 #[derive(Debug, Clone, Copy, Default)]
 struct Points {
     len: usize,
-    values: [f64; 4],
+    values: [f64; MAX_DEGREE],
 }
 
 impl Points {
@@ -440,11 +476,8 @@ impl Points {
 
 /// The real roots of `poly'` in `(0, 1)`, sorted.
 fn critical_points(poly: &[f64]) -> Points {
-    let mut derivative = [0.0; 4];
-    for k in 1..poly.len().min(5) {
-        derivative[k - 1] = k as f64 * poly[k];
-    }
-    roots_in_unit_interval(&derivative[..poly.len().saturating_sub(1).min(4)])
+    let d = derivative(poly);
+    roots_in_unit_interval(&d[..poly.len().saturating_sub(1).min(MAX_DEGREE)])
 }
 
 /// Every real root of `poly` in `(0, 1)`, sorted, by recursion on the
@@ -483,7 +516,7 @@ mod tests {
         scan_step(
             guard,
             check_start,
-            Interpolant::Polynomial,
+            Interpolant::Polynomial { degree: 4 },
             f64::INFINITY,
             g,
         )
@@ -534,6 +567,30 @@ mod tests {
     }
 
     #[test]
+    fn a_rate_lost_in_the_fit_does_not_decide_the_way_a_guard_leaves_zero() {
+        // A shut unit opening (curvature 1.2e-6 over the step), computed as
+        // a difference of states of size one (rounded to 1e-16) whose fit
+        // carries a rate of -2e-15: it leaves zero upwards and must not fire
+        // (seen in a cradle with DOP853).
+        let g = |s: f64| ((-2e-15 * s + 1.2e-6 * s * s) / 1e-16).round() * 1e-16;
+        for degree in [4, 7] {
+            let scan = scan_step(
+                &FALLING,
+                true,
+                Interpolant::Polynomial { degree },
+                f64::INFINITY,
+                g,
+            );
+            assert_eq!(scan.crossing, None, "degree {degree}");
+        }
+        // A rate that shows before the curvature takes over still decides.
+        assert_eq!(
+            first_crossing(&FALLING, true, |s| -1e-3 * s + 1.2e-6 * s * s),
+            Some(0.0)
+        );
+    }
+
+    #[test]
     fn a_guard_that_stays_on_zero_has_not_crossed() {
         // A packed unit at rest: the guard is zero all through the step.
         assert_eq!(first_crossing(&FALLING, true, |_| 0.0), None);
@@ -564,7 +621,7 @@ mod tests {
         let graze = scan_step(
             &FALLING,
             false,
-            Interpolant::Polynomial,
+            Interpolant::Polynomial { degree: 4 },
             f64::INFINITY,
             |s| (s - 0.5).powi(2) - 1e-6,
         );
@@ -578,7 +635,7 @@ mod tests {
         let miss = scan_step(
             &FALLING,
             false,
-            Interpolant::Polynomial,
+            Interpolant::Polynomial { degree: 4 },
             f64::INFINITY,
             |s| (s - 0.5).powi(2) + 1e-6,
         );
@@ -589,7 +646,7 @@ mod tests {
             scan_step(
                 &FALLING,
                 false,
-                Interpolant::Polynomial,
+                Interpolant::Polynomial { degree: 4 },
                 f64::INFINITY,
                 |s| 0.1 - s * s
             )

@@ -2,6 +2,8 @@
 //! resets ([`model`]); the simulation owns the event queue, event location
 //! and the loop ([`simulation`]).
 
+pub mod adaptive;
+pub mod dop853;
 pub mod dopri5;
 pub mod integrator;
 pub mod linear;
@@ -15,7 +17,7 @@ pub mod taylor;
 pub mod verlet;
 pub mod zeno;
 
-pub use dopri5::Tolerances;
+pub use adaptive::Tolerances;
 pub use integrator::Method;
 pub use local::{Fired, LocalModel, simulate_local};
 pub use model::{Affects, Direction, Flow, Guard, HybridModel, Jump, Mode};

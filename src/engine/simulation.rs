@@ -21,10 +21,10 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
-use crate::engine::dopri5::{StepFailure, Tolerances};
+use crate::engine::adaptive::{StepFailure, Tolerances};
 use crate::engine::integrator::{Integrator, Method, Motion, motion};
 use crate::engine::locate::scan_step;
-use crate::engine::model::{Affects, HybridModel, Mode};
+use crate::engine::model::{Affects, Direction, HybridModel, Mode};
 use crate::engine::observer::{EventRecord, Observer, SETTLE};
 use crate::engine::queue::EventQueue;
 use crate::engine::zeno::ZenoWatch;
@@ -355,6 +355,7 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
         let guard = model.guards(mode)[slot];
         let mut before = std::mem::take(&mut self.before);
         self.state_at(t.since(self.origin), &mut before);
+        let t = self.sharpen(slot, t, &mut before);
         self.after.copy_from_slice(&before);
         let jump = model.reset(mode, slot, &mut self.after);
         let recorded = if !all_finite(&before) || !all_finite(&self.after) {
@@ -406,6 +407,52 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
                 self.start_segment()
             }
         }
+    }
+
+    /// The crossing of guard `slot` at `t` (state `x`, from the dense
+    /// output) sharpened where the integrator can (see
+    /// [`Integrator::sharpen`]); the correction stays within a thousandth of
+    /// the step and before the next queued event, so the order of events
+    /// is kept.
+    fn sharpen(&mut self, slot: usize, t: Time, x: &mut [f64]) -> Time {
+        if !(self.motion == Motion::Stepped && self.stepped) {
+            return t;
+        }
+        let (model, mode) = (self.model, self.mode);
+        let tau = t.since(self.origin);
+        let h = self.integrator.h();
+        let next = self
+            .queue
+            .peek()
+            .map_or(h, |(_, later)| later.since(self.origin));
+        let reach = (1e-3 * h).min(next - tau);
+        let guard = |y: &[f64]| model.guard(mode, slot, y);
+        let found = guard(x);
+        let crossed = |v: f64| match model.guards(mode)[slot].direction {
+            Direction::Falling => v <= 0.0,
+            Direction::Rising => v >= 0.0,
+            Direction::Either => v == 0.0 || v.signum() == found.signum(),
+        };
+        let mut sharp = std::mem::take(&mut self.after);
+        let result = self.integrator.sharpen(
+            model,
+            mode,
+            &self.state,
+            tau,
+            reach,
+            &guard,
+            &crossed,
+            &mut sharp,
+        );
+        let t = match result {
+            Some(tau) => {
+                x.copy_from_slice(&sharp);
+                self.origin.after(tau)
+            }
+            None => t,
+        };
+        self.after = sharp;
+        t
     }
 
     fn count(&mut self, mode: Mode, slot: usize) {

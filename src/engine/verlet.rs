@@ -10,7 +10,7 @@
 //!
 //! [`HybridModel::second_order`]: crate::engine::HybridModel::second_order
 
-use crate::engine::dopri5::StepFailure;
+use crate::engine::adaptive::StepFailure;
 use crate::engine::model::{HybridModel, Mode};
 
 #[derive(Debug, Clone)]

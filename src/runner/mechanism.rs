@@ -42,6 +42,10 @@ pub(super) fn run(
                     "dopri5",
                     format!("strain formulation: Dormand-Prince 5(4), rtol {:e}, atol {:e}", tol.rtol, tol.atol),
                 ),
+                Method::Dop853(tol) => (
+                    "dop853",
+                    format!("strain formulation: DOP853 (Dormand-Prince 8(5,3)), rtol {:e}, atol {:e}", tol.rtol, tol.atol),
+                ),
                 Method::Verlet { step } => ("verlet", format!("strain formulation: Stormer-Verlet, step {step:e}")),
             };
             Ok(Report {
@@ -65,18 +69,22 @@ pub(super) fn run(
             };
             let outcome = simulate(&model, mode, &x0, &options, observer);
             let (e, r) = model.strain(outcome.final_mode, &outcome.final_state);
+            let (method, integrator) = match scene.method {
+                Method::Dop853(_) => ("dop853", "DOP853"),
+                _ => ("dopri5", "Dormand-Prince 5(4)"),
+            };
             let description = match charts {
-                Charts::Switch => {
-                    "angle formulation: equation (8) by Dormand-Prince 5(4), switching to the strain chart near theta = 0"
-                }
+                Charts::Switch => format!(
+                    "angle formulation: equation (8) by {integrator}, switching to the strain chart near theta = 0"
+                ),
                 Charts::Plain => {
-                    "angle formulation: equation (8) by Dormand-Prince 5(4), no chart switching"
+                    format!("angle formulation: equation (8) by {integrator}, no chart switching")
                 }
             };
             Ok(Report {
                 outcome,
-                method: "dopri5",
-                description: description.into(),
+                method,
+                description,
                 final_state: vec![("strain", e), ("strain_rate", r)],
                 fields: None,
             })

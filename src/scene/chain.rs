@@ -20,7 +20,7 @@
 //! - optional: `initial` `{"strain": [N numbers], "velocity": [N numbers]}`
 //!   (unit strains, `>= 0` with the constraint, and node velocities; either
 //!   may be left out), `solver` (`exact`, the default, the event-local
-//!   Taylor flow; `dopri5`, `verlet` or `linear` run the chain as an ODE, the
+//!   Taylor flow; `dopri5`, `dop853`, `verlet` or `linear` run the chain as an ODE, the
 //!   independent path, for up to [`MAX_ODE_UNITS`] units), `max_events`,
 //!   `description`.
 

@@ -17,8 +17,9 @@
 //! - optional: `chart` (angle only: `"switch"`, the default, crosses
 //!   `theta = 0` in the strain chart; `"none"` integrates (8) as it is and
 //!   fails there), `solver` (see [`solver`](crate::scene::solver): the
-//!   strain formulation takes `exact` (default), `linear`, `dopri5` and
-//!   `verlet`; the angle formulation `dopri5`, the default, with `rtol` and
+//!   strain formulation takes `exact` (default), `linear`, `dopri5`,
+//!   `dop853` and `verlet`; the angle formulation `dopri5`, the default, or
+//!   `dop853`, with `rtol` and
 //!   `atol` 1e-12 unless given), `max_events` (event budget, default 10^9),
 //!   `description` (free text).
 
@@ -153,11 +154,11 @@ pub fn resolve_solver(
 ) -> Result<(Method, Tolerances), SceneError> {
     let (method, tolerances) = spec.resolve()?;
     let refused = match (formulation, method) {
-        (Formulation::Angle(_), Method::Exact | Method::Linear) => {
-            Some("the angle formulation (8) has no closed form and is not linear; use \"dopri5\"")
-        }
+        (Formulation::Angle(_), Method::Exact | Method::Linear) => Some(
+            "the angle formulation (8) has no closed form and is not linear; use \"dopri5\" or \"dop853\"",
+        ),
         (Formulation::Angle(_), Method::Verlet { .. }) => Some(
-            "the angle formulation's acceleration depends on the angle rate, which Stormer-Verlet cannot take; use \"dopri5\"",
+            "the angle formulation's acceleration depends on the angle rate, which Stormer-Verlet cannot take; use \"dopri5\" or \"dop853\"",
         ),
         _ => None,
     };

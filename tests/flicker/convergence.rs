@@ -1,6 +1,7 @@
 //! Each integrator shows its order on a smooth problem (a loose orbit of the
 //! mechanism, no events): Stormer-Verlet's error falls as h^2, Dormand-Prince's
-//! as (work)^-5, and the linear propagator is exact to round-off.
+//! as (work)^-5, DOP853's as (work)^-8, and the linear propagator is exact
+//! to round-off.
 
 use flicker::engine::{Method, Options, Tolerances, simulate};
 use flicker::models::mechanism::strain::FLIGHT;
@@ -72,6 +73,26 @@ fn dormand_prince_is_fifth_order() {
     println!("Dormand-Prince measured order {order:.3}");
     assert!(
         (order - 5.0).abs() < 0.3,
+        "measured order {order}: {points:?}"
+    );
+}
+
+#[test]
+fn dop853_is_eighth_order() {
+    let points: Vec<(f64, f64)> = [1e-8, 1e-9, 1e-10, 1e-11, 1e-12]
+        .iter()
+        .map(|&tol| {
+            let (error, cost) = error_and_cost(Method::Dop853(Tolerances {
+                rtol: tol,
+                atol: tol,
+            }));
+            (cost, error)
+        })
+        .collect();
+    let order = -slope(&points);
+    println!("DOP853 measured order {order:.3}: {points:?}");
+    assert!(
+        (order - 8.0).abs() < 0.3,
         "measured order {order}: {points:?}"
     );
 }

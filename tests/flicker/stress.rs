@@ -33,8 +33,8 @@ fn no_method_is_silently_wrong_and_each_says_why_it_fails() {
     let rows = rows();
     assert_eq!(
         rows.len(),
-        29,
-        "8 cases: 7 strain cases x 4 methods + the angle case"
+        37,
+        "8 cases: 7 strain cases x 5 methods + the angle case x 2"
     );
     for r in &rows {
         assert!(
@@ -86,7 +86,7 @@ fn no_method_is_silently_wrong_and_each_says_why_it_fails() {
     };
     assert!(reason.contains("singular at theta = 0"));
     // Grazes a numerical method cannot resolve are refused, not guessed.
-    for method in ["dopri5", "verlet"] {
+    for method in ["dopri5", "dop853", "verlet"] {
         let Verdict::Failed { reason } = verdict(&rows, "separatrix", method) else {
             panic!("{method} on the separatrix must fail loudly")
         };
@@ -98,7 +98,7 @@ fn no_method_is_silently_wrong_and_each_says_why_it_fails() {
         verdict(&rows, "double_crossing", "linear"),
         Verdict::Passed { .. }
     ));
-    for method in ["exact", "linear", "dopri5", "verlet"] {
+    for method in ["exact", "linear", "dopri5", "dop853", "verlet"] {
         assert!(
             matches!(verdict(&rows, "chattering", method), Verdict::Passed { .. }),
             "{method}"
