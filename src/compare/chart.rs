@@ -84,12 +84,13 @@ where
     methods.dedup();
     for (i, method) in methods.iter().enumerate() {
         let colour = PALETTE[i % PALETTE.len()];
-        let mut line: Vec<(f64, f64)> = points
+        // In the order of the runs, loosest setting first: sorting by cost
+        // would zigzag wherever timing noise swaps two close runs.
+        let line: Vec<(f64, f64)> = points
             .iter()
             .filter(|p| p.0 == *method)
             .map(|p| (p.1, p.2))
             .collect();
-        line.sort_by(|a, b| a.1.total_cmp(&b.1));
         chart
             .draw_series(LineSeries::new(line.clone(), colour.stroke_width(2)))
             .map_err(err)?

@@ -497,7 +497,10 @@ fn roots_in_unit_interval(poly: &[f64]) -> Points {
     for &right in turning.iter().chain(std::iter::once(&1.0)) {
         let f_right = horner(p, right);
         if f_left * f_right < 0.0 {
-            roots.push(refine_polynomial(left, right, &|s| horner(p, s)));
+            // Illinois rather than bisection: a septic's roots take a few
+            // iterations each, not fifty.
+            let at = |s: f64| horner(p, s);
+            roots.push(refine(left, f_left, right, f_right, &mut { at }, &at));
         } else if f_right == 0.0 && right < 1.0 {
             roots.push(right);
         }
