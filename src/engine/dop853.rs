@@ -366,12 +366,13 @@ impl Dop853 {
     /// flow from there by its second-order Taylor polynomial (two more: the
     /// rate at `tau` and the rate one Newton step along it) and find the
     /// guard's zero on that by secant steps, nudged forward until it has
-    /// crossed. The correction is of the size of the dense output's error, so
-    /// the polynomial's own error (cubic in it) is far below round-off.
-    /// Returns the corrected time, with the state there in `x`, if the
-    /// correction is no larger than `reach`; `None` keeps the dense output's
-    /// answer (`x` is scratch). The stages are spent: the next step starts
-    /// afresh, as after every event.
+    /// crossed. The correction is of the size of the dense output's error,
+    /// and the polynomial's own error is cubic in it: far below round-off
+    /// at the tolerances where sharpening matters, and never worse than the
+    /// dense output it replaces. Returns the correction to `tau`, with the
+    /// state there in `x`, if it is no larger than `reach`; `None` keeps the
+    /// dense output's answer (`x` is scratch). The stages are spent: the
+    /// next step starts afresh, as after every event.
     #[allow(clippy::too_many_arguments)]
     pub fn sharpen<M: HybridModel + ?Sized>(
         &mut self,
@@ -396,6 +397,12 @@ impl Dop853 {
         // The stages are free now: k[1] takes f at tau, k[2] f one step on.
         let start = std::mem::take(&mut self.y1);
         let first = -guard(&start) / slope;
+        if !(first.abs() <= 2.0 * reach) {
+            // A flat or undefined slope, or a correction out of reach: the
+            // flow is not asked about states far from the crossing.
+            self.y1 = start;
+            return None;
+        }
         self.stage_at(model, mode, &start, 1);
         for i in 0..x.len() {
             self.scratch[i] = start[i] + first * self.k[1][i];
@@ -419,9 +426,7 @@ impl Dop853 {
         let floor = f64::EPSILON * tau.abs().max(f64::MIN_POSITIVE);
         let found = zero_along(&mut along, first, slope, floor, crossed, x);
         self.y1 = start;
-        found
-            .filter(|s| s.abs() <= reach && tau + s >= 0.0)
-            .map(|s| tau + s)
+        found.filter(|s| s.abs() <= reach && tau + s >= 0.0)
     }
 
     /// `k[stage] = f(y)`.

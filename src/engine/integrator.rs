@@ -186,8 +186,8 @@ impl Integrator {
         }
     }
 
-    /// Sharpen a crossing at `tau` into the last step where the method's
-    /// dense output is less accurate than its steps (DOP853, see
+    /// The correction to a crossing at `tau` into the last step where the
+    /// method's dense output is less accurate than its steps (DOP853, see
     /// [`Dop853::sharpen`]); `None` for the others and where sharpening
     /// declines, leaving the dense output's crossing as it was.
     #[allow(clippy::too_many_arguments)]

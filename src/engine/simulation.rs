@@ -413,13 +413,14 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
     /// output) sharpened where the integrator can (see
     /// [`Integrator::sharpen`]); the correction stays within a thousandth of
     /// the step and before the next queued event, so the order of events
-    /// is kept.
+    /// is kept. A re-fire at the segment's start is left alone: its state
+    /// is the segment's own.
     fn sharpen(&mut self, slot: usize, t: Time, x: &mut [f64]) -> Time {
-        if !(self.motion == Motion::Stepped && self.stepped) {
+        let tau = t.since(self.origin);
+        if !(self.motion == Motion::Stepped && self.stepped) || tau == 0.0 {
             return t;
         }
         let (model, mode) = (self.model, self.mode);
-        let tau = t.since(self.origin);
         let h = self.integrator.h();
         let next = self
             .queue
@@ -427,14 +428,28 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
             .map_or(h, |(_, later)| later.since(self.origin));
         let reach = (1e-3 * h).min(next - tau);
         let guard = |y: &[f64]| model.guard(mode, slot, y);
-        let found = guard(x);
-        let crossed = |v: f64| match model.guards(mode)[slot].direction {
+        let direction = model.guards(mode)[slot].direction;
+        // For a guard of either direction, the side it came from: a little
+        // before the crossing on the dense output.
+        let before = if direction == Direction::Either {
+            let mut y = std::mem::take(&mut self.after);
+            self.integrator.eval((tau - 1e-4 * h).max(0.0), &mut y);
+            let g = guard(&y);
+            self.after = y;
+            if g == 0.0 {
+                return t;
+            }
+            g
+        } else {
+            0.0
+        };
+        let crossed = |v: f64| match direction {
             Direction::Falling => v <= 0.0,
             Direction::Rising => v >= 0.0,
-            Direction::Either => v == 0.0 || v.signum() == found.signum(),
+            Direction::Either => v == 0.0 || v.signum() != before.signum(),
         };
         let mut sharp = std::mem::take(&mut self.after);
-        let result = self.integrator.sharpen(
+        let correction = self.integrator.sharpen(
             model,
             mode,
             &self.state,
@@ -444,10 +459,10 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
             &crossed,
             &mut sharp,
         );
-        let t = match result {
-            Some(tau) => {
+        let t = match correction {
+            Some(s) => {
                 x.copy_from_slice(&sharp);
-                self.origin.after(tau)
+                t.after(s)
             }
             None => t,
         };

@@ -82,7 +82,8 @@ fn compare_writes_rows_that_rank_the_methods() {
     // Tightening a method makes it more accurate: Verlet by h^2 (4x per halving).
     assert!(dopri5.windows(2).all(|w| w[1] < w[0]), "dopri5 {dopri5:?}");
     assert!(dop853.windows(2).all(|w| w[1] < w[0]), "dop853 {dop853:?}");
-    // At equal tolerance the 8th-order pair is no less accurate.
+    // At equal tolerance the 8th-order pair is about as accurate or better
+    // (within 10x: the two pairs' error constants differ).
     assert!(
         dop853[2] < 10.0 * dopri5[2],
         "dop853 {dop853:?}, dopri5 {dopri5:?}"
