@@ -397,7 +397,7 @@ impl Dop853 {
         // The stages are free now: k[1] takes f at tau, k[2] f one step on.
         let start = std::mem::take(&mut self.y1);
         let first = -guard(&start) / slope;
-        if !(first.abs() <= 2.0 * reach) {
+        if first.is_nan() || first.abs() > 2.0 * reach {
             // A flat or undefined slope, or a correction out of reach: the
             // flow is not asked about states far from the crossing.
             self.y1 = start;
