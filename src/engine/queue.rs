@@ -22,6 +22,10 @@ pub struct EventQueue {
     /// Slots are small integers: a fast non-cryptographic hash will do.
     queue: PriorityQueue<usize, Priority, FxBuildHasher>,
     exact: Vec<Time>,
+    /// Whether each slot is in the queue: most cancellations are of slots
+    /// that are not (a chain re-predicts every unit each window), and this
+    /// answers them without hashing.
+    queued: Vec<bool>,
 }
 
 impl EventQueue {
@@ -33,15 +37,20 @@ impl EventQueue {
         };
         if self.exact.len() <= slot {
             self.exact.resize(slot + 1, Time::default());
+            self.queued.resize(slot + 1, false);
         }
         self.exact[slot] = time;
+        self.queued[slot] = true;
         self.queue.push(slot, Reverse((t, slot)));
         true
     }
 
     /// Forget the prediction for `slot`, if any.
     pub fn cancel(&mut self, slot: usize) {
-        self.queue.remove(&slot);
+        if let Some(queued) = self.queued.get_mut(slot).filter(|q| **q) {
+            *queued = false;
+            self.queue.remove(&slot);
+        }
     }
 
     /// The earliest slot and its exact time, without removing it.
@@ -53,11 +62,14 @@ impl EventQueue {
 
     /// Remove and return the earliest slot and its exact time.
     pub fn pop(&mut self) -> Option<(usize, Time)> {
-        self.queue.pop().map(|(slot, _)| (slot, self.exact[slot]))
+        let (slot, _) = self.queue.pop()?;
+        self.queued[slot] = false;
+        Some((slot, self.exact[slot]))
     }
 
     pub fn clear(&mut self) {
         self.queue.clear();
+        self.queued.fill(false);
     }
 }
 
@@ -74,6 +86,22 @@ mod tests {
         q.schedule(1, Time::new(3.0)); // replaces the 1.0 prediction
         let order: Vec<usize> = std::iter::from_fn(|| q.pop().map(|(s, _)| s)).collect();
         assert_eq!(order, vec![0, 3, 1]);
+    }
+
+    #[test]
+    fn cancelled_and_popped_slots_can_be_scheduled_again() {
+        let mut q = EventQueue::default();
+        q.schedule(2, Time::new(1.0));
+        q.cancel(2);
+        q.cancel(5); // never scheduled
+        assert!(q.peek().is_none());
+        q.schedule(2, Time::new(4.0));
+        q.schedule(1, Time::new(3.0));
+        assert_eq!(q.pop().map(|(s, _)| s), Some(1));
+        q.cancel(1); // already popped
+        q.schedule(1, Time::new(5.0));
+        let order: Vec<usize> = std::iter::from_fn(|| q.pop().map(|(s, _)| s)).collect();
+        assert_eq!(order, vec![2, 1]);
     }
 
     #[test]

@@ -23,14 +23,17 @@ pub fn eval2(c: &[f64], s: f64) -> (f64, f64, f64) {
     (p, d1, d2)
 }
 
-/// `(p(s), p'(s))` of `p = sum c[k] s^k`.
-fn eval1(c: &[f64], s: f64) -> (f64, f64) {
-    let (mut p, mut d1) = (0.0, 0.0);
+/// `(p(s), p'(s), sum |c[k]| |s|^k)`: the last bounds the rounding of `p(s)`
+/// (relative, a few ulps of it).
+fn eval1_with_size(c: &[f64], s: f64) -> (f64, f64, f64) {
+    let (mut p, mut d1, mut size) = (0.0, 0.0, 0.0);
+    let a = s.abs();
     for &ck in c.iter().rev() {
         d1 = d1 * s + p;
         p = p * s + ck;
+        size = size * a + ck.abs();
     }
-    (p, d1)
+    (p, d1, size)
 }
 
 /// `p(s)` of `p = sum c[k] s^k`.
@@ -302,8 +305,9 @@ impl Piece<'_> {
     }
 
     /// The root of a strictly decreasing `p` on `[lo, hi]` with `p(lo) > 0 >=
-    /// p(hi)`, to a few ulps: Newton's method from the secant point, kept
-    /// inside the bracket (bisecting when a step leaves it).
+    /// p(hi)`, to a few ulps or until `p` is zero to rounding: Newton's
+    /// method from the secant point, kept inside the bracket (bisecting when
+    /// a step leaves it).
     fn refine(&self, (mut lo, p_lo): (f64, f64), (mut hi, p_hi): (f64, f64)) -> f64 {
         let secant = lo + (hi - lo) * p_lo / (p_lo - p_hi);
         let mut x = if secant > lo && secant < hi {
@@ -312,11 +316,17 @@ impl Piece<'_> {
             0.5 * (lo + hi)
         };
         for _ in 0..100 {
-            let (p, d1) = eval1(self.c, x);
+            let (p, d1, size) = eval1_with_size(self.c, x);
             if p > 0.0 {
                 lo = x;
             } else {
                 hi = x;
+            }
+            // Zero to rounding: further Newton steps would only chase the
+            // noise of the evaluation (a slow closing makes that noise a
+            // step far wider than a few ulps of x).
+            if p.abs() <= 4.0 * f64::EPSILON * size {
+                break;
             }
             let newton = x - p / d1;
             let next = if newton > lo && newton < hi {
