@@ -3,6 +3,7 @@
 use std::path::Path;
 
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 /// How a curve is drawn.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -206,12 +207,17 @@ impl Figure {
                 .max_by(|a, b| reach(a).total_cmp(&reach(b)));
             if let (Some(label), Some(corner)) = (&curve.label, corner) {
                 let at = (corner.0, corner.1 + 0.01 * (y1 - y0));
+                // Text ends at a corner in the right half, so that it stays
+                // inside the plot.
+                let across = if (corner.0 - x0) / (x1 - x0) > 0.5 {
+                    HPos::Right
+                } else {
+                    HPos::Left
+                };
+                let style = TextStyle::from(("sans-serif", 13).into_font())
+                    .pos(Pos::new(across, VPos::Bottom));
                 chart
-                    .draw_series(std::iter::once(Text::new(
-                        label.clone(),
-                        at,
-                        ("sans-serif", 13).into_font(),
-                    )))
+                    .draw_series(std::iter::once(Text::new(label.clone(), at, style)))
                     .map_err(err)?;
             }
         }
