@@ -668,13 +668,19 @@ fn levels(
             Some(f) if k == 0 => f,
             _ => 0.0,
         };
-        for i in 0..count {
-            let here = i * s + k;
-            let right = if i + 1 < count { gap[here + s] } else { load };
-            let u = vel[here];
-            gap[here + 1] = (u - left) * inv;
-            vel[here + 1] = (right - gap[here]) * inv;
-            left = u;
+        // Two passes, so that each walks whole series without index
+        // arithmetic: gaps of order k + 1 from velocities of order k, then
+        // velocities of order k + 1 from gaps of order k (untouched by the
+        // first pass).
+        let (gap, vel) = (&mut gap[..count * s], &mut vel[..count * s]);
+        for (g, v) in gap.chunks_exact_mut(s).zip(vel.chunks_exact(s)) {
+            g[k + 1] = (v[k] - left) * inv;
+            left = v[k];
+        }
+        let mut rights = gap.chunks_exact(s).skip(1).map(|g| g[k]);
+        for (v, g) in vel.chunks_exact_mut(s).zip(gap.chunks_exact(s)) {
+            let right = rights.next().unwrap_or(load);
+            v[k + 1] = (right - g[k]) * inv;
         }
         if let Some(b) = block.filter(|&b| b < count) {
             let nodes = (count - b + 1) as f64;
