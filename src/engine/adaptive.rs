@@ -1,5 +1,12 @@
 //! What the adaptive Runge-Kutta pairs share: tolerances, why a step
-//! fails, the starting step and the step-size factor.
+//! fails, and the step-size control (starting step, acceptance, growth).
+//! A pair supplies its stages, error estimate and dense output; the loop
+//! of trials is the same for every pair:
+//!
+//! ```text
+//! let mut h = control.begin(model, mode, y0, h_max, h_min, &mut stages, &mut scratch)?;
+//! while let Some(next) = control.judge(h, attempt(h), h_min)? { h = next }
+//! ```
 
 use crate::engine::model::{HybridModel, Mode};
 
@@ -40,49 +47,155 @@ pub enum StepFailure {
     NotApplicable(String),
 }
 
-/// Hairer's starting step for a pair whose error estimate is of order
-/// `order` in the step size (5 for Dormand-Prince, 8 for DOP853): the size at which
-/// an Euler step's change and its second-derivative estimate both stay
-/// within tolerance. `f0` holds `f(y0)`; `y` and `f1` are scratch.
-#[allow(clippy::too_many_arguments)]
-pub fn initial_step<M: HybridModel + ?Sized>(
-    model: &M,
-    mode: Mode,
-    tol: Tolerances,
+/// The step-size memory and rules of an adaptive pair.
+#[derive(Debug, Clone)]
+pub struct StepControl {
+    pub tol: Tolerances,
+    /// Order of the pair's error estimate in the step size.
     order: i32,
-    y0: &[f64],
-    f0: &[f64],
-    y: &mut [f64],
-    f1: &mut [f64],
-    h_max: f64,
-) -> f64 {
-    let n = y0.len() as f64;
-    let norm =
-        |v: &dyn Fn(usize) -> f64| ((0..y0.len()).map(|i| v(i).powi(2)).sum::<f64>() / n).sqrt();
-    let d0 = norm(&|i| y0[i] / tol.scale(y0[i]));
-    let d1 = norm(&|i| f0[i] / tol.scale(y0[i]));
-    let h0 = if d0 < 1e-5 || d1 < 1e-5 {
-        1e-6
-    } else {
-        0.01 * d0 / d1
-    }
-    .min(h_max);
-    for i in 0..y0.len() {
-        y[i] = y0[i] + h0 * f0[i];
-    }
-    model.rhs(mode, y, f1);
-    let d2 = norm(&|i| (f1[i] - f0[i]) / tol.scale(y0[i])) / h0;
-    let h1 = if d1.max(d2) <= 1e-15 {
-        (h0 * 1e-3).max(1e-6)
-    } else {
-        (0.01 / d1.max(d2)).powf(1.0 / f64::from(order))
-    };
-    (100.0 * h0).min(h1).min(h_max)
+    /// Largest factor a step grows by after an accepted trial, and smallest
+    /// it shrinks by after a rejected one.
+    growth: f64,
+    shrinkage: f64,
+    /// Whether the first stage holds `f` at the start of the next step
+    /// (first same as last): false after a restart.
+    pub fsal: bool,
+    h_next: Option<f64>,
+    /// Right-hand-side evaluations so far.
+    pub evaluations: u64,
+    /// Largest component of the error estimate of the last accepted step.
+    pub local_error: f64,
 }
 
-/// `err^(-1/order)`, the step-size factor for an error estimate of that order.
-/// Step control needs two digits, not sixteen: single precision halves its
-/// cost, which matters when the right-hand side is cheap.
-pub fn shrink(err: f64, order: i32) -> f64 {
-    f64::from((err as f32).powf(-1.0 / order as f32))
+/// A trial's error: the scaled norm step control uses (accepted at most 1,
+/// non-finite when the trial blew up) and its largest component, absolute.
+#[derive(Debug, Clone, Copy)]
+pub struct TrialError {
+    pub norm: f64,
+    pub largest: f64,
+}
+
+impl StepControl {
+    pub fn new(tol: Tolerances, order: i32, growth: f64, shrinkage: f64) -> Self {
+        StepControl {
+            tol,
+            order,
+            growth,
+            shrinkage,
+            fsal: false,
+            h_next: None,
+            evaluations: 0,
+            local_error: 0.0,
+        }
+    }
+
+    /// Start a step from `y0`: `f(y0)` into `stages[0]` unless the last
+    /// step left it there, and the size of the first trial (the last
+    /// step's successor, or Hairer's starting step after a restart).
+    #[allow(clippy::too_many_arguments)]
+    pub fn begin<M: HybridModel + ?Sized>(
+        &mut self,
+        model: &M,
+        mode: Mode,
+        y0: &[f64],
+        h_max: f64,
+        h_min: f64,
+        stages: &mut [Vec<f64>],
+        scratch: &mut [f64],
+    ) -> Result<f64, StepFailure> {
+        if !self.fsal {
+            model.rhs(mode, y0, &mut stages[0]);
+            self.evaluations += 1;
+            if stages[0].iter().any(|v| !v.is_finite()) {
+                return Err(StepFailure::NonFinite);
+            }
+        }
+        let h = match (self.fsal, self.h_next) {
+            (true, Some(h)) => h,
+            _ => {
+                let (f0, rest) = stages.split_at_mut(1);
+                self.evaluations += 1;
+                self.initial_step(model, mode, y0, &f0[0], scratch, &mut rest[0], h_max)
+            }
+        };
+        collapsed_below(h.min(h_max), h_min)
+    }
+
+    /// After a trial of size `h`: `None` if it is accepted (its error kept,
+    /// the next step's size chosen), else the size to try instead.
+    pub fn judge(
+        &mut self,
+        h: f64,
+        error: TrialError,
+        h_min: f64,
+    ) -> Result<Option<f64>, StepFailure> {
+        let err = error.norm;
+        let next = if !err.is_finite() {
+            0.1 * h
+        } else if err <= 1.0 {
+            let grow = (0.9 * self.shrink(err)).min(self.growth);
+            self.h_next = Some(h * grow.max(1.0));
+            self.local_error = error.largest;
+            return Ok(None);
+        } else {
+            h * (0.9 * self.shrink(err)).max(self.shrinkage)
+        };
+        collapsed_below(next, h_min).map(Some)
+    }
+
+    /// Hairer's starting step: the size at which an Euler step's change and
+    /// its second-derivative estimate both stay within tolerance. `f0`
+    /// holds `f(y0)`; `y` and `f1` are scratch.
+    #[allow(clippy::too_many_arguments)]
+    fn initial_step<M: HybridModel + ?Sized>(
+        &self,
+        model: &M,
+        mode: Mode,
+        y0: &[f64],
+        f0: &[f64],
+        y: &mut [f64],
+        f1: &mut [f64],
+        h_max: f64,
+    ) -> f64 {
+        let tol = self.tol;
+        let n = y0.len() as f64;
+        let norm = |v: &dyn Fn(usize) -> f64| {
+            ((0..y0.len()).map(|i| v(i).powi(2)).sum::<f64>() / n).sqrt()
+        };
+        let d0 = norm(&|i| y0[i] / tol.scale(y0[i]));
+        let d1 = norm(&|i| f0[i] / tol.scale(y0[i]));
+        let h0 = if d0 < 1e-5 || d1 < 1e-5 {
+            1e-6
+        } else {
+            0.01 * d0 / d1
+        }
+        .min(h_max);
+        for i in 0..y0.len() {
+            y[i] = y0[i] + h0 * f0[i];
+        }
+        model.rhs(mode, y, f1);
+        let d2 = norm(&|i| (f1[i] - f0[i]) / tol.scale(y0[i])) / h0;
+        let h1 = if d1.max(d2) <= 1e-15 {
+            (h0 * 1e-3).max(1e-6)
+        } else {
+            (0.01 / d1.max(d2)).powf(1.0 / f64::from(self.order))
+        };
+        (100.0 * h0).min(h1).min(h_max)
+    }
+
+    /// `err^(-1/order)`, the step-size factor. Step control needs two
+    /// digits, not sixteen: single precision halves its cost, which matters
+    /// when the right-hand side is cheap.
+    fn shrink(&self, err: f64) -> f64 {
+        f64::from((err as f32).powf(-1.0 / self.order as f32))
+    }
+}
+
+/// `h`, unless it is below `h_min`: the solution is (nearly) singular here.
+fn collapsed_below(h: f64, h_min: f64) -> Result<f64, StepFailure> {
+    if h < h_min {
+        Err(StepFailure::Collapsed { h })
+    } else {
+        Ok(h)
+    }
 }

@@ -17,7 +17,7 @@
 // Stage sums read several arrays at one index: an index loop says it plainly.
 #![allow(clippy::needless_range_loop)]
 
-use crate::engine::adaptive::{StepFailure, Tolerances, initial_step, shrink};
+use crate::engine::adaptive::{StepControl, StepFailure, Tolerances, TrialError};
 use crate::engine::model::{HybridModel, Mode};
 
 /// The order of the error estimate in the step size.
@@ -248,57 +248,58 @@ impl DenseStep {
     }
 }
 
+/// A crossing found on the dense output, `tau` into the step, for
+/// [`Dop853::sharpen`]: how far it may move, the guard, and which of the
+/// guard's values count as having crossed.
+pub struct Crossing<'a> {
+    pub tau: f64,
+    pub reach: f64,
+    pub guard: &'a dyn Fn(&[f64]) -> f64,
+    pub crossed: &'a dyn Fn(f64) -> bool,
+}
+
 /// The integrator's working storage and step-size memory.
 #[derive(Debug, Clone)]
 pub struct Dop853 {
-    tol: Tolerances,
+    control: StepControl,
     k: [Vec<f64>; ALL_STAGES],
     y1: Vec<f64>,
     scratch: Vec<f64>,
-    /// Whether `k[0]` holds `f` at the start of the next step.
-    fsal: bool,
-    h_next: Option<f64>,
     dense: DenseStep,
-    /// Right-hand-side evaluations so far.
-    pub evaluations: u64,
-    /// Largest component of the error estimate of the last trial step.
-    trial_error: f64,
-    /// The same, for the last accepted step.
-    local_error: f64,
 }
 
 impl Dop853 {
     pub fn new(dimension: usize, tol: Tolerances) -> Self {
         let v = || vec![0.0; dimension];
         Dop853 {
-            tol,
+            control: StepControl::new(tol, ORDER, 6.0, 0.333),
             k: std::array::from_fn(|_| v()),
             y1: v(),
             scratch: v(),
-            fsal: false,
-            h_next: None,
             dense: DenseStep {
                 h: 0.0,
                 y0: v(),
                 r: std::array::from_fn(|_| v()),
                 y1: v(),
             },
-            evaluations: 0,
-            trial_error: 0.0,
-            local_error: 0.0,
         }
     }
 
     /// Forget the previous step: the next one starts from a state that was
     /// not this integrator's last output (after a reset).
     pub fn restart(&mut self) {
-        self.fsal = false;
+        self.control.fsal = false;
     }
 
     /// The error estimate of the last accepted step (largest component,
     /// absolute).
     pub fn local_error(&self) -> f64 {
-        self.local_error
+        self.control.local_error
+    }
+
+    /// Right-hand-side evaluations so far.
+    pub fn evaluations(&self) -> u64 {
+        self.control.evaluations
     }
 
     /// The dense output of the last accepted step.
@@ -315,48 +316,24 @@ impl Dop853 {
         h_max: f64,
         h_min: f64,
     ) -> Result<(), StepFailure> {
-        if !self.fsal {
-            self.stage_at(model, mode, y0, 0);
-            if self.k[0].iter().any(|v| !v.is_finite()) {
-                return Err(StepFailure::NonFinite);
-            }
-        }
-        let mut h = match (self.fsal, self.h_next) {
-            (true, Some(h)) => h,
-            _ => {
-                let [f0, f1, ..] = &mut self.k;
-                self.evaluations += 1;
-                initial_step(
-                    model,
-                    mode,
-                    self.tol,
-                    ORDER,
-                    y0,
-                    f0,
-                    &mut self.scratch,
-                    f1,
-                    h_max,
-                )
-            }
-        }
-        .min(h_max);
+        let mut h = self.control.begin(
+            model,
+            mode,
+            y0,
+            h_max,
+            h_min,
+            &mut self.k,
+            &mut self.scratch,
+        )?;
         loop {
-            if h < h_min {
-                return Err(StepFailure::Collapsed { h });
+            let error = self.attempt(model, mode, y0, h);
+            match self.control.judge(h, error, h_min)? {
+                Some(next) => h = next,
+                None => {
+                    self.finish(model, mode, y0, h);
+                    return Ok(());
+                }
             }
-            let err = self.attempt(model, mode, y0, h);
-            if !err.is_finite() {
-                h *= 0.1;
-                continue;
-            }
-            if err <= 1.0 {
-                let grow = (0.9 * shrink(err, ORDER)).min(6.0);
-                self.h_next = Some(h * grow.max(1.0));
-                self.local_error = self.trial_error;
-                self.finish(model, mode, y0, h);
-                return Ok(());
-            }
-            h *= (0.9 * shrink(err, ORDER)).max(0.333);
         }
     }
 
@@ -373,25 +350,27 @@ impl Dop853 {
     /// state there in `x`, if it is no larger than `reach`; `None` keeps the
     /// dense output's answer (`x` is scratch). The stages are spent: the
     /// next step starts afresh, as after every event.
-    #[allow(clippy::too_many_arguments)]
     pub fn sharpen<M: HybridModel + ?Sized>(
         &mut self,
         model: &M,
         mode: Mode,
         y0: &[f64],
-        tau: f64,
-        reach: f64,
-        guard: &dyn Fn(&[f64]) -> f64,
-        crossed: &dyn Fn(f64) -> bool,
+        crossing: &Crossing,
         x: &mut [f64],
     ) -> Option<f64> {
+        let &Crossing {
+            tau,
+            reach,
+            guard,
+            crossed,
+        } = crossing;
         let h = self.dense.h;
         let (a, b) = ((tau - 1e-4 * h).max(0.0), (tau + 1e-4 * h).min(h));
         self.dense.eval(a, x);
         let g_a = guard(x);
         self.dense.eval(b, x);
         let slope = (guard(x) - g_a) / (b - a);
-        self.fsal = false;
+        self.control.fsal = false;
         self.stage_at(model, mode, y0, 0);
         self.attempt(model, mode, y0, tau);
         // The stages are free now: k[1] takes f at tau, k[2] f one step on.
@@ -438,7 +417,7 @@ impl Dop853 {
         stage: usize,
     ) {
         model.rhs(mode, y, &mut self.k[stage]);
-        self.evaluations += 1;
+        self.control.evaluations += 1;
     }
 
     /// Evaluate `stage` from `y0` and the stages before it.
@@ -460,14 +439,14 @@ impl Dop853 {
         self.scratch = y;
     }
 
-    /// One trial step of size `h`; returns the scaled error norm.
+    /// One trial step of size `h`, and its error.
     fn attempt<M: HybridModel + ?Sized>(
         &mut self,
         model: &M,
         mode: Mode,
         y0: &[f64],
         h: f64,
-    ) -> f64 {
+    ) -> TrialError {
         for stage in 1..STAGES {
             self.stage(model, mode, y0, h, stage);
         }
@@ -479,23 +458,30 @@ impl Dop853 {
             self.y1[i] = y0[i] + h * high;
             let e5: f64 = E5.iter().map(|&(j, e)| e * k[j][i]).sum();
             let e3 = high - BHH.iter().map(|&(j, b)| b * k[j][i]).sum::<f64>();
-            let scale = self.tol.scale(y0[i].abs().max(self.y1[i].abs()));
+            let scale = self.control.tol.scale(y0[i].abs().max(self.y1[i].abs()));
             err5 += (e5 / scale).powi(2);
             err3 += (e3 / scale).powi(2);
             largest = largest.max(e5.abs());
         }
         if self.y1.iter().any(|v| !v.is_finite()) || !(err5.is_finite() && err3.is_finite()) {
-            return f64::NAN;
+            return TrialError {
+                norm: f64::NAN,
+                largest: f64::NAN,
+            };
         }
         if err5 == 0.0 && err3 == 0.0 {
-            self.trial_error = 0.0;
-            return 0.0;
+            return TrialError {
+                norm: 0.0,
+                largest: 0.0,
+            };
         }
         // Hairer's combination: |e5|^2 / sqrt(|e5|^2 + 0.01 |e3|^2) scales
         // like h^8 where both estimates are in their asymptotic regime.
         let damping = err5.sqrt() / (err5 + 0.01 * err3).sqrt();
-        self.trial_error = h * largest * damping;
-        h * err5 / ((err5 + 0.01 * err3) * y0.len() as f64).sqrt()
+        TrialError {
+            norm: h * err5 / ((err5 + 0.01 * err3) * y0.len() as f64).sqrt(),
+            largest: h * largest * damping,
+        }
     }
 
     /// Evaluate `f(y1)` (carried over to the next step) and the dense
@@ -523,7 +509,7 @@ impl Dop853 {
         self.dense.y0.copy_from_slice(y0);
         self.dense.y1.copy_from_slice(&self.y1);
         self.k.swap(0, END);
-        self.fsal = true;
+        self.control.fsal = true;
     }
 }
 
@@ -571,7 +557,8 @@ fn zero_along(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::engine::{Flow, Guard, Jump};
+    use crate::models::mechanism::strain::FLIGHT;
+    use crate::models::mechanism::{Mechanism, StrainMechanism};
 
     /// The nodes `c_i`, transcribed independently of `A`: row sums must
     /// reproduce them.
@@ -638,41 +625,19 @@ mod tests {
         assert!(moment(&e5, 5).abs() > 1e-6);
     }
 
-    /// x'' = -x as a first-order system.
-    struct Oscillator;
-
-    impl HybridModel for Oscillator {
-        fn dimension(&self) -> usize {
-            2
-        }
-        fn state_names(&self, _: Mode) -> &[&'static str] {
-            &["x", "v"]
-        }
-        fn mode_name(&self, _: Mode) -> &'static str {
-            "flight"
-        }
-        fn guards(&self, _: Mode) -> &[Guard] {
-            &[]
-        }
-        fn guard(&self, _: Mode, _: usize, _: &[f64]) -> f64 {
-            0.0
-        }
-        fn flow(&self, _: Mode) -> Flow {
-            Flow::Ode
-        }
-        fn rhs(&self, _: Mode, x: &[f64], dx: &mut [f64]) {
-            dx[0] = x[1];
-            dx[1] = -x[0];
-        }
-        fn reset(&self, _: Mode, _: usize, _: &mut [f64]) -> Jump {
-            unreachable!("no guards")
-        }
-    }
-
     #[test]
     fn the_dense_output_is_seventh_order_inside_the_step() {
         // Halving the step divides the interpolant's error at a fixed
         // fraction of it by about 2^8 (local error of a 7th-degree interpolant).
+        // The mechanism's strain flow is a harmonic oscillator with a
+        // closed form to compare with.
+        let model = StrainMechanism {
+            mechanism: Mechanism {
+                eta: 1.5,
+                omega: 1.0,
+            },
+        };
+        let (eps, rate) = (0.3, 0.2);
         let error = |h_max: f64| {
             let mut m = Dop853::new(
                 2,
@@ -681,12 +646,13 @@ mod tests {
                     atol: 1.0,
                 },
             );
-            m.step(&Oscillator, 0, &[1.0, 0.0], h_max, 0.0).unwrap();
+            m.step(&model, FLIGHT, &[eps, rate], h_max, 0.0).unwrap();
             let h = m.dense().h;
             let mut x = [0.0; 2];
             let tau = 0.37 * h;
             m.dense().eval(tau, &mut x);
-            (h, (x[0] - tau.cos()).abs().max((x[1] + tau.sin()).abs()))
+            let exact = model.mechanism.flow(eps, rate, tau);
+            (h, (x[0] - exact.0).abs().max((x[1] - exact.1).abs()))
         };
         let ((h1, coarse), (h2, fine)) = (error(0.4), error(0.2));
         let order = (coarse / fine).ln() / (h1 / h2).ln();

@@ -11,7 +11,7 @@
 // Stage sums read several arrays at one index: an index loop says it plainly.
 #![allow(clippy::needless_range_loop)]
 
-use crate::engine::adaptive::{StepFailure, Tolerances, initial_step, shrink};
+use crate::engine::adaptive::{StepControl, StepFailure, Tolerances, TrialError};
 use crate::engine::model::{HybridModel, Mode};
 
 /// The order of the error estimate in the step size.
@@ -80,53 +80,44 @@ impl DenseStep {
 /// The integrator's working storage and step-size memory.
 #[derive(Debug, Clone)]
 pub struct Dopri5 {
-    tol: Tolerances,
+    control: StepControl,
     k: [Vec<f64>; 7],
     y1: Vec<f64>,
     scratch: Vec<f64>,
-    /// Whether `k[0]` holds `f` at the start of the next step (first same as last).
-    fsal: bool,
-    h_next: Option<f64>,
     dense: DenseStep,
-    /// Right-hand-side evaluations so far.
-    pub evaluations: u64,
-    /// Largest component of the error estimate of the last trial step.
-    trial_error: f64,
-    /// The same, for the last accepted step.
-    local_error: f64,
 }
 
 impl Dopri5 {
     pub fn new(dimension: usize, tol: Tolerances) -> Self {
         let v = || vec![0.0; dimension];
         Dopri5 {
-            tol,
+            control: StepControl::new(tol, ORDER, 5.0, 0.2),
             k: [v(), v(), v(), v(), v(), v(), v()],
             y1: v(),
             scratch: v(),
-            fsal: false,
-            h_next: None,
             dense: DenseStep {
                 h: 0.0,
                 r: [v(), v(), v(), v(), v()],
                 y1: v(),
             },
-            evaluations: 0,
-            trial_error: 0.0,
-            local_error: 0.0,
         }
     }
 
     /// Forget the previous step: the next one starts from a state that was
     /// not this integrator's last output (after a reset).
     pub fn restart(&mut self) {
-        self.fsal = false;
+        self.control.fsal = false;
     }
 
     /// The embedded error estimate of the last accepted step (largest
     /// component, absolute): a pessimistic bound on its local error.
     pub fn local_error(&self) -> f64 {
-        self.local_error
+        self.control.local_error
+    }
+
+    /// Right-hand-side evaluations so far.
+    pub fn evaluations(&self) -> u64 {
+        self.control.evaluations
     }
 
     /// The dense output of the last accepted step.
@@ -143,64 +134,40 @@ impl Dopri5 {
         h_max: f64,
         h_min: f64,
     ) -> Result<(), StepFailure> {
-        if !self.fsal {
-            self.eval(model, mode, y0, 0);
-            if self.k[0].iter().any(|v| !v.is_finite()) {
-                return Err(StepFailure::NonFinite);
-            }
-        }
-        let mut h = match (self.fsal, self.h_next) {
-            (true, Some(h)) => h,
-            _ => {
-                let [f0, f1, ..] = &mut self.k;
-                self.evaluations += 1;
-                initial_step(
-                    model,
-                    mode,
-                    self.tol,
-                    ORDER,
-                    y0,
-                    f0,
-                    &mut self.scratch,
-                    f1,
-                    h_max,
-                )
-            }
-        }
-        .min(h_max);
+        let mut h = self.control.begin(
+            model,
+            mode,
+            y0,
+            h_max,
+            h_min,
+            &mut self.k,
+            &mut self.scratch,
+        )?;
         loop {
-            if h < h_min {
-                return Err(StepFailure::Collapsed { h });
+            let error = self.attempt(model, mode, y0, h);
+            match self.control.judge(h, error, h_min)? {
+                Some(next) => h = next,
+                None => {
+                    self.finish(y0, h);
+                    return Ok(());
+                }
             }
-            let err = self.attempt(model, mode, y0, h);
-            if !err.is_finite() {
-                h *= 0.1;
-                continue;
-            }
-            if err <= 1.0 {
-                let grow = (0.9 * shrink(err, ORDER)).min(5.0);
-                self.h_next = Some(h * grow.max(1.0));
-                self.local_error = self.trial_error;
-                self.finish(y0, h);
-                return Ok(());
-            }
-            h *= (0.9 * shrink(err, ORDER)).max(0.2);
         }
     }
 
     fn eval<M: HybridModel + ?Sized>(&mut self, model: &M, mode: Mode, y: &[f64], stage: usize) {
         model.rhs(mode, y, &mut self.k[stage]);
-        self.evaluations += 1;
+        self.control.evaluations += 1;
     }
 
-    /// One trial step of size `h`; returns the scaled error norm.
+    /// One trial step of size `h`, and its error.
     fn attempt<M: HybridModel + ?Sized>(
         &mut self,
         model: &M,
         mode: Mode,
         y0: &[f64],
         h: f64,
-    ) -> f64 {
+    ) -> TrialError {
         let stages: [(usize, &[f64]); 6] = [
             (1, &[A21]),
             (2, &[A31, A32]),
@@ -225,8 +192,7 @@ impl Dopri5 {
             self.scratch = y;
         }
         let k = &self.k;
-        let mut sum = 0.0;
-        self.trial_error = 0.0;
+        let (mut sum, mut largest) = (0.0, 0.0_f64);
         for i in 0..y0.len() {
             let e = h
                 * (E1 * k[0][i]
@@ -235,14 +201,19 @@ impl Dopri5 {
                     + E5 * k[4][i]
                     + E6 * k[5][i]
                     + E7 * k[6][i]);
-            let scale = self.tol.scale(y0[i].abs().max(self.y1[i].abs()));
+            let scale = self.control.tol.scale(y0[i].abs().max(self.y1[i].abs()));
             sum += (e / scale).powi(2);
-            self.trial_error = self.trial_error.max(e.abs());
+            largest = largest.max(e.abs());
         }
-        if self.y1.iter().any(|v| !v.is_finite()) || k[6].iter().any(|v| !v.is_finite()) {
-            return f64::NAN;
+        let blew_up = self.y1.iter().any(|v| !v.is_finite()) || k[6].iter().any(|v| !v.is_finite());
+        TrialError {
+            norm: if blew_up {
+                f64::NAN
+            } else {
+                (sum / y0.len() as f64).sqrt()
+            },
+            largest,
         }
-        (sum / y0.len() as f64).sqrt()
     }
 
     /// Store the dense output of the accepted step and carry `f(y1)` over.
@@ -267,6 +238,6 @@ impl Dopri5 {
         self.dense.h = h;
         self.dense.y1.copy_from_slice(&self.y1);
         self.k.swap(0, 6);
-        self.fsal = true;
+        self.control.fsal = true;
     }
 }

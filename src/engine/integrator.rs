@@ -6,7 +6,7 @@
 //! frozen state, or steps of the chosen integrator.
 
 use crate::engine::adaptive::{StepFailure, Tolerances};
-use crate::engine::dop853::Dop853;
+use crate::engine::dop853::{Crossing, Dop853};
 use crate::engine::dopri5::Dopri5;
 use crate::engine::linear::Linear;
 use crate::engine::locate::Interpolant;
@@ -180,8 +180,7 @@ impl Integrator {
         match self {
             Integrator::Dopri5(_) => Interpolant::Polynomial { degree: 4 },
             Integrator::Dop853(_) => Interpolant::Polynomial { degree: 7 },
-            // A cubic Hermite interpolant is a quartic with a zero top coefficient.
-            Integrator::Verlet(_) => Interpolant::Polynomial { degree: 4 },
+            Integrator::Verlet(_) => Interpolant::Polynomial { degree: 3 },
             Integrator::Linear(_) => Interpolant::Other,
         }
     }
@@ -190,20 +189,16 @@ impl Integrator {
     /// method's dense output is less accurate than its steps (DOP853, see
     /// [`Dop853::sharpen`]); `None` for the others and where sharpening
     /// declines, leaving the dense output's crossing as it was.
-    #[allow(clippy::too_many_arguments)]
     pub fn sharpen<M: HybridModel + ?Sized>(
         &mut self,
         model: &M,
         mode: Mode,
         y0: &[f64],
-        tau: f64,
-        reach: f64,
-        guard: &dyn Fn(&[f64]) -> f64,
-        crossed: &dyn Fn(f64) -> bool,
+        crossing: &Crossing,
         x: &mut [f64],
     ) -> Option<f64> {
         match self {
-            Integrator::Dop853(m) => m.sharpen(model, mode, y0, tau, reach, guard, crossed, x),
+            Integrator::Dop853(m) => m.sharpen(model, mode, y0, crossing, x),
             _ => None,
         }
     }
@@ -221,8 +216,8 @@ impl Integrator {
     /// Right-hand-side or propagator evaluations so far.
     pub fn evaluations(&self) -> u64 {
         match self {
-            Integrator::Dopri5(m) => m.evaluations,
-            Integrator::Dop853(m) => m.evaluations,
+            Integrator::Dopri5(m) => m.evaluations(),
+            Integrator::Dop853(m) => m.evaluations(),
             Integrator::Verlet(m) => m.evaluations,
             Integrator::Linear(m) => m.evaluations(),
         }

@@ -22,6 +22,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use crate::engine::adaptive::{StepFailure, Tolerances};
+use crate::engine::dop853::Crossing;
 use crate::engine::integrator::{Integrator, Method, Motion, motion};
 use crate::engine::locate::scan_step;
 use crate::engine::model::{Affects, Direction, HybridModel, Mode};
@@ -449,16 +450,15 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
             Direction::Either => v == 0.0 || v.signum() != before.signum(),
         };
         let mut sharp = std::mem::take(&mut self.after);
-        let correction = self.integrator.sharpen(
-            model,
-            mode,
-            &self.state,
+        let crossing = Crossing {
             tau,
             reach,
-            &guard,
-            &crossed,
-            &mut sharp,
-        );
+            guard: &guard,
+            crossed: &crossed,
+        };
+        let correction = self
+            .integrator
+            .sharpen(model, mode, &self.state, &crossing, &mut sharp);
         let t = match correction {
             Some(s) => {
                 x.copy_from_slice(&sharp);

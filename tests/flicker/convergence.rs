@@ -57,12 +57,13 @@ fn stormer_verlet_is_second_order() {
     );
 }
 
-#[test]
-fn dormand_prince_is_fifth_order() {
-    let points: Vec<(f64, f64)> = [1e-6, 1e-7, 1e-8, 1e-9, 1e-10]
+/// The order an adaptive pair shows: the slope of error against flow
+/// evaluations over `tolerances` (rtol = atol), log-log.
+fn adaptive_order(pair: fn(Tolerances) -> Method, tolerances: [f64; 5]) -> f64 {
+    let points: Vec<(f64, f64)> = tolerances
         .iter()
         .map(|&tol| {
-            let (error, cost) = error_and_cost(Method::Dopri5(Tolerances {
+            let (error, cost) = error_and_cost(pair(Tolerances {
                 rtol: tol,
                 atol: tol,
             }));
@@ -70,31 +71,25 @@ fn dormand_prince_is_fifth_order() {
         })
         .collect();
     let order = -slope(&points);
-    println!("Dormand-Prince measured order {order:.3}");
-    assert!(
-        (order - 5.0).abs() < 0.3,
-        "measured order {order}: {points:?}"
+    println!(
+        "{}: measured order {order:.3}: {points:?}",
+        pair(Tolerances::default()).name()
     );
+    order
+}
+
+#[test]
+fn dormand_prince_is_fifth_order() {
+    let order = adaptive_order(Method::Dopri5, [1e-6, 1e-7, 1e-8, 1e-9, 1e-10]);
+    assert!((order - 5.0).abs() < 0.3, "measured order {order}");
 }
 
 #[test]
 fn dop853_is_eighth_order() {
-    let points: Vec<(f64, f64)> = [1e-8, 1e-9, 1e-10, 1e-11, 1e-12]
-        .iter()
-        .map(|&tol| {
-            let (error, cost) = error_and_cost(Method::Dop853(Tolerances {
-                rtol: tol,
-                atol: tol,
-            }));
-            (cost, error)
-        })
-        .collect();
-    let order = -slope(&points);
-    println!("DOP853 measured order {order:.3}: {points:?}");
-    assert!(
-        (order - 8.0).abs() < 0.3,
-        "measured order {order}: {points:?}"
-    );
+    // Tighter: at looser tolerances its few long steps are not yet in the
+    // asymptotic regime.
+    let order = adaptive_order(Method::Dop853, [1e-8, 1e-9, 1e-10, 1e-11, 1e-12]);
+    assert!((order - 8.0).abs() < 0.3, "measured order {order}");
 }
 
 #[test]
