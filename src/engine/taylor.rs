@@ -140,7 +140,9 @@ pub fn first_fall(c: &[f64], a: f64, b: f64) -> Result<Option<f64>, String> {
 /// division), which only a zero of `p` at `a` needs.
 fn shifted_to(c: &[f64], a: f64, (p, d1, d2): (f64, f64, f64)) -> Vec<f64> {
     let mut shifted = c.to_vec();
-    for k in 0..shifted.len() {
+    // At `a = 0` (a series that starts at the event just past) there is
+    // nothing to shift.
+    for k in (0..shifted.len()).filter(|_| a != 0.0) {
         for j in (k..shifted.len() - 1).rev() {
             shifted[j] += a * shifted[j + 1];
         }

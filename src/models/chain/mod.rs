@@ -25,6 +25,7 @@ pub mod coarse;
 pub mod collide;
 pub mod modal;
 pub mod ode;
+pub mod series;
 pub mod taylor;
 
 pub use modal::modal;

@@ -19,6 +19,11 @@
 //! none is missed and all come in strict time order through the engine's
 //! queue.
 //!
+//! The series are stored coefficient-major ([`Series`]), so the window
+//! start's evaluation, recursion and proof that a gap stays open over the
+//! whole window (most gaps do, and are then not searched at all) each run
+//! along rows of all units at once.
+//!
 //! An impact at unit `j` changes the velocities of nodes `j - 1` and `j`
 //! only. A unit or node `d` places beyond them first feels that change in
 //! its coefficient of order `2d` (along a single path, `theta^(2d) / (2d)!`
@@ -44,12 +49,13 @@
 //! ways, so a unit on the edge is neither captured nor released over and
 //! over.
 
-use crate::engine::taylor::{eval, first_fall, integral};
+use crate::engine::taylor::{first_fall, integral};
 use crate::engine::{Direction, Fired, Guard, LocalModel};
 use crate::time::Time;
 
 use super::Chain;
 use super::collide::cascade;
+use super::series::{MAX_COLUMN, Series};
 
 /// Window length in scaled time `omega t`: longer windows mean fewer full
 /// re-expansions but longer series and a wider reach per impact.
@@ -78,15 +84,20 @@ pub struct TaylorChain {
     /// Per index `0..=N+1` (1..N used): the scaled time since `start` at
     /// which its series begins (its clock).
     origin: Vec<f64>,
-    /// Series of gaps `Delta_n` and scaled velocities `u_n`, `K + 1`
-    /// coefficients per index, index-major.
-    gap: Vec<f64>,
-    vel: Vec<f64>,
+    /// Series of gaps `Delta_n` and scaled velocities `u_n`, column `n`
+    /// for index `n` (0 the wall, N + 1 the ghost).
+    series: Series,
+    /// Per unit, whether its gap is proven open over the whole window
+    /// (set at the window start, cleared when an impact re-expands it):
+    /// most units are, and their predictions cost nothing.
+    open: Vec<bool>,
     guards: Vec<Guard>,
     /// A gap this close to zero counts as shut in a simultaneous impact.
     shut_below: f64,
-    scratch_gap: Vec<f64>,
-    scratch_vel: Vec<f64>,
+    /// The series of an impact's reach, re-expanded from its instant.
+    scratch: Series,
+    /// The window end's clocks, gaps, velocities and bounds, per column.
+    sweep: [Vec<f64>; 3],
     /// The cascade's view of an impact's reach: which units are shut, and
     /// the node velocities (kept to spare an allocation per impact).
     scratch_shut: Vec<bool>,
@@ -150,7 +161,6 @@ impl TaylorChain {
         let reach = reach_for(WINDOW, order);
         let omega = (chain.stiffness / chain.mass).sqrt();
         let ghost = (chain.load - chain.critical_load) / chain.stiffness;
-        let stride = order + 1;
         let mut guards = if chain.constraint {
             let mut impacts = vec![Guard::affine(IMPACT, Direction::Falling); n];
             impacts.push(Guard::affine(RELEASE, Direction::Falling).as_crossing());
@@ -173,12 +183,12 @@ impl TaylorChain {
             start: Time::new(0.0),
             span: WINDOW / omega,
             origin: vec![0.0; n + 2],
-            gap: vec![0.0; (n + 2) * stride],
-            vel: vec![0.0; (n + 2) * stride],
+            series: Series::new(order, n),
+            open: vec![false; n + 2],
             guards,
             shut_below: 16.0 * f64::EPSILON * scale,
-            scratch_gap: Vec::new(),
-            scratch_vel: Vec::new(),
+            scratch: Series::new(order, 0),
+            sweep: Default::default(),
             scratch_shut: Vec::new(),
             scratch_nodes: Vec::new(),
             wall_integral: 0.0,
@@ -188,22 +198,17 @@ impl TaylorChain {
             held_since: None,
             chain,
         };
-        for i in 1..=n {
-            model.gap[i * stride] = gaps[i - 1];
-            model.vel[i * stride] = velocities[i - 1] / omega;
+        model.series.gap[1..=n].copy_from_slice(gaps);
+        for (u, v) in model.series.vel[1..=n].iter_mut().zip(velocities) {
+            *u = v / omega;
         }
-        let (gap, vel) = (&mut model.gap[stride..], &mut model.vel[stride..]);
-        levels(gap, vel, n, order, Some(ghost), None);
+        model.series.expand(ghost, None);
         Ok(model)
     }
 
     /// Series order and reach of an impact (units each way), for reports.
     pub fn order_and_reach(&self) -> (usize, usize) {
         (self.order, self.reach)
-    }
-
-    fn stride(&self) -> usize {
-        self.order + 1
     }
 
     /// Scaled time of `t` since the window start.
@@ -213,13 +218,19 @@ impl TaylorChain {
 
     /// `(Delta_n, u_n)` of index `n` at scaled time `sigma` in the window.
     fn state(&self, n: usize, sigma: f64) -> (f64, f64) {
-        let s = self.stride();
         let tau = (sigma - self.origin[n]).max(0.0);
-        let range = n * s..(n + 1) * s;
-        (
-            eval(&self.gap[range.clone()], tau),
-            eval(&self.vel[range], tau),
-        )
+        let s = &self.series;
+        (s.value(&s.gap, n, tau), s.value(&s.vel, n, tau))
+    }
+
+    /// `integral of Delta_1 d sigma` over the first `tau` of unit 1's series.
+    fn wall_area(&self, tau: f64) -> f64 {
+        integral(self.gap_series(1, &mut [0.0; MAX_COLUMN]), tau)
+    }
+
+    /// The gap series of unit `n`, into `out`.
+    fn gap_series<'o>(&self, n: usize, out: &'o mut [f64; MAX_ORDER + 1]) -> &'o [f64] {
+        self.series.column(&self.series.gap, n, out)
     }
 
     /// Unit gaps `Delta_n` and node velocities `v_n` at `t` (not before the
@@ -253,9 +264,8 @@ impl TaylorChain {
     /// difference from [`momentum`](Self::momentum) is the balance error.
     pub fn momentum_by_impulses(&self, t: Time) -> f64 {
         let c = &self.chain;
-        let s = self.stride();
         let tau = (self.sigma(t) - self.origin[1]).max(0.0);
-        let area = (self.wall_integral + integral(&self.gap[s..2 * s], tau)) / self.omega;
+        let area = (self.wall_integral + self.wall_area(tau)) / self.omega;
         let held = self
             .held_since
             .map_or(0.0, |since| (c.critical_load - c.load) * t.since(since));
@@ -281,19 +291,19 @@ impl TaylorChain {
 
     /// Re-expand every unit at the end of the window and start the next.
     fn next_window(&mut self) {
-        let (n, s) = (self.chain.units, self.stride());
-        for i in 1..=n {
-            let (d, u) = self.state(i, WINDOW);
-            if i == 1 {
-                self.wall_integral += integral(&self.gap[s..2 * s], WINDOW - self.origin[1]);
-            }
-            self.gap[i * s] = d;
-            self.vel[i * s] = u;
-            self.origin[i] = 0.0;
-        }
-        let (gap, vel) = (&mut self.gap[s..], &mut self.vel[s..]);
-        let block = self.block.map(|a| a - 1);
-        levels(gap, vel, n, self.order, Some(self.ghost), block);
+        let n = self.chain.units;
+        self.wall_integral += self.wall_area(WINDOW - self.origin[1]);
+        let [tau, gaps, vels] = &mut self.sweep;
+        tau.clear();
+        tau.extend(self.origin[1..=n].iter().map(|o| (WINDOW - o).max(0.0)));
+        gaps.resize(n, 0.0);
+        vels.resize(n, 0.0);
+        self.series.values(1, tau, gaps, vels);
+        self.series.gap[1..=n].copy_from_slice(gaps);
+        self.series.vel[1..=n].copy_from_slice(vels);
+        self.origin.fill(0.0);
+        self.series.expand(self.ghost, self.block);
+        self.series.open_over(WINDOW, tau, &mut self.open);
         self.start = self.start.after(self.span);
     }
 
@@ -305,20 +315,21 @@ impl TaylorChain {
         let (mut lo, mut hi) = (unit, unit);
         loop {
             let (r_lo, r_hi) = self.reach_around(lo, hi);
-            let (w_lo, count) = self.load_window(r_lo, r_hi, sigma);
-            let s = self.stride();
-            let u_at = |node: usize, v: &[f64]| if node == 0 { 0.0 } else { v[(node - w_lo) * s] };
+            let w_lo = self.load_window(r_lo, r_hi, sigma);
+            // Column of index i in the scratch series; node 0 (the wall)
+            // reads zero there.
+            let col = |i: usize| i + 1 - w_lo;
+            let u_at = |node: usize, v: &[f64]| if node == 0 { 0.0 } else { v[col(node)] };
             let rel_velocity =
-                self.omega * (u_at(unit - 1, &self.scratch_vel) - u_at(unit, &self.scratch_vel));
+                self.omega * (u_at(unit - 1, &self.scratch.vel) - u_at(unit, &self.scratch.vel));
             let mut shut = std::mem::take(&mut self.scratch_shut);
             shut.clear();
             shut.extend(
-                (r_lo..=r_hi)
-                    .map(|i| i == unit || self.scratch_gap[(i - w_lo) * s] <= self.shut_below),
+                (r_lo..=r_hi).map(|i| i == unit || self.scratch.gap[col(i)] <= self.shut_below),
             );
             let mut v = std::mem::take(&mut self.scratch_nodes);
             v.clear();
-            v.extend((r_lo - 1..=r_hi).map(|i| u_at(i, &self.scratch_vel)));
+            v.extend((r_lo - 1..=r_hi).map(|i| u_at(i, &self.scratch.vel)));
             // Not closing after all (a graze within round-off, or a unit
             // coming to rest shut) changes no velocity, but the unit is
             // still re-expanded from here with its gap clamped to zero, so
@@ -337,11 +348,11 @@ impl TaylorChain {
             // Momentum the wall gave (flips of node 1 only).
             self.wall_impulse += self.chain.mass * self.omega * wall;
             for (k, node) in (r_lo - 1..=r_hi).enumerate().filter(|(_, node)| *node > 0) {
-                self.scratch_vel[(node - w_lo) * s] = v[k];
+                self.scratch.vel[col(node)] = v[k];
             }
             self.scratch_nodes = v;
             for i in touched.clone().chain(std::iter::once(unit)) {
-                let g = &mut self.scratch_gap[(i - w_lo) * s];
+                let g = &mut self.scratch.gap[col(i)];
                 // Shut means zero: drop the round-off overlap.
                 *g = g.max(0.0);
             }
@@ -353,7 +364,7 @@ impl TaylorChain {
             if r_hi == n {
                 self.settle_end(r_lo, w_lo, t, self.shut_below);
             }
-            self.store_window(r_lo, r_hi, w_lo, count, sigma);
+            self.store_window(r_lo, r_hi, w_lo, sigma);
             return Fired {
                 affects: self.guards_of(r_lo, r_hi),
                 unit: Some(unit as u64),
@@ -372,8 +383,8 @@ impl TaylorChain {
         let sigma = self.sigma(t);
         self.set_block((a < n).then_some(a + 1), t);
         let (r_lo, r_hi) = self.reach_around(a.saturating_sub(1).max(1), n);
-        let (w_lo, count) = self.load_window(r_lo, r_hi, sigma);
-        self.store_window(r_lo, r_hi, w_lo, count, sigma);
+        let w_lo = self.load_window(r_lo, r_hi, sigma);
+        self.store_window(r_lo, r_hi, w_lo, sigma);
         Fired {
             affects: self.guards_of(r_lo, r_hi),
             unit: Some(a as u64),
@@ -399,51 +410,49 @@ impl TaylorChain {
     }
 
     /// The state at `sigma` of the units within the series' spread of
-    /// `r_lo..=r_hi`, into the scratch series' order 0; returns the
-    /// window's first unit and its length.
-    fn load_window(&mut self, r_lo: usize, r_hi: usize, sigma: f64) -> (usize, usize) {
-        let (n, s) = (self.chain.units, self.stride());
+    /// `r_lo..=r_hi`, into the scratch series' order 0 (column 1 is unit
+    /// `w_lo`); returns `w_lo`.
+    fn load_window(&mut self, r_lo: usize, r_hi: usize, sigma: f64) -> usize {
+        let n = self.chain.units;
         let (w_lo, w_hi) = (
             r_lo.saturating_sub(self.spread).max(1),
             (r_hi + self.spread).min(n),
         );
         let count = w_hi - w_lo + 1;
-        self.scratch_gap.clear();
-        self.scratch_gap.resize(count * s, 0.0);
-        self.scratch_vel.clear();
-        self.scratch_vel.resize(count * s, 0.0);
-        for i in w_lo..=w_hi {
-            let (d, u) = self.state(i, sigma);
-            self.scratch_gap[(i - w_lo) * s] = d;
-            self.scratch_vel[(i - w_lo) * s] = u;
-        }
-        (w_lo, count)
+        self.scratch.reset(count);
+        let tau = &mut self.sweep[0];
+        tau.clear();
+        tau.extend(
+            self.origin[w_lo..=w_hi]
+                .iter()
+                .map(|o| (sigma - o).max(0.0)),
+        );
+        let (gaps, vels) = (
+            &mut self.scratch.gap[1..=count],
+            &mut self.scratch.vel[1..=count],
+        );
+        self.series.values(w_lo, tau, gaps, vels);
+        w_lo
     }
 
     /// Expand the scratch window and keep the series of `r_lo..=r_hi`,
     /// which start at `sigma`.
-    fn store_window(&mut self, r_lo: usize, r_hi: usize, w_lo: usize, count: usize, sigma: f64) {
-        let (n, s) = (self.chain.units, self.stride());
-        let reaches_end = w_lo + count - 1 == n;
-        let ghost = reaches_end.then_some(self.ghost);
-        let block = self.block.filter(|_| reaches_end).map(|a| a - w_lo);
-        levels(
-            &mut self.scratch_gap,
-            &mut self.scratch_vel,
-            count,
-            self.order,
-            ghost,
-            block,
-        );
+    fn store_window(&mut self, r_lo: usize, r_hi: usize, w_lo: usize, sigma: f64) {
+        let n = self.chain.units;
+        let reaches_end = w_lo + self.scratch.width() - 3 == n;
+        let ghost = if reaches_end { self.ghost } else { 0.0 };
+        let block = self.block.filter(|_| reaches_end).map(|a| a + 1 - w_lo);
+        self.scratch.expand(ghost, block);
         if r_lo == 1 {
             // The wall force's integral so far on unit 1's series, before
             // the series is replaced.
-            self.wall_integral += integral(&self.gap[s..2 * s], sigma - self.origin[1]);
+            self.wall_integral += self.wall_area(sigma - self.origin[1]);
         }
-        let (from, to) = ((r_lo - w_lo) * s, (r_hi - w_lo + 1) * s);
-        self.gap[r_lo * s..(r_hi + 1) * s].copy_from_slice(&self.scratch_gap[from..to]);
-        self.vel[r_lo * s..(r_hi + 1) * s].copy_from_slice(&self.scratch_vel[from..to]);
+        let count = r_hi - r_lo + 1;
+        self.series
+            .copy_columns(&self.scratch, r_lo + 1 - w_lo, r_lo, count);
         self.origin[r_lo..=r_hi].fill(sigma);
+        self.open[r_lo..=r_hi].fill(false);
     }
 
     /// The guards whose predictions a change to units `r_lo..=r_hi` moves:
@@ -464,18 +473,18 @@ impl TaylorChain {
     /// force is least in unit `a`, and positive while
     /// `(N - a + 1) Delta_{a-1} < (F_cr - F) / k`.
     fn settle_end(&mut self, r_lo: usize, w_lo: usize, t: Time, speeds: f64) -> bool {
-        let (n, s) = (self.chain.units, self.stride());
+        let n = self.chain.units;
         if self.block.is_some() || self.ghost >= 0.0 {
             return false;
         }
-        let gap = |i: usize, g: &[f64]| g[(i - w_lo) * s];
-        let node = |i: usize, v: &[f64]| if i == 0 { 0.0 } else { v[(i - w_lo) * s] };
+        let gap = |i: usize, g: &[f64]| g[i + 1 - w_lo];
+        let node = |i: usize, v: &[f64]| if i == 0 { 0.0 } else { v[i + 1 - w_lo] };
         let floor = if r_lo == 1 { 1 } else { r_lo + 1 };
         let mut a = n + 1;
         while a > floor {
             let unit = a - 1;
-            let resting = gap(unit, &self.scratch_gap) <= self.shut_below
-                && (node(unit - 1, &self.scratch_vel) - node(unit, &self.scratch_vel)).abs()
+            let resting = gap(unit, &self.scratch.gap) <= self.shut_below
+                && (node(unit - 1, &self.scratch.vel) - node(unit, &self.scratch.vel)).abs()
                     <= speeds;
             if !resting {
                 break;
@@ -486,7 +495,7 @@ impl TaylorChain {
         // round-off, the same margin the release keeps), the rest is pushed.
         if a >= 2
             && a <= n
-            && (n - a + 1) as f64 * gap(a - 1, &self.scratch_gap) + self.ghost > self.force_noise(a)
+            && (n - a + 1) as f64 * gap(a - 1, &self.scratch.gap) + self.ghost > self.force_noise(a)
         {
             a += 1;
         }
@@ -502,16 +511,16 @@ impl TaylorChain {
         } else {
             nodes
                 .clone()
-                .map(|i| node(i, &self.scratch_vel))
+                .map(|i| node(i, &self.scratch.vel))
                 .sum::<f64>()
                 / (n - a + 2) as f64
         };
         for i in a..=n {
-            self.scratch_gap[(i - w_lo) * s] = 0.0;
+            self.scratch.gap[i + 1 - w_lo] = 0.0;
         }
         let mut removed = 0.0;
         for i in nodes.filter(|&i| i > 0) {
-            let v = &mut self.scratch_vel[(i - w_lo) * s];
+            let v = &mut self.scratch.vel[i + 1 - w_lo];
             removed += *v - mean;
             *v = mean;
         }
@@ -541,11 +550,11 @@ impl TaylorChain {
         }
         self.set_block(None, t);
         let (r_lo, r_hi) = self.reach_around(unit, n);
-        let (w_lo, count) = self.load_window(r_lo, r_hi, sigma);
+        let w_lo = self.load_window(r_lo, r_hi, sigma);
         if !self.settle_end(r_lo, w_lo, t, f64::INFINITY) {
             return None;
         }
-        self.store_window(r_lo, r_hi, w_lo, count, sigma);
+        self.store_window(r_lo, r_hi, w_lo, sigma);
         Some(Fired {
             affects: self.guards_of(r_lo, r_hi),
             unit: Some(unit as u64),
@@ -577,7 +586,7 @@ impl LocalModel for TaylorChain {
     }
 
     fn predict(&self, guard: usize, now: Time) -> Result<Option<Time>, String> {
-        let (n, s) = (self.chain.units, self.stride());
+        let n = self.chain.units;
         if guard + 1 == self.guards.len() {
             return Ok(Some(self.start.after(self.span)));
         }
@@ -589,20 +598,24 @@ impl LocalModel for TaylorChain {
                 return Ok(None);
             };
             let scale = (n - a + 1) as f64;
-            let mut force = [0.0; MAX_ORDER + 1];
-            for (f, d) in force.iter_mut().zip(&self.gap[(a - 1) * s..a * s]) {
-                *f = -scale * d;
+            let mut force = [0.0; MAX_COLUMN];
+            let len = self.gap_series(a - 1, &mut force).len();
+            for f in &mut force[..len] {
+                *f *= -scale;
             }
             // Released once the force is clearly below zero.
             force[0] -= self.ghost - self.force_noise(a);
-            return self.first_root(a - 1, &force[..s], now);
+            return self.first_root(a - 1, &force[..len], now);
         }
         if self.block.is_some_and(|a| guard + 1 >= a) {
             // Resting in the end block: no impact until it is released.
             return Ok(None);
         }
         let unit = guard + 1;
-        self.first_root(unit, &self.gap[unit * s..(unit + 1) * s], now)
+        if self.open[unit] {
+            return Ok(None);
+        }
+        self.first_root(unit, self.gap_series(unit, &mut [0.0; MAX_COLUMN]), now)
     }
 
     fn fire(&mut self, guard: usize, t: Time) -> Result<Fired, String> {
@@ -640,73 +653,15 @@ impl LocalModel for TaylorChain {
     }
 }
 
-/// Fill orders `1..=K` of the series of `count` consecutive indices from
-/// their order 0 (index-major, `K + 1` per index). The first index's left
-/// neighbour reads zero velocity: the wall's if it is unit 1; otherwise
-/// orders above `2i` of the `i`-th index from that open end are not valid
-/// (they would need states beyond it), and likewise at the right end
-/// unless `ghost` says it is unit N with that constant elongation beyond.
-///
-/// `block` (with `ghost`): the slice's units from this index on are the end
-/// block in resting contact: shut at every order, their nodes (and the
-/// node on the block's left) moving as one rigid body pushed by the ghost
-/// and pulled by the unit left of it; a block from index 0 includes the
-/// wall and is at rest.
-fn levels(
-    gap: &mut [f64],
-    vel: &mut [f64],
-    count: usize,
-    order: usize,
-    ghost: Option<f64>,
-    block: Option<usize>,
-) {
-    let s = order + 1;
-    for k in 0..order {
-        let inv = 1.0 / (k + 1) as f64;
-        let mut left = 0.0; // velocity series of the index on the left, order k
-        let load = match ghost {
-            Some(f) if k == 0 => f,
-            _ => 0.0,
-        };
-        // Two passes, so that each walks whole series without index
-        // arithmetic: gaps of order k + 1 from velocities of order k, then
-        // velocities of order k + 1 from gaps of order k (untouched by the
-        // first pass).
-        let (gap, vel) = (&mut gap[..count * s], &mut vel[..count * s]);
-        for (g, v) in gap.chunks_exact_mut(s).zip(vel.chunks_exact(s)) {
-            g[k + 1] = (v[k] - left) * inv;
-            left = v[k];
-        }
-        let mut rights = gap.chunks_exact(s).skip(1).map(|g| g[k]);
-        for (v, g) in vel.chunks_exact_mut(s).zip(gap.chunks_exact(s)) {
-            let right = rights.next().unwrap_or(load);
-            v[k + 1] = (right - g[k]) * inv;
-        }
-        if let Some(b) = block.filter(|&b| b < count) {
-            let nodes = (count - b + 1) as f64;
-            let rigid = match b {
-                0 => 0.0,
-                _ => (load - gap[(b - 1) * s + k]) * inv / nodes,
-            };
-            for i in b..count {
-                gap[i * s + k + 1] = 0.0;
-            }
-            for i in b.saturating_sub(1)..count {
-                vel[i * s + k + 1] = rigid;
-            }
-        }
-    }
-}
-
 /// Highest series order a window may need.
-const MAX_ORDER: usize = 63;
+const MAX_ORDER: usize = MAX_COLUMN - 1;
 
 /// The smallest order whose truncation over a window is certified.
 fn order_for(window: f64) -> usize {
     let x = 2.0 * window;
     (1..=MAX_ORDER)
         .find(|&k| tail(x, k + 1) < CERTIFIED)
-        .expect("a window below 1 converges")
+        .expect("the window is short enough for a series of order 15")
 }
 
 /// The smallest reach beyond which an impact's effect is certified. The

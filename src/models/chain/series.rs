@@ -1,0 +1,208 @@
+//! Taylor series of a run of consecutive chain indices, stored
+//! coefficient-major: row `k` holds the order-`k` coefficients of every
+//! index side by side, so the recursion, the evaluation of a whole window
+//! and the cheap proof that a gap stays open are each a stencil or a
+//! pointwise update along a row, which the compiler vectorizes.
+//!
+//! Column `c` is chain index `first + c - 1`: the gap `Delta` of that unit
+//! and the scaled velocity `u` of its node (the unit's end away from the
+//! wall). Columns `0` and `width - 1` are boundaries: the velocity in column
+//! 0 reads zero (the wall's if the run starts at unit 1), the gap in the last
+//! column is the ghost elongation beyond the loaded end (or zero).
+
+/// Longest series a column is gathered into (orders up to 15).
+pub const MAX_COLUMN: usize = 16;
+
+/// Gap and velocity series of `width - 2` consecutive indices, with their
+/// boundary columns.
+#[derive(Debug, Clone, Default)]
+pub struct Series {
+    order: usize,
+    width: usize,
+    pub gap: Vec<f64>,
+    pub vel: Vec<f64>,
+}
+
+impl Series {
+    /// Zero series of order `order` for `units` indices.
+    pub fn new(order: usize, units: usize) -> Self {
+        assert!(order < MAX_COLUMN, "series order {order} is too high");
+        let mut series = Series {
+            order,
+            ..Series::default()
+        };
+        series.reset(units);
+        series
+    }
+
+    /// Zero every coefficient and make room for `units` indices.
+    pub fn reset(&mut self, units: usize) {
+        self.width = units + 2;
+        let len = (self.order + 1) * self.width;
+        for row in [&mut self.gap, &mut self.vel] {
+            row.clear();
+            row.resize(len, 0.0);
+        }
+    }
+
+    pub fn width(&self) -> usize {
+        self.width
+    }
+
+    /// Where coefficient `k` of column `c` is.
+    pub fn at(&self, k: usize, c: usize) -> usize {
+        k * self.width + c
+    }
+
+    /// The series of column `c` of `row` (`gap` or `vel`) into `out`.
+    pub fn column<'o>(&self, row: &[f64], c: usize, out: &'o mut [f64]) -> &'o [f64] {
+        let out = &mut out[..=self.order];
+        for (x, &r) in out.iter_mut().zip(row[c..].iter().step_by(self.width)) {
+            *x = r;
+        }
+        out
+    }
+
+    /// `sum_k row[k][c] tau^k`.
+    pub fn value(&self, row: &[f64], c: usize, tau: f64) -> f64 {
+        let mut column = [0.0; MAX_COLUMN];
+        self.column(row, c, &mut column)
+            .iter()
+            .rev()
+            .fold(0.0, |p, &x| p * tau + x)
+    }
+
+    /// Gaps and velocities of columns `first..first + tau.len()`, each at
+    /// its own `tau`, into `gaps` and `vels` (as long as `tau`).
+    pub fn values(&self, first: usize, tau: &[f64], gaps: &mut [f64], vels: &mut [f64]) {
+        let (w, cols) = (self.width, first..first + tau.len());
+        for (out, row) in [(gaps, &self.gap), (vels, &self.vel)] {
+            out.fill(0.0);
+            for k in (0..=self.order).rev() {
+                let coefficients = &row[k * w..(k + 1) * w][cols.clone()];
+                for ((p, &t), &c) in out.iter_mut().zip(tau).zip(coefficients) {
+                    *p = *p * t + c;
+                }
+            }
+        }
+    }
+
+    /// Fill orders `1..=K` from order 0. The boundary columns are set here:
+    /// velocity zero on the left, the ghost elongation `ghost` (order 0
+    /// only) on the right. Orders above `2i` of the `i`-th column from an
+    /// open end are not valid (they would need states beyond it); the left
+    /// end is exact when it is the wall, the right when it is unit N.
+    ///
+    /// `block`: columns from this one on are the end block in resting
+    /// contact: shut at every order, their nodes and the node on the
+    /// block's left moving as one rigid body pushed by the ghost and pulled
+    /// by the unit left of it; a block from column 1 includes the wall
+    /// and is at rest.
+    pub fn expand(&mut self, ghost: f64, block: Option<usize>) {
+        let w = self.width;
+        for k in 0..=self.order {
+            self.vel[k * w] = 0.0;
+            self.gap[k * w + w - 1] = if k == 0 { ghost } else { 0.0 };
+        }
+        for k in 0..self.order {
+            let inv = 1.0 / (k + 1) as f64;
+            let (done, next) = self.gap.split_at_mut((k + 1) * w);
+            let (gap, next_gap) = (&done[k * w..], &mut next[..w]);
+            let (done, next) = self.vel.split_at_mut((k + 1) * w);
+            let (vel, next_vel) = (&done[k * w..], &mut next[..w]);
+            // Delta_n' = u_n - u_{n-1},  u_n' = Delta_{n+1} - Delta_n.
+            for ((g, &v), &left) in next_gap[1..w - 1].iter_mut().zip(&vel[1..]).zip(vel) {
+                *g = (v - left) * inv;
+            }
+            for ((v, &d), &right) in next_vel[1..w - 1].iter_mut().zip(&gap[1..]).zip(&gap[2..]) {
+                *v = (right - d) * inv;
+            }
+            if let Some(b) = block.filter(|&b| b < w - 1) {
+                let rigid = match b {
+                    1 => 0.0,
+                    _ => (gap[w - 1] - gap[b - 1]) * inv / (w - b) as f64,
+                };
+                next_gap[b..w - 1].fill(0.0);
+                next_vel[(b - 1).max(1)..w - 1].fill(rigid);
+            }
+        }
+    }
+
+    /// Per column, whether its gap is proven to stay above zero on
+    /// `[0, span]`: `Delta_0 > sum_{k >= 1} |Delta_k| span^k` (padded for
+    /// rounding), or constant.
+    pub fn open_over(&self, span: f64, bound: &mut Vec<f64>, open: &mut [bool]) {
+        let w = self.width;
+        bound.clear();
+        bound.resize(w, 0.0);
+        let mut power = 1.0;
+        for k in 1..=self.order {
+            power *= span;
+            for (b, &c) in bound.iter_mut().zip(&self.gap[k * w..(k + 1) * w]) {
+                *b += c.abs() * power;
+            }
+        }
+        for ((o, &b), &c) in open.iter_mut().zip(bound.iter()).zip(&self.gap[..w]) {
+            *o = c - b * (1.0 + 1e-12) > 0.0 || b == 0.0;
+        }
+    }
+
+    /// Copy columns `from..from + count` of `source` (same order) into
+    /// columns `to..` of this series, every order.
+    pub fn copy_columns(&mut self, source: &Series, from: usize, to: usize, count: usize) {
+        let (w, v) = (self.width, source.width);
+        for k in 0..=self.order {
+            let (dst, src) = (
+                k * w + to..k * w + to + count,
+                k * v + from..k * v + from + count,
+            );
+            self.gap[dst.clone()].copy_from_slice(&source.gap[src.clone()]);
+            self.vel[dst].copy_from_slice(&source.vel[src]);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn expansion_follows_the_free_chain_by_hand() {
+        // Two units at the wall, the second loaded by a ghost of 0.5:
+        // Delta' = (u_1, u_2 - u_1), u' = (Delta_2 - Delta_1, 0.5 - Delta_2).
+        let mut s = Series::new(2, 2);
+        let (d, u) = ([0.3, 0.1], [0.2, -0.4]);
+        for c in 1..=2 {
+            s.gap[c] = d[c - 1];
+            s.vel[c] = u[c - 1];
+        }
+        s.expand(0.5, None);
+        assert_eq!(s.gap[s.at(1, 1)], u[0]);
+        assert_eq!(s.gap[s.at(1, 2)], u[1] - u[0]);
+        assert_eq!(s.vel[s.at(1, 1)], d[1] - d[0]);
+        assert_eq!(s.vel[s.at(1, 2)], 0.5 - d[1]);
+        // Second order: Delta_1'' / 2 = u_1' / 2 = (Delta_2 - Delta_1) / 2.
+        assert_eq!(s.gap[s.at(2, 1)], (d[1] - d[0]) / 2.0);
+        // u_2'' / 2 = -Delta_2' / 2 = -(u_2 - u_1) / 2.
+        assert_eq!(s.vel[s.at(2, 2)], -(u[1] - u[0]) / 2.0);
+        // Evaluation agrees with the columns' own Horner sums.
+        let mut column = [0.0; 3];
+        let series = s.column(&s.gap, 2, &mut column).to_vec();
+        let tau = 0.01;
+        let by_hand = series[0] + series[1] * tau + series[2] * tau * tau;
+        assert!((s.value(&s.gap, 2, tau) - by_hand).abs() < 1e-16);
+    }
+
+    #[test]
+    fn a_gap_that_may_close_is_not_called_open() {
+        let mut s = Series::new(1, 2);
+        s.gap[1] = 1.0;
+        s.gap[2] = 1.0;
+        let (first, second) = (s.at(1, 1), s.at(1, 2));
+        s.gap[first] = -10.0; // closes at 0.1
+        s.gap[second] = -1.0; // closes at 1
+        let mut open = [false; 4];
+        s.open_over(0.5, &mut Vec::new(), &mut open);
+        assert_eq!(&open[1..3], &[false, true]);
+    }
+}
