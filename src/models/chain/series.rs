@@ -35,14 +35,14 @@ impl Series {
         series
     }
 
-    /// Zero every coefficient and make room for `units` indices.
+    /// Make room for `units` indices. Coefficients are left as they were:
+    /// order 0 is for the caller to set, [`expand`](Self::expand) sets the
+    /// rest.
     pub fn reset(&mut self, units: usize) {
         self.width = units + 2;
         let len = (self.order + 1) * self.width;
-        for row in [&mut self.gap, &mut self.vel] {
-            row.clear();
-            row.resize(len, 0.0);
-        }
+        self.gap.resize(len, 0.0);
+        self.vel.resize(len, 0.0);
     }
 
     pub fn width(&self) -> usize {
@@ -77,8 +77,8 @@ impl Series {
     pub fn values(&self, first: usize, tau: &[f64], gaps: &mut [f64], vels: &mut [f64]) {
         let (w, cols) = (self.width, first..first + tau.len());
         for (out, row) in [(gaps, &self.gap), (vels, &self.vel)] {
-            out.fill(0.0);
-            for k in (0..=self.order).rev() {
+            out.copy_from_slice(&row[self.order * w..][cols.clone()]);
+            for k in (0..self.order).rev() {
                 let coefficients = &row[k * w..(k + 1) * w][cols.clone()];
                 for ((p, &t), &c) in out.iter_mut().zip(tau).zip(coefficients) {
                     *p = *p * t + c;
@@ -128,21 +128,22 @@ impl Series {
         }
     }
 
-    /// Per column, whether its gap is proven to stay above zero on
-    /// `[0, span]`: `Delta_0 > sum_{k >= 1} |Delta_k| span^k` (padded for
-    /// rounding), or constant.
-    pub fn open_over(&self, span: f64, bound: &mut Vec<f64>, open: &mut [bool]) {
-        let w = self.width;
+    /// For columns `first..first + open.len()`, whether the gap is proven
+    /// to stay above zero on `[0, span]`: `Delta_0 > sum_{k >= 1} |Delta_k|
+    /// span^k` (padded for rounding), or constant.
+    pub fn open_over(&self, first: usize, span: f64, bound: &mut Vec<f64>, open: &mut [bool]) {
+        let (w, cols) = (self.width, first..first + open.len());
         bound.clear();
-        bound.resize(w, 0.0);
+        bound.resize(open.len(), 0.0);
         let mut power = 1.0;
         for k in 1..=self.order {
             power *= span;
-            for (b, &c) in bound.iter_mut().zip(&self.gap[k * w..(k + 1) * w]) {
+            let row = &self.gap[k * w..(k + 1) * w][cols.clone()];
+            for (b, &c) in bound.iter_mut().zip(row) {
                 *b += c.abs() * power;
             }
         }
-        for ((o, &b), &c) in open.iter_mut().zip(bound.iter()).zip(&self.gap[..w]) {
+        for ((o, &b), &c) in open.iter_mut().zip(bound.iter()).zip(&self.gap[cols]) {
             *o = c - b * (1.0 + 1e-12) > 0.0 || b == 0.0;
         }
     }
@@ -201,8 +202,8 @@ mod tests {
         let (first, second) = (s.at(1, 1), s.at(1, 2));
         s.gap[first] = -10.0; // closes at 0.1
         s.gap[second] = -1.0; // closes at 1
-        let mut open = [false; 4];
-        s.open_over(0.5, &mut Vec::new(), &mut open);
-        assert_eq!(&open[1..3], &[false, true]);
+        let mut open = [true; 2];
+        s.open_over(1, 0.5, &mut Vec::new(), &mut open);
+        assert_eq!(open, [false, true]);
     }
 }

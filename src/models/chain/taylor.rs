@@ -30,11 +30,12 @@
 //! times the jump); pushing the jump through the recursion with absolute
 //! values bounds every later order too, and orders past the series' own
 //! by `2^k / k!`. Units within the reach `D` (the smallest `d` bringing the
-//! whole bound over the rest of the window under `2^-60`) are re-expanded
-//! from the impact's instant (each keeps its own clock, the time its series
-//! starts at), the rest keep their series, which are still exact to below
-//! round-off. So an impact costs O(K D) whatever N is, and only the `2D + 1`
-//! guards within the reach are re-predicted.
+//! whole bound over the rest of the window under `2^-60`, tabled by eighths
+//! of the window and rounded up) are re-expanded from the impact's instant
+//! (each keeps its own clock, the time its series starts at), the rest keep
+//! their series, which are still exact to below round-off. So an impact
+//! costs O(K D) whatever N is, and only the `2D + 1` guards within the
+//! reach are re-predicted (those proven open to the window's end at once).
 //!
 //! Resting contact (PHYSICS.md s.4): a shut unit is pushed shut only at the
 //! loaded end with `F < F_cr` (inside, `Delta_n'' = omega^2 (Delta_{n+1} +
@@ -61,6 +62,10 @@ use super::series::{MAX_COLUMN, Series};
 /// re-expansions but longer series and a wider reach per impact.
 pub const WINDOW: f64 = 0.035;
 
+/// Spans of the rest of a window the reach is tabled for: an impact late in
+/// a window reaches less far before the next re-expansion.
+const REACH_STEPS: usize = 8;
+
 /// Truncation and reach bounds are below this fraction of the state scale.
 const CERTIFIED: f64 = 1.0 / (1u64 << 60) as f64;
 
@@ -70,8 +75,9 @@ pub struct TaylorChain {
     pub chain: Chain,
     /// Series order `K`.
     order: usize,
-    /// Reach `D` of an impact, in units each way.
-    reach: usize,
+    /// Reach `D` of an impact, in units each way, by what is left of the
+    /// window: entry `j` holds for up to `(j + 1) / REACH_STEPS` of it.
+    reaches: [usize; REACH_STEPS],
     /// Units each way that a series of order `K` draws on: `ceil(K / 2)`.
     spread: usize,
     omega: f64,
@@ -87,9 +93,9 @@ pub struct TaylorChain {
     /// Series of gaps `Delta_n` and scaled velocities `u_n`, column `n`
     /// for index `n` (0 the wall, N + 1 the ghost).
     series: Series,
-    /// Per unit, whether its gap is proven open over the whole window
-    /// (set at the window start, cleared when an impact re-expands it):
-    /// most units are, and their predictions cost nothing.
+    /// Per unit, whether its gap is proven open from its series' start to
+    /// the window's end (set whenever the series is): most units are, and
+    /// their predictions cost nothing.
     open: Vec<bool>,
     guards: Vec<Guard>,
     /// A gap this close to zero counts as shut in a simultaneous impact.
@@ -158,7 +164,8 @@ impl TaylorChain {
             );
         }
         let order = order_for(WINDOW);
-        let reach = reach_for(WINDOW, order);
+        let reaches =
+            std::array::from_fn(|j| reach_for(WINDOW * (j + 1) as f64 / REACH_STEPS as f64, order));
         let omega = (chain.stiffness / chain.mass).sqrt();
         let ghost = (chain.load - chain.critical_load) / chain.stiffness;
         let mut guards = if chain.constraint {
@@ -176,7 +183,7 @@ impl TaylorChain {
             .fold(ghost.abs(), f64::max);
         let mut model = TaylorChain {
             order,
-            reach,
+            reaches,
             spread: order.div_ceil(2),
             omega,
             ghost,
@@ -208,7 +215,7 @@ impl TaylorChain {
 
     /// Series order and reach of an impact (units each way), for reports.
     pub fn order_and_reach(&self) -> (usize, usize) {
-        (self.order, self.reach)
+        (self.order, self.reaches[REACH_STEPS - 1])
     }
 
     /// Scaled time of `t` since the window start.
@@ -303,7 +310,7 @@ impl TaylorChain {
         self.series.vel[1..=n].copy_from_slice(vels);
         self.origin.fill(0.0);
         self.series.expand(self.ghost, self.block);
-        self.series.open_over(WINDOW, tau, &mut self.open);
+        self.series.open_over(1, WINDOW, tau, &mut self.open[1..=n]);
         self.start = self.start.after(self.span);
     }
 
@@ -314,7 +321,7 @@ impl TaylorChain {
         let sigma = self.sigma(t);
         let (mut lo, mut hi) = (unit, unit);
         loop {
-            let (r_lo, r_hi) = self.reach_around(lo, hi);
+            let (r_lo, r_hi) = self.reach_around(lo, hi, sigma);
             let w_lo = self.load_window(r_lo, r_hi, sigma);
             // Column of index i in the scratch series; node 0 (the wall)
             // reads zero there.
@@ -382,7 +389,7 @@ impl TaylorChain {
             .expect("the release guard is predicted only with a block");
         let sigma = self.sigma(t);
         self.set_block((a < n).then_some(a + 1), t);
-        let (r_lo, r_hi) = self.reach_around(a.saturating_sub(1).max(1), n);
+        let (r_lo, r_hi) = self.reach_around(a.saturating_sub(1).max(1), n, sigma);
         let w_lo = self.load_window(r_lo, r_hi, sigma);
         self.store_window(r_lo, r_hi, w_lo, sigma);
         Fired {
@@ -393,16 +400,21 @@ impl TaylorChain {
         }
     }
 
-    /// Units `lo - D ..= hi + D`, and the whole end block with the node on
+    /// The reach of a change at `sigma`, for the rest of the window: the
+    /// entry for the shortest tabled span at least as long (rounding up).
+    fn reach_at(&self, sigma: f64) -> usize {
+        let left = (WINDOW - sigma).max(0.0) / WINDOW * (1.0 + 1e-12);
+        let j = (left * REACH_STEPS as f64).ceil() as usize;
+        self.reaches[j.clamp(1, REACH_STEPS) - 1]
+    }
+
+    /// Units `lo - D ..= hi + D` (`D` the reach at `sigma`), and the whole end block with the node on
     /// its left if the window their series draw on (the spread beyond) comes
     /// to it: a rigid block passes a change on at once, and the free
     /// recursion must not be run across it.
-    fn reach_around(&self, lo: usize, hi: usize) -> (usize, usize) {
-        let n = self.chain.units;
-        let (r_lo, r_hi) = (
-            lo.saturating_sub(self.reach).max(1),
-            (hi + self.reach).min(n),
-        );
+    fn reach_around(&self, lo: usize, hi: usize, sigma: f64) -> (usize, usize) {
+        let (n, reach) = (self.chain.units, self.reach_at(sigma));
+        let (r_lo, r_hi) = (lo.saturating_sub(reach).max(1), (hi + reach).min(n));
         match self.block {
             Some(a) if r_hi + self.spread + 1 >= a => (r_lo.min(a.saturating_sub(1).max(1)), n),
             _ => (r_lo, r_hi),
@@ -452,7 +464,10 @@ impl TaylorChain {
         self.series
             .copy_columns(&self.scratch, r_lo + 1 - w_lo, r_lo, count);
         self.origin[r_lo..=r_hi].fill(sigma);
-        self.open[r_lo..=r_hi].fill(false);
+        let span = (WINDOW - sigma).max(0.0);
+        let bound = &mut self.sweep[0];
+        let open = &mut self.open[r_lo..=r_hi];
+        self.scratch.open_over(r_lo + 1 - w_lo, span, bound, open);
     }
 
     /// The guards whose predictions a change to units `r_lo..=r_hi` moves:
@@ -544,12 +559,12 @@ impl TaylorChain {
     fn settle_chatter(&mut self, unit: usize, t: Time) -> Option<Fired> {
         let n = self.chain.units;
         let sigma = self.sigma(t);
-        if self.block.is_some_and(|a| unit + 1 < a) || self.block.is_none() && unit + self.reach < n
-        {
+        let far = unit + self.reach_at(sigma) < n;
+        if self.block.is_some_and(|a| unit + 1 < a) || self.block.is_none() && far {
             return None;
         }
         self.set_block(None, t);
-        let (r_lo, r_hi) = self.reach_around(unit, n);
+        let (r_lo, r_hi) = self.reach_around(unit, n, sigma);
         let w_lo = self.load_window(r_lo, r_hi, sigma);
         if !self.settle_end(r_lo, w_lo, t, f64::INFINITY) {
             return None;
@@ -616,6 +631,11 @@ impl LocalModel for TaylorChain {
             return Ok(None);
         }
         self.first_root(unit, self.gap_series(unit, &mut [0.0; MAX_COLUMN]), now)
+    }
+
+    fn quiet(&self, guard: usize) -> bool {
+        // Impact guards exist only with the constraint on.
+        self.chain.constraint && guard < self.chain.units && self.open[guard + 1]
     }
 
     fn fire(&mut self, guard: usize, t: Time) -> Result<Fired, String> {
@@ -733,5 +753,27 @@ mod tests {
         assert!(leading(reach) < CERTIFIED, "{reach}");
         assert!(leading(reach - 1) > CERTIFIED, "{reach}");
         assert!(order < 16 && reach < 8, "{order} {reach}");
+    }
+
+    #[test]
+    fn an_impact_late_in_a_window_reaches_less_far() {
+        let chain = Chain::in_scene_units(30, 2.0, 1.0, 0.0, true);
+        let model = TaylorChain::new(chain, &[0.01; 30], &[0.0; 30]).unwrap();
+        let full = model.order_and_reach().1;
+        assert_eq!(model.reach_at(0.0), full);
+        assert_eq!(model.reach_at(WINDOW * 0.01), full);
+        // With an eighth of the window left, the span is short enough to
+        // certify a lower reach; never past the window's end.
+        assert!(model.reach_at(WINDOW * 0.9) < full);
+        assert_eq!(model.reach_at(WINDOW * 1.5), model.reach_at(WINDOW));
+        // The table is rounded up: a span just under a tabled one takes
+        // its entry, one just over the next, which is never lower.
+        for j in 1..REACH_STEPS {
+            let at = WINDOW * (1.0 - j as f64 / REACH_STEPS as f64);
+            let (under, over) = (at + 1e-6 * WINDOW, at - 1e-6 * WINDOW);
+            let tabled = reach_for(WINDOW * j as f64 / REACH_STEPS as f64, model.order);
+            assert_eq!(model.reach_at(under), tabled);
+            assert!(model.reach_at(over) >= tabled);
+        }
     }
 }
