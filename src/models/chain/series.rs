@@ -129,22 +129,37 @@ impl Series {
     }
 
     /// For columns `first..first + open.len()`, whether the gap is proven
-    /// to stay above zero on `[0, span]`: `Delta_0 > sum_{k >= 1} |Delta_k|
-    /// span^k` (padded for rounding), or constant.
-    pub fn open_over(&self, first: usize, span: f64, bound: &mut Vec<f64>, open: &mut [bool]) {
-        let (w, cols) = (self.width, first..first + open.len());
-        bound.clear();
-        bound.resize(open.len(), 0.0);
-        let mut power = 1.0;
+    /// not to fall through zero on `[0, span]`: it stays above zero,
+    /// `Delta_0 > sum_{k >= 1} |Delta_k| span^k`, or it starts at or above
+    /// zero and rises all along, `Delta_1 > sum_{k >= 2} k |Delta_k|
+    /// span^(k-1)` (both padded for rounding), or it is constant.
+    pub fn open_over(&self, first: usize, span: f64, bounds: &mut Vec<f64>, open: &mut [bool]) {
+        let (w, n) = (self.width, open.len());
+        let cols = first..first + n;
+        bounds.clear();
+        bounds.resize(2 * n, 0.0);
+        let (reach, turn) = bounds.split_at_mut(n);
+        let mut power = 1.0; // span^(k - 1)
         for k in 1..=self.order {
-            power *= span;
             let row = &self.gap[k * w..(k + 1) * w][cols.clone()];
-            for (b, &c) in bound.iter_mut().zip(row) {
+            if k >= 2 {
+                let factor = k as f64 * power;
+                for (b, &c) in turn.iter_mut().zip(row) {
+                    *b += c.abs() * factor;
+                }
+            }
+            power *= span;
+            for (b, &c) in reach.iter_mut().zip(row) {
                 *b += c.abs() * power;
             }
         }
-        for ((o, &b), &c) in open.iter_mut().zip(bound.iter()).zip(&self.gap[cols]) {
-            *o = c - b * (1.0 + 1e-12) > 0.0 || b == 0.0;
+        let (values, slopes) = (&self.gap[cols.clone()], &self.gap[w..2 * w][cols]);
+        let bounds = reach.iter().zip(turn.iter());
+        for (((o, &c), &slope), (&b, &t)) in open.iter_mut().zip(values).zip(slopes).zip(bounds) {
+            // Without short circuits, so that the loop vectorizes.
+            let above = (c - b * (1.0 + 1e-12) > 0.0) | (b == 0.0);
+            let rising = (c >= 0.0) & (slope - t * (1.0 + 1e-12) > 0.0);
+            *o = above | rising;
         }
     }
 
@@ -205,5 +220,18 @@ mod tests {
         let mut open = [true; 2];
         s.open_over(1, 0.5, &mut Vec::new(), &mut open);
         assert_eq!(open, [false, true]);
+        // Rising from zero all along the span is not a fall; turning back
+        // down within it may be.
+        s.gap[1] = 0.0;
+        s.gap[first] = 1.0;
+        s.open_over(1, 0.1, &mut Vec::new(), &mut open[..1]);
+        assert!(open[0]);
+        let mut s = Series::new(2, 1);
+        let (slope, curvature) = (s.at(1, 1), s.at(2, 1));
+        (s.gap[slope], s.gap[curvature]) = (1.0, -10.0); // turns at 0.05
+        s.open_over(1, 0.1, &mut Vec::new(), &mut open[..1]);
+        assert!(!open[0]);
+        s.open_over(1, 0.04, &mut Vec::new(), &mut open[..1]);
+        assert!(open[0]);
     }
 }
