@@ -9,9 +9,23 @@
 //! wall). Columns `0` and `width - 1` are boundaries: the velocity in column
 //! 0 reads zero (the wall's if the run starts at unit 1), the gap in the last
 //! column is the ghost elongation beyond the loaded end (or zero).
+//!
+//! Rows are worked in whole blocks of [`LANES`] columns, past the last
+//! column if need be (rows are allocated long enough): at an impact they
+//! are about 20 columns long, too short for the compiler's own unrolled
+//! loops, which would leave them to a scalar tail. What lands past the last
+//! column is never read back into it.
 
 /// Longest series a column is gathered into (orders up to 15).
 pub const MAX_COLUMN: usize = 16;
+
+/// Columns per block: two AVX2 registers.
+pub const LANES: usize = 8;
+
+/// `n` rounded up to whole blocks.
+pub fn blocks(n: usize) -> usize {
+    n.div_ceil(LANES) * LANES
+}
 
 /// Gap and velocity series of `width - 2` consecutive indices, with their
 /// boundary columns.
@@ -19,6 +33,8 @@ pub const MAX_COLUMN: usize = 16;
 pub struct Series {
     order: usize,
     width: usize,
+    /// Allocated row length: room for whole blocks from any column.
+    stride: usize,
     pub gap: Vec<f64>,
     pub vel: Vec<f64>,
 }
@@ -40,7 +56,8 @@ impl Series {
     /// rest.
     pub fn reset(&mut self, units: usize) {
         self.width = units + 2;
-        let len = (self.order + 1) * self.width;
+        self.stride = blocks(self.width) + LANES;
+        let len = (self.order + 1) * self.stride;
         self.gap.resize(len, 0.0);
         self.vel.resize(len, 0.0);
     }
@@ -51,38 +68,48 @@ impl Series {
 
     /// Where coefficient `k` of column `c` is.
     pub fn at(&self, k: usize, c: usize) -> usize {
-        k * self.width + c
+        k * self.stride + c
     }
 
-    /// The series of column `c` of `row` (`gap` or `vel`) into `out`.
-    pub fn column<'o>(&self, row: &[f64], c: usize, out: &'o mut [f64]) -> &'o [f64] {
+    /// The series of column `c` of `rows` (`gap` or `vel`) into `out`.
+    pub fn column<'o>(&self, rows: &[f64], c: usize, out: &'o mut [f64]) -> &'o [f64] {
         let out = &mut out[..=self.order];
-        for (x, &r) in out.iter_mut().zip(row[c..].iter().step_by(self.width)) {
+        for (x, &r) in out.iter_mut().zip(rows[c..].iter().step_by(self.stride)) {
             *x = r;
         }
         out
     }
 
-    /// `sum_k row[k][c] tau^k`.
-    pub fn value(&self, row: &[f64], c: usize, tau: f64) -> f64 {
+    /// `sum_k rows[k][c] tau^k`.
+    pub fn value(&self, rows: &[f64], c: usize, tau: f64) -> f64 {
         let mut column = [0.0; MAX_COLUMN];
-        self.column(row, c, &mut column)
+        self.column(rows, c, &mut column)
             .iter()
             .rev()
             .fold(0.0, |p, &x| p * tau + x)
     }
 
     /// Gaps and velocities of columns `first..first + tau.len()`, each at
-    /// its own `tau`, into `gaps` and `vels` (as long as `tau`).
+    /// its own `tau`, into `gaps` and `vels`. All three are whole blocks
+    /// long (see [`blocks`]); past the last column they hold anything.
     pub fn values(&self, first: usize, tau: &[f64], gaps: &mut [f64], vels: &mut [f64]) {
-        let (w, cols) = (self.width, first..first + tau.len());
-        for (out, row) in [(gaps, &self.gap), (vels, &self.vel)] {
-            out.copy_from_slice(&row[self.order * w..][cols.clone()]);
-            for k in (0..self.order).rev() {
-                let coefficients = &row[k * w..(k + 1) * w][cols.clone()];
-                for ((p, &t), &c) in out.iter_mut().zip(tau).zip(coefficients) {
-                    *p = *p * t + c;
+        let (taus, _) = tau.as_chunks::<LANES>();
+        debug_assert_eq!(taus.len() * LANES, tau.len(), "whole blocks only");
+        for (out, rows) in [(gaps, &self.gap), (vels, &self.vel)] {
+            let (out, _) = out[..tau.len()].as_chunks_mut::<LANES>();
+            // Block by block, each sum held in registers through all the
+            // orders: a short row would otherwise wait on memory each order.
+            for (j, (p, t)) in out.iter_mut().zip(taus).enumerate() {
+                let block = |k: usize| -> [f64; LANES] {
+                    let at = self.at(k, first + j * LANES);
+                    rows[at..at + LANES].try_into().expect("a block of a row")
+                };
+                let mut sum = block(self.order);
+                for k in (0..self.order).rev() {
+                    let c = block(k);
+                    sum = std::array::from_fn(|i| sum[i] * t[i] + c[i]);
                 }
+                *p = sum;
             }
         }
     }
@@ -99,24 +126,23 @@ impl Series {
     /// by the unit left of it; a block from column 1 includes the wall
     /// and is at rest.
     pub fn expand(&mut self, ghost: f64, block: Option<usize>) {
-        let w = self.width;
+        let (w, s) = (self.width, self.stride);
+        let n = blocks(w - 2);
         for k in 0..=self.order {
-            self.vel[k * w] = 0.0;
-            self.gap[k * w + w - 1] = if k == 0 { ghost } else { 0.0 };
+            self.vel[k * s] = 0.0;
+            self.gap[k * s + w - 1] = if k == 0 { ghost } else { 0.0 };
         }
         for k in 0..self.order {
             let inv = 1.0 / (k + 1) as f64;
-            let (done, next) = self.gap.split_at_mut((k + 1) * w);
-            let (gap, next_gap) = (&done[k * w..], &mut next[..w]);
-            let (done, next) = self.vel.split_at_mut((k + 1) * w);
-            let (vel, next_vel) = (&done[k * w..], &mut next[..w]);
+            let (done, next) = self.gap.split_at_mut((k + 1) * s);
+            let (gap, next_gap) = (&done[k * s..], &mut next[..s]);
+            let (done, next) = self.vel.split_at_mut((k + 1) * s);
+            let (vel, next_vel) = (&done[k * s..], &mut next[..s]);
             // Delta_n' = u_n - u_{n-1},  u_n' = Delta_{n+1} - Delta_n.
-            for ((g, &v), &left) in next_gap[1..w - 1].iter_mut().zip(&vel[1..]).zip(vel) {
-                *g = (v - left) * inv;
-            }
-            for ((v, &d), &right) in next_vel[1..w - 1].iter_mut().zip(&gap[1..]).zip(&gap[2..]) {
-                *v = (right - d) * inv;
-            }
+            difference(&mut next_gap[1..=n], &vel[1..], vel, inv);
+            difference(&mut next_vel[1..=n], &gap[2..], &gap[1..], inv);
+            // The whole blocks ran over the ghost: it is zero past order 0.
+            next_gap[w - 1] = 0.0;
             if let Some(b) = block.filter(|&b| b < w - 1) {
                 let rigid = match b {
                     1 => 0.0,
@@ -133,48 +159,62 @@ impl Series {
     /// `Delta_0 > sum_{k >= 1} |Delta_k| span^k`, or it starts at or above
     /// zero and rises all along, `Delta_1 > sum_{k >= 2} k |Delta_k|
     /// span^(k-1)` (both padded for rounding), or it is constant.
-    pub fn open_over(&self, first: usize, span: f64, bounds: &mut Vec<f64>, open: &mut [bool]) {
-        let (w, n) = (self.width, open.len());
-        let cols = first..first + n;
-        bounds.clear();
-        bounds.resize(2 * n, 0.0);
-        let (reach, turn) = bounds.split_at_mut(n);
-        let mut power = 1.0; // span^(k - 1)
-        for k in 1..=self.order {
-            let row = &self.gap[k * w..(k + 1) * w][cols.clone()];
-            if k >= 2 {
+    pub fn open_over(&self, first: usize, span: f64, open: &mut [bool]) {
+        for (j, open) in open.chunks_mut(LANES).enumerate() {
+            let block = |k: usize| -> [f64; LANES] {
+                let at = self.at(k, first + j * LANES);
+                self.gap[at..at + LANES]
+                    .try_into()
+                    .expect("a block of a row")
+            };
+            // Block by block, the bounds held in registers through all the
+            // orders.
+            let (mut reach, mut turn) = ([0.0; LANES], [0.0; LANES]);
+            let mut power = 1.0; // span^(k - 1)
+            for k in 1..=self.order {
+                let c = block(k);
                 let factor = k as f64 * power;
-                for (b, &c) in turn.iter_mut().zip(row) {
-                    *b += c.abs() * factor;
+                if k >= 2 {
+                    turn = std::array::from_fn(|i| turn[i] + c[i].abs() * factor);
                 }
+                power *= span;
+                reach = std::array::from_fn(|i| reach[i] + c[i].abs() * power);
             }
-            power *= span;
-            for (b, &c) in reach.iter_mut().zip(row) {
-                *b += c.abs() * power;
+            let (values, slopes) = (block(0), block(1));
+            for (i, o) in open.iter_mut().enumerate() {
+                let (c, b, t) = (values[i], reach[i], turn[i]);
+                let above = c - b * (1.0 + 1e-12) > 0.0 || b == 0.0;
+                let rising = c >= 0.0 && slopes[i] - t * (1.0 + 1e-12) > 0.0;
+                *o = above || rising;
             }
-        }
-        let (values, slopes) = (&self.gap[cols.clone()], &self.gap[w..2 * w][cols]);
-        let bounds = reach.iter().zip(turn.iter());
-        for (((o, &c), &slope), (&b, &t)) in open.iter_mut().zip(values).zip(slopes).zip(bounds) {
-            // Without short circuits, so that the loop vectorizes.
-            let above = (c - b * (1.0 + 1e-12) > 0.0) | (b == 0.0);
-            let rising = (c >= 0.0) & (slope - t * (1.0 + 1e-12) > 0.0);
-            *o = above | rising;
         }
     }
 
     /// Copy columns `from..from + count` of `source` (same order) into
     /// columns `to..` of this series, every order.
     pub fn copy_columns(&mut self, source: &Series, from: usize, to: usize, count: usize) {
-        let (w, v) = (self.width, source.width);
         for k in 0..=self.order {
-            let (dst, src) = (
-                k * w + to..k * w + to + count,
-                k * v + from..k * v + from + count,
-            );
+            let dst = self.at(k, to)..self.at(k, to) + count;
+            let src = source.at(k, from)..source.at(k, from) + count;
             self.gap[dst.clone()].copy_from_slice(&source.gap[src.clone()]);
             self.vel[dst].copy_from_slice(&source.vel[src]);
         }
+    }
+}
+
+// Row kernels over whole blocks. Each takes its rows as separate slices,
+// which tells the compiler they do not overlap.
+
+/// `out[i] = (a[i] - b[i]) * scale`.
+#[inline]
+fn difference(out: &mut [f64], a: &[f64], b: &[f64], scale: f64) {
+    let n = out.len();
+    let (out, _) = out.as_chunks_mut::<LANES>();
+    let (a, _) = a[..n].as_chunks::<LANES>();
+    let (b, _) = b[..n].as_chunks::<LANES>();
+    debug_assert_eq!(out.len() * LANES, n, "whole blocks only");
+    for ((o, x), y) in out.iter_mut().zip(a).zip(b) {
+        *o = std::array::from_fn(|i| (x[i] - y[i]) * scale);
     }
 }
 
@@ -218,20 +258,20 @@ mod tests {
         s.gap[first] = -10.0; // closes at 0.1
         s.gap[second] = -1.0; // closes at 1
         let mut open = [true; 2];
-        s.open_over(1, 0.5, &mut Vec::new(), &mut open);
+        s.open_over(1, 0.5, &mut open);
         assert_eq!(open, [false, true]);
         // Rising from zero all along the span is not a fall; turning back
         // down within it may be.
         s.gap[1] = 0.0;
         s.gap[first] = 1.0;
-        s.open_over(1, 0.1, &mut Vec::new(), &mut open[..1]);
+        s.open_over(1, 0.1, &mut open[..1]);
         assert!(open[0]);
         let mut s = Series::new(2, 1);
         let (slope, curvature) = (s.at(1, 1), s.at(2, 1));
         (s.gap[slope], s.gap[curvature]) = (1.0, -10.0); // turns at 0.05
-        s.open_over(1, 0.1, &mut Vec::new(), &mut open[..1]);
+        s.open_over(1, 0.1, &mut open[..1]);
         assert!(!open[0]);
-        s.open_over(1, 0.04, &mut Vec::new(), &mut open[..1]);
+        s.open_over(1, 0.04, &mut open[..1]);
         assert!(open[0]);
     }
 }

@@ -56,7 +56,7 @@ use crate::time::Time;
 
 use super::Chain;
 use super::collide::cascade;
-use super::series::{MAX_COLUMN, Series};
+use super::series::{MAX_COLUMN, Series, blocks};
 
 /// Window length in scaled time `omega t`: longer windows mean fewer full
 /// re-expansions but longer series and a wider reach per impact.
@@ -303,14 +303,15 @@ impl TaylorChain {
         let [tau, gaps, vels] = &mut self.sweep;
         tau.clear();
         tau.extend(self.origin[1..=n].iter().map(|o| (WINDOW - o).max(0.0)));
-        gaps.resize(n, 0.0);
-        vels.resize(n, 0.0);
+        tau.resize(blocks(n), 0.0);
+        gaps.resize(blocks(n), 0.0);
+        vels.resize(blocks(n), 0.0);
         self.series.values(1, tau, gaps, vels);
-        self.series.gap[1..=n].copy_from_slice(gaps);
-        self.series.vel[1..=n].copy_from_slice(vels);
+        self.series.gap[1..=n].copy_from_slice(&gaps[..n]);
+        self.series.vel[1..=n].copy_from_slice(&vels[..n]);
         self.origin.fill(0.0);
         self.series.expand(self.ghost, self.block);
-        self.series.open_over(1, WINDOW, tau, &mut self.open[1..=n]);
+        self.series.open_over(1, WINDOW, &mut self.open[1..=n]);
         self.start = self.start.after(self.span);
     }
 
@@ -439,9 +440,11 @@ impl TaylorChain {
                 .iter()
                 .map(|o| (sigma - o).max(0.0)),
         );
+        // Whole blocks: past the window, row 0 is set by the expansion.
+        tau.resize(blocks(count), 0.0);
         let (gaps, vels) = (
-            &mut self.scratch.gap[1..=count],
-            &mut self.scratch.vel[1..=count],
+            &mut self.scratch.gap[1..=blocks(count)],
+            &mut self.scratch.vel[1..=blocks(count)],
         );
         self.series.values(w_lo, tau, gaps, vels);
         w_lo
@@ -465,9 +468,8 @@ impl TaylorChain {
             .copy_columns(&self.scratch, r_lo + 1 - w_lo, r_lo, count);
         self.origin[r_lo..=r_hi].fill(sigma);
         let span = (WINDOW - sigma).max(0.0);
-        let bound = &mut self.sweep[0];
         let open = &mut self.open[r_lo..=r_hi];
-        self.scratch.open_over(r_lo + 1 - w_lo, span, bound, open);
+        self.scratch.open_over(r_lo + 1 - w_lo, span, open);
     }
 
     /// The guards whose predictions a change to units `r_lo..=r_hi` moves:
