@@ -46,6 +46,7 @@ impl EventQueue {
     }
 
     /// Forget the prediction for `slot`, if any.
+    #[inline]
     pub fn cancel(&mut self, slot: usize) {
         if let Some(queued) = self.queued.get_mut(slot).filter(|q| **q) {
             *queued = false;

@@ -139,8 +139,7 @@ impl Series {
             let (done, next) = self.vel.split_at_mut((k + 1) * s);
             let (vel, next_vel) = (&done[k * s..], &mut next[..s]);
             // Delta_n' = u_n - u_{n-1},  u_n' = Delta_{n+1} - Delta_n.
-            difference(&mut next_gap[1..=n], &vel[1..], vel, inv);
-            difference(&mut next_vel[1..=n], &gap[2..], &gap[1..], inv);
+            differences(&mut next_gap[1..=n], &mut next_vel[1..=n], gap, vel, inv);
             // The whole blocks ran over the ghost: it is zero past order 0.
             next_gap[w - 1] = 0.0;
             if let Some(b) = block.filter(|&b| b < w - 1) {
@@ -194,10 +193,9 @@ impl Series {
     /// columns `to..` of this series, every order.
     pub fn copy_columns(&mut self, source: &Series, from: usize, to: usize, count: usize) {
         for k in 0..=self.order {
-            let dst = self.at(k, to)..self.at(k, to) + count;
-            let src = source.at(k, from)..source.at(k, from) + count;
-            self.gap[dst.clone()].copy_from_slice(&source.gap[src.clone()]);
-            self.vel[dst].copy_from_slice(&source.vel[src]);
+            let (dst, src) = (self.at(k, to), source.at(k, from));
+            self.gap[dst..dst + count].copy_from_slice(&source.gap[src..src + count]);
+            self.vel[dst..dst + count].copy_from_slice(&source.vel[src..src + count]);
         }
     }
 }
@@ -205,16 +203,26 @@ impl Series {
 // Row kernels over whole blocks. Each takes its rows as separate slices,
 // which tells the compiler they do not overlap.
 
-/// `out[i] = (a[i] - b[i]) * scale`.
+/// One order of the recursion over whole blocks from column 1:
+/// `next_gap[i] = (vel[i + 1] - vel[i]) * scale` and `next_vel[i] =
+/// (gap[i + 2] - gap[i + 1]) * scale`, the rows of order `k` given from
+/// column 0 and the next ones from column 1.
 #[inline]
-fn difference(out: &mut [f64], a: &[f64], b: &[f64], scale: f64) {
-    let n = out.len();
-    let (out, _) = out.as_chunks_mut::<LANES>();
-    let (a, _) = a[..n].as_chunks::<LANES>();
-    let (b, _) = b[..n].as_chunks::<LANES>();
-    debug_assert_eq!(out.len() * LANES, n, "whole blocks only");
-    for ((o, x), y) in out.iter_mut().zip(a).zip(b) {
-        *o = std::array::from_fn(|i| (x[i] - y[i]) * scale);
+fn differences(next_gap: &mut [f64], next_vel: &mut [f64], gap: &[f64], vel: &[f64], scale: f64) {
+    let n = next_gap.len();
+    let (next_gap, _) = next_gap.as_chunks_mut::<LANES>();
+    let (next_vel, _) = next_vel[..n].as_chunks_mut::<LANES>();
+    debug_assert_eq!(next_gap.len() * LANES, n, "whole blocks only");
+    let block = |row: &[f64], at: usize| -> [f64; LANES] {
+        row[at..at + LANES].try_into().expect("a block of a row")
+    };
+    for (j, (g, v)) in next_gap.iter_mut().zip(next_vel).enumerate() {
+        let c = j * LANES;
+        let (left, here) = (block(vel, c), block(vel, c + 1));
+        let (own, right) = (block(gap, c + 1), block(gap, c + 2));
+        // Delta_n' = u_n - u_{n-1},  u_n' = Delta_{n+1} - Delta_n.
+        *g = std::array::from_fn(|i| (here[i] - left[i]) * scale);
+        *v = std::array::from_fn(|i| (right[i] - own[i]) * scale);
     }
 }
 
