@@ -201,7 +201,7 @@ impl Piece<'_> {
         };
         match verdict {
             Verdict::Clear => None,
-            Verdict::Root => Some(self.refine((x0, at0.0), (x1, end))),
+            Verdict::Root => Some(self.refine((x0, at0), (x1, end))),
             Verdict::Unknown => {
                 let mid = 0.5 * (x0 + x1);
                 let budget = self.budget.get();
@@ -307,12 +307,20 @@ impl Piece<'_> {
     }
 
     /// The root of a strictly decreasing `p` on `[lo, hi]` with `p(lo) > 0 >=
-    /// p(hi)`, to a few ulps or until `p` is zero to rounding: Newton's
-    /// method from the secant point, kept inside the bracket (bisecting when
-    /// a step leaves it).
-    fn refine(&self, (mut lo, p_lo): (f64, f64), (mut hi, p_hi): (f64, f64)) -> f64 {
+    /// p(hi)` (value, slope and curvature at `lo` given), to a few ulps or
+    /// until `p` is zero to rounding: Newton's method, kept inside the
+    /// bracket (bisecting when a step leaves it).
+    fn refine(&self, (mut lo, at_lo): (f64, (f64, f64, f64)), (mut hi, p_hi): (f64, f64)) -> f64 {
+        // Start from the root of the second-order expansion at `lo`, off
+        // by the third-order term only (a Newton step or two from the
+        // root); the secant point if that root is not in the bracket.
+        let (p_lo, d1, d2) = at_lo;
+        let denominator = -d1 + (d1 * d1 - 2.0 * d2 * p_lo).max(0.0).sqrt();
+        let quadratic = lo + 2.0 * p_lo / denominator;
         let secant = lo + (hi - lo) * p_lo / (p_lo - p_hi);
-        let mut x = if secant > lo && secant < hi {
+        let mut x = if quadratic > lo && quadratic < hi {
+            quadratic
+        } else if secant > lo && secant < hi {
             secant
         } else {
             0.5 * (lo + hi)
@@ -328,6 +336,12 @@ impl Piece<'_> {
             // noise of the evaluation (a slow closing makes that noise a
             // step far wider than a few ulps of x).
             if p.abs() <= 4.0 * f64::EPSILON * size {
+                // One last step, from values already in hand, lands
+                // within that noise, most often far inside it.
+                let newton = x - p / d1;
+                if newton >= lo && newton <= hi {
+                    x = newton;
+                }
                 break;
             }
             let newton = x - p / d1;
