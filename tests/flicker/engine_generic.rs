@@ -1,12 +1,15 @@
-//! The engine's own rules, on a model made for them: a reset re-predicts
-//! only the guards it says it affects, and events at the same instant come
-//! out in a fixed order (guard order), so logs are reproducible.
+//! The engine's own rules, on models made for them: a reset re-predicts
+//! only the guards it says it affects (and a local model's quiet guards not
+//! at all), and events at the same instant come out in a fixed order (guard
+//! order), so logs are reproducible.
 
 use std::cell::Cell;
 
 use flicker::engine::{
-    Affects, Direction, Flow, Guard, HybridModel, Jump, Mode, Options, Recorder, Status, simulate,
+    Affects, Direction, Fired, Flow, Guard, HybridModel, Jump, LocalModel, Mode, Options, Recorder,
+    Status, simulate, simulate_local,
 };
+use flicker::time::Time;
 
 /// Two independent ramps `x' = 1`, `y' = 4`, each wrapped to zero at one.
 struct TwoRamps {
@@ -96,4 +99,67 @@ fn simultaneous_events_come_out_in_guard_order() {
     for e in log.events.iter().filter(|e| e.guard == "wrap_y") {
         assert_eq!((e.t * 4.0).fract(), 0.0, "y wraps every quarter: {}", e.t);
     }
+}
+
+/// A local model with a clock ticking at whole times and an alarm set for
+/// t = 2.5, which the first tick silences: from then on the model calls the
+/// alarm quiet.
+struct SilencedAlarm {
+    silenced: bool,
+    alarm_predictions: Cell<u64>,
+}
+
+const CLOCK: [Guard; 2] = [
+    Guard::affine("tick", Direction::Rising),
+    Guard::affine("alarm", Direction::Rising),
+];
+
+impl LocalModel for SilencedAlarm {
+    fn mode_name(&self) -> &'static str {
+        "clock"
+    }
+    fn guards(&self) -> &[Guard] {
+        &CLOCK
+    }
+    fn predict(&self, guard: usize, now: Time) -> Result<Option<Time>, String> {
+        if guard == 0 {
+            return Ok(Some(Time::new(now.value().floor() + 1.0)));
+        }
+        self.alarm_predictions.set(self.alarm_predictions.get() + 1);
+        Ok((!self.silenced).then_some(Time::new(2.5)))
+    }
+    fn quiet(&self, guard: usize) -> bool {
+        guard == 1 && self.silenced
+    }
+    fn fire(&mut self, guard: usize, _: Time) -> Result<Fired, String> {
+        self.silenced = true;
+        Ok(Fired {
+            affects: guard..2,
+            unit: None,
+            rel_velocity: None,
+            x: None,
+        })
+    }
+}
+
+#[test]
+fn a_quiet_guard_is_dropped_from_the_queue_without_a_prediction() {
+    let mut model = SilencedAlarm {
+        silenced: false,
+        alarm_predictions: Cell::new(0),
+    };
+    let mut log = Recorder::default();
+    let outcome = simulate_local(
+        &mut model,
+        &Options::until(3.2),
+        &[],
+        &mut |_, _| {},
+        &mut log,
+    );
+    assert_eq!(outcome.status, Status::Completed);
+    // The alarm queued for 2.5 at the start is gone after the first tick,
+    // and was never asked about again.
+    assert_eq!(outcome.events_by_guard["tick"], 3);
+    assert!(!outcome.events_by_guard.contains_key("alarm"));
+    assert_eq!(model.alarm_predictions.get(), 1);
 }

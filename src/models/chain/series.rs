@@ -236,10 +236,8 @@ mod tests {
         // Delta' = (u_1, u_2 - u_1), u' = (Delta_2 - Delta_1, 0.5 - Delta_2).
         let mut s = Series::new(2, 2);
         let (d, u) = ([0.3, 0.1], [0.2, -0.4]);
-        for c in 1..=2 {
-            s.gap[c] = d[c - 1];
-            s.vel[c] = u[c - 1];
-        }
+        s.gap[1..=2].copy_from_slice(&d);
+        s.vel[1..=2].copy_from_slice(&u);
         s.expand(0.5, None);
         assert_eq!(s.gap[s.at(1, 1)], u[0]);
         assert_eq!(s.gap[s.at(1, 2)], u[1] - u[0]);

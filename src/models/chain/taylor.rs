@@ -20,9 +20,11 @@
 //! queue.
 //!
 //! The series are stored coefficient-major ([`Series`]), so the window
-//! start's evaluation, recursion and proof that a gap stays open over the
-//! whole window (most gaps do, and are then not searched at all) each run
-//! along rows of all units at once.
+//! start's evaluation, recursion and proof that a gap cannot fall through
+//! zero before the window ends (it stays above zero, or starts at or above
+//! zero and rises all along) each run along rows of all units at once. Most
+//! gaps are so proven; the engine then drops their guards without a search
+//! ([`LocalModel::quiet`]).
 //!
 //! An impact at unit `j` changes the velocities of nodes `j - 1` and `j`
 //! only. A unit or node `d` places beyond them first feels that change in
@@ -102,7 +104,9 @@ pub struct TaylorChain {
     shut_below: f64,
     /// The series of an impact's reach, re-expanded from its instant.
     scratch: Series,
-    /// The window end's clocks, gaps, velocities and bounds, per column.
+    /// Where each series is evaluated (its own time since its origin), and
+    /// the gaps and velocities there, per column: a window's end, or the
+    /// instant of an impact.
     sweep: [Vec<f64>; 3],
     /// The cascade's view of an impact's reach: which units are shut, and
     /// the node velocities (kept to spare an allocation per impact).
@@ -236,7 +240,7 @@ impl TaylorChain {
     }
 
     /// The gap series of unit `n`, into `out`.
-    fn gap_series<'o>(&self, n: usize, out: &'o mut [f64; MAX_ORDER + 1]) -> &'o [f64] {
+    fn gap_series<'o>(&self, n: usize, out: &'o mut [f64; MAX_COLUMN]) -> &'o [f64] {
         self.series.column(&self.series.gap, n, out)
     }
 
