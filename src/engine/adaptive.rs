@@ -1,12 +1,8 @@
 //! What the adaptive Runge-Kutta pairs share: tolerances, why a step
 //! fails, and the step-size control (starting step, acceptance, growth).
-//! A pair supplies its stages, error estimate and dense output; the loop
-//! of trials is the same for every pair:
-//!
-//! ```text
-//! let mut h = control.begin(model, mode, y0, h_max, h_min, &mut stages, &mut scratch)?;
-//! while let Some(next) = control.judge(h, attempt(h), h_min)? { h = next }
-//! ```
+//! A pair supplies its stages, error estimate and dense output
+//! ([`EmbeddedPair`]); the loop of trials, [`EmbeddedPair::step`], is the
+//! same for every pair.
 
 use crate::engine::model::{HybridModel, Mode};
 
@@ -45,6 +41,69 @@ pub enum StepFailure {
     NonFinite,
     /// The method cannot integrate this mode (said why).
     NotApplicable(String),
+}
+
+/// An embedded Runge-Kutta pair: its stages and trial steps; the step
+/// loop, restarts and counts are shared.
+pub trait EmbeddedPair {
+    /// The step control, the stages (the first holds `f` at a step's
+    /// start) and a scratch state.
+    fn parts(&mut self) -> (&mut StepControl, &mut [Vec<f64>], &mut [f64]);
+
+    fn control(&self) -> &StepControl;
+
+    /// One trial step of size `h` from `y0`, and its error.
+    fn attempt<M: HybridModel + ?Sized>(
+        &mut self,
+        model: &M,
+        mode: Mode,
+        y0: &[f64],
+        h: f64,
+    ) -> TrialError;
+
+    /// Keep the accepted trial of size `h`: its dense output, and `f` at
+    /// its end for the next step.
+    fn finish<M: HybridModel + ?Sized>(&mut self, model: &M, mode: Mode, y0: &[f64], h: f64);
+
+    /// Take one accepted step from `y0`, no longer than `h_max`.
+    fn step<M: HybridModel + ?Sized>(
+        &mut self,
+        model: &M,
+        mode: Mode,
+        y0: &[f64],
+        h_max: f64,
+        h_min: f64,
+    ) -> Result<(), StepFailure> {
+        let (control, stages, scratch) = self.parts();
+        let mut h = control.begin(model, mode, y0, h_max, h_min, stages, scratch)?;
+        loop {
+            let error = self.attempt(model, mode, y0, h);
+            match self.parts().0.judge(h, error, h_min)? {
+                Some(next) => h = next,
+                None => {
+                    self.finish(model, mode, y0, h);
+                    return Ok(());
+                }
+            }
+        }
+    }
+
+    /// Forget the previous step: the next one starts from a state that was
+    /// not this pair's last output (after a reset).
+    fn restart(&mut self) {
+        self.parts().0.fsal = false;
+    }
+
+    /// The error estimate of the last accepted step (largest component,
+    /// absolute): a pessimistic bound on its local error.
+    fn local_error(&self) -> f64 {
+        self.control().local_error
+    }
+
+    /// Right-hand-side evaluations so far.
+    fn evaluations(&self) -> u64 {
+        self.control().evaluations
+    }
 }
 
 /// The step-size memory and rules of an adaptive pair.

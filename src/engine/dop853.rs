@@ -17,7 +17,7 @@
 // Stage sums read several arrays at one index: an index loop says it plainly.
 #![allow(clippy::needless_range_loop)]
 
-use crate::engine::adaptive::{StepControl, StepFailure, Tolerances, TrialError};
+use crate::engine::adaptive::{EmbeddedPair, StepControl, Tolerances, TrialError};
 use crate::engine::model::{HybridModel, Mode};
 
 /// The order of the error estimate in the step size.
@@ -285,56 +285,9 @@ impl Dop853 {
         }
     }
 
-    /// Forget the previous step: the next one starts from a state that was
-    /// not this integrator's last output (after a reset).
-    pub fn restart(&mut self) {
-        self.control.fsal = false;
-    }
-
-    /// The error estimate of the last accepted step (largest component,
-    /// absolute).
-    pub fn local_error(&self) -> f64 {
-        self.control.local_error
-    }
-
-    /// Right-hand-side evaluations so far.
-    pub fn evaluations(&self) -> u64 {
-        self.control.evaluations
-    }
-
     /// The dense output of the last accepted step.
     pub fn dense(&self) -> &DenseStep {
         &self.dense
-    }
-
-    /// Take one accepted step from `y0`, no longer than `h_max`.
-    pub fn step<M: HybridModel + ?Sized>(
-        &mut self,
-        model: &M,
-        mode: Mode,
-        y0: &[f64],
-        h_max: f64,
-        h_min: f64,
-    ) -> Result<(), StepFailure> {
-        let mut h = self.control.begin(
-            model,
-            mode,
-            y0,
-            h_max,
-            h_min,
-            &mut self.k,
-            &mut self.scratch,
-        )?;
-        loop {
-            let error = self.attempt(model, mode, y0, h);
-            match self.control.judge(h, error, h_min)? {
-                Some(next) => h = next,
-                None => {
-                    self.finish(model, mode, y0, h);
-                    return Ok(());
-                }
-            }
-        }
     }
 
     /// Sharpen a crossing found on the dense output, whose error (one order
@@ -437,6 +390,16 @@ impl Dop853 {
         let y = std::mem::take(&mut self.scratch);
         self.stage_at(model, mode, &y, stage);
         self.scratch = y;
+    }
+}
+
+impl EmbeddedPair for Dop853 {
+    fn parts(&mut self) -> (&mut StepControl, &mut [Vec<f64>], &mut [f64]) {
+        (&mut self.control, &mut self.k, &mut self.scratch)
+    }
+
+    fn control(&self) -> &StepControl {
+        &self.control
     }
 
     /// One trial step of size `h`, and its error.

@@ -11,7 +11,7 @@
 // Stage sums read several arrays at one index: an index loop says it plainly.
 #![allow(clippy::needless_range_loop)]
 
-use crate::engine::adaptive::{StepControl, StepFailure, Tolerances, TrialError};
+use crate::engine::adaptive::{EmbeddedPair, StepControl, Tolerances, TrialError};
 use crate::engine::model::{HybridModel, Mode};
 
 /// The order of the error estimate in the step size.
@@ -103,64 +103,26 @@ impl Dopri5 {
         }
     }
 
-    /// Forget the previous step: the next one starts from a state that was
-    /// not this integrator's last output (after a reset).
-    pub fn restart(&mut self) {
-        self.control.fsal = false;
-    }
-
-    /// The embedded error estimate of the last accepted step (largest
-    /// component, absolute): a pessimistic bound on its local error.
-    pub fn local_error(&self) -> f64 {
-        self.control.local_error
-    }
-
-    /// Right-hand-side evaluations so far.
-    pub fn evaluations(&self) -> u64 {
-        self.control.evaluations
-    }
-
     /// The dense output of the last accepted step.
     pub fn dense(&self) -> &DenseStep {
         &self.dense
-    }
-
-    /// Take one accepted step from `y0`, no longer than `h_max`.
-    pub fn step<M: HybridModel + ?Sized>(
-        &mut self,
-        model: &M,
-        mode: Mode,
-        y0: &[f64],
-        h_max: f64,
-        h_min: f64,
-    ) -> Result<(), StepFailure> {
-        let mut h = self.control.begin(
-            model,
-            mode,
-            y0,
-            h_max,
-            h_min,
-            &mut self.k,
-            &mut self.scratch,
-        )?;
-        loop {
-            let error = self.attempt(model, mode, y0, h);
-            match self.control.judge(h, error, h_min)? {
-                Some(next) => h = next,
-                None => {
-                    self.finish(y0, h);
-                    return Ok(());
-                }
-            }
-        }
     }
 
     fn eval<M: HybridModel + ?Sized>(&mut self, model: &M, mode: Mode, y: &[f64], stage: usize) {
         model.rhs(mode, y, &mut self.k[stage]);
         self.control.evaluations += 1;
     }
+}
 
-    /// One trial step of size `h`, and its error.
+impl EmbeddedPair for Dopri5 {
+    fn parts(&mut self) -> (&mut StepControl, &mut [Vec<f64>], &mut [f64]) {
+        (&mut self.control, &mut self.k, &mut self.scratch)
+    }
+
+    fn control(&self) -> &StepControl {
+        &self.control
+    }
+
     fn attempt<M: HybridModel + ?Sized>(
         &mut self,
         model: &M,
@@ -217,7 +179,7 @@ impl Dopri5 {
     }
 
     /// Store the dense output of the accepted step and carry `f(y1)` over.
-    fn finish(&mut self, y0: &[f64], h: f64) {
+    fn finish<M: HybridModel + ?Sized>(&mut self, _: &M, _: Mode, y0: &[f64], h: f64) {
         let k = &self.k;
         let r = &mut self.dense.r;
         for i in 0..y0.len() {

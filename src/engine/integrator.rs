@@ -5,7 +5,7 @@
 //! [`Motion`] is what it means for one mode: the model's exact flow, a
 //! frozen state, or steps of the chosen integrator.
 
-use crate::engine::adaptive::{StepFailure, Tolerances};
+use crate::engine::adaptive::{EmbeddedPair, StepFailure, Tolerances};
 use crate::engine::dop853::{Crossing, Dop853};
 use crate::engine::dopri5::Dopri5;
 use crate::engine::linear::Linear;
