@@ -5,6 +5,7 @@
 pub mod adaptive;
 pub mod dop853;
 pub mod dopri5;
+pub mod fused;
 pub mod integrator;
 pub mod linear;
 pub mod local;

@@ -12,33 +12,36 @@
 //! root (then refined), or halved. Pieces are visited left to right, so the
 //! first root found is the earliest; none can be missed.
 
+use crate::engine::fused::mul_add;
+
 /// `(p(s), p'(s), p''(s))` of `p = sum c[k] s^k`.
 pub fn eval2(c: &[f64], s: f64) -> (f64, f64, f64) {
     let (mut p, mut d1, mut d2) = (0.0, 0.0, 0.0);
     for &ck in c.iter().rev() {
-        d2 = d2 * s + 2.0 * d1;
-        d1 = d1 * s + p;
-        p = p * s + ck;
+        d2 = mul_add(d2, s, 2.0 * d1);
+        d1 = mul_add(d1, s, p);
+        p = mul_add(p, s, ck);
     }
     (p, d1, d2)
 }
 
-/// `(p(s), p'(s), sum |c[k]| |s|^k)`: the last bounds the rounding of `p(s)`
-/// (relative, a few ulps of it).
-fn eval1_with_size(c: &[f64], s: f64) -> (f64, f64, f64) {
-    let (mut p, mut d1, mut size) = (0.0, 0.0, 0.0);
+/// `(p(s), p'(s), p''(s), sum |c[k]| |s|^k)`: the last bounds the rounding
+/// of `p(s)` (relative, a few ulps of it).
+fn eval2_with_size(c: &[f64], s: f64) -> (f64, f64, f64, f64) {
+    let (mut p, mut d1, mut d2, mut size) = (0.0, 0.0, 0.0, 0.0);
     let a = s.abs();
     for &ck in c.iter().rev() {
-        d1 = d1 * s + p;
-        p = p * s + ck;
-        size = size * a + ck.abs();
+        d2 = mul_add(d2, s, 2.0 * d1);
+        d1 = mul_add(d1, s, p);
+        p = mul_add(p, s, ck);
+        size = mul_add(size, a, ck.abs());
     }
-    (p, d1, size)
+    (p, d1, d2, size)
 }
 
 /// `p(s)` of `p = sum c[k] s^k`.
 pub fn eval(c: &[f64], s: f64) -> f64 {
-    c.iter().rev().fold(0.0, |p, &ck| p * s + ck)
+    c.iter().rev().fold(0.0, |p, &ck| mul_add(p, s, ck))
 }
 
 /// The integral of `p` from 0 to `s`.
@@ -56,7 +59,7 @@ fn third_derivative_bound(c: &[f64], b: f64) -> f64 {
     let mut bound = 0.0;
     for (k, &ck) in c.iter().enumerate().skip(3).rev() {
         let k = k as f64;
-        bound = bound * b + ck.abs() * k * (k - 1.0) * (k - 2.0);
+        bound = mul_add(bound, b, ck.abs() * k * (k - 1.0) * (k - 2.0));
     }
     // Rounding in the sum above is relative and tiny; pad it all the same.
     bound * (1.0 + 1e-12)
@@ -88,11 +91,19 @@ pub fn first_fall(c: &[f64], a: f64, b: f64) -> Result<Option<f64>, String> {
         .iter()
         .skip(1)
         .rev()
-        .fold(0.0, |acc, ck| (acc + ck.abs()) * b);
+        .fold(0.0, |acc, ck| mul_add(acc, b, ck.abs()))
+        * b;
     let constant = c.first().copied().unwrap_or(0.0);
     if constant - reach * (1.0 + 1e-12) > 0.0 || reach == 0.0 {
         return Ok(None);
     }
+    search_fall(c, a, b)
+}
+
+/// [`first_fall`] without its first, cheap proof that `p` stays above
+/// zero on `[0, b]` (`c_0 > sum_{k >= 1} |c_k| b^k`, or `p` constant), for a
+/// caller that has tried that proof already.
+pub fn search_fall(c: &[f64], a: f64, b: f64) -> Result<Option<f64>, String> {
     let (mut from, mut at) = (a, eval2(c, a));
     if at.0 <= 0.0 {
         // On (or a round-off below) zero: the first derivative that is not
@@ -326,25 +337,35 @@ impl Piece<'_> {
             0.5 * (lo + hi)
         };
         for _ in 0..100 {
-            let (p, d1, size) = eval1_with_size(self.c, x);
+            let (p, d1, d2, size) = eval2_with_size(self.c, x);
             if p > 0.0 {
                 lo = x;
             } else {
                 hi = x;
             }
+            let newton = x - p / d1;
             // Zero to rounding: further Newton steps would only chase the
             // noise of the evaluation (a slow closing makes that noise a
             // step far wider than a few ulps of x).
             if p.abs() <= 4.0 * f64::EPSILON * size {
                 // One last step, from values already in hand, lands
                 // within that noise, most often far inside it.
-                let newton = x - p / d1;
                 if newton >= lo && newton <= hi {
                     x = newton;
                 }
                 break;
             }
-            let newton = x - p / d1;
+            // Newton's step leaves an error of about |p'' / (2 p')| times
+            // its square: below a quarter ulp of the root, the step lands
+            // on it and one more evaluation could only confirm it.
+            let step = newton - x;
+            if newton > lo
+                && newton < hi
+                && (d2 / d1).abs() * step * step <= 0.5 * f64::EPSILON * newton.abs()
+            {
+                x = newton;
+                break;
+            }
             let next = if newton > lo && newton < hi {
                 newton
             } else {
@@ -443,5 +464,54 @@ mod tests {
             (s - exact).abs() <= 8.0 * f64::EPSILON * exact,
             "{s} {exact}"
         );
+    }
+
+    #[test]
+    fn the_search_alone_answers_as_the_whole_first_fall() {
+        // Cases the cheap bound settles (clearly positive, constant) and
+        // cases it does not: the search must agree on all of them.
+        let cases: Vec<(Vec<f64>, f64)> = vec![
+            (vec![1.0, 0.1, -0.2], 0.0),
+            (vec![0.5], 0.0),
+            (vec![-0.5], 0.0),
+            (vec![0.0, 0.0, 0.0], 0.0),
+            (from_roots(&[0.3, 0.5, 0.9], -1.0), 0.0),
+            (from_roots(&[0.3, 0.5, 0.9], -1.0), 0.6),
+            (from_roots(&[0.5, 0.5, 0.5], 1.0), 0.5),
+            (vec![0.0, 1.0, -0.1], 0.0),
+        ];
+        for (c, a) in cases {
+            assert_eq!(
+                search_fall(&c, a, 1.0),
+                first_fall(&c, a, 1.0),
+                "{c:?} from {a}"
+            );
+        }
+    }
+
+    #[test]
+    fn roots_of_higher_degree_are_within_their_conditioning() {
+        // The second-order start is off by the higher terms here: the
+        // refinement must still end within a few ulps, whichever way it
+        // stops.
+        for (roots, scale) in [
+            (vec![0.3, 0.7, 1.2], -1.0),
+            (vec![0.01234, 0.5, 0.8, 1.5, 2.0], -1.0),
+            (vec![0.3333, 0.34, 3.0, -1.0, -2.0, 4.0, 5.0], -2.5),
+        ] {
+            let c = from_roots(&roots, scale);
+            let s = first_fall(&c, 0.0, 1.0).unwrap().unwrap();
+            // A root is conditioned to the rounding of p there over |p'|
+            // (wide for the two close roots of the last case).
+            let r = roots[0];
+            let size: f64 = c
+                .iter()
+                .enumerate()
+                .map(|(k, x)| x.abs() * r.powi(k as i32))
+                .sum();
+            let slope = eval2(&c, r).1.abs();
+            let conditioned = 4.0 * f64::EPSILON * (r + size / slope);
+            assert!((s - r).abs() <= conditioned, "{s} {r} {conditioned:e}");
+        }
     }
 }

@@ -16,11 +16,28 @@
 //! loops, which would leave them to a scalar tail. What lands past the last
 //! column is never read back into it.
 
+use crate::engine::fused::mul_add;
+
 /// Longest series a column is gathered into (orders up to 15).
 pub const MAX_COLUMN: usize = 16;
 
 /// Columns per block: two AVX2 registers.
 pub const LANES: usize = 8;
+
+/// Blocks whose sums run side by side in the row passes: enough
+/// independent chains to hide the latency of each step.
+const GROUP: usize = 2;
+
+/// `1 / (k + 1)` for the step from order `k` to `k + 1`.
+const INVERSES: [f64; MAX_COLUMN] = {
+    let mut inverses = [0.0; MAX_COLUMN];
+    let mut k = 0;
+    while k < MAX_COLUMN {
+        inverses[k] = 1.0 / (k + 1) as f64;
+        k += 1;
+    }
+    inverses
+};
 
 /// `n` rounded up to whole blocks.
 pub fn blocks(n: usize) -> usize {
@@ -86,7 +103,7 @@ impl Series {
         self.column(rows, c, &mut column)
             .iter()
             .rev()
-            .fold(0.0, |p, &x| p * tau + x)
+            .fold(0.0, |p, &x| mul_add(p, tau, x))
     }
 
     /// Gaps and velocities of columns `first..first + tau.len()`, each at
@@ -95,23 +112,44 @@ impl Series {
     pub fn values(&self, first: usize, tau: &[f64], gaps: &mut [f64], vels: &mut [f64]) {
         let (taus, _) = tau.as_chunks::<LANES>();
         debug_assert_eq!(taus.len() * LANES, tau.len(), "whole blocks only");
-        for (out, rows) in [(gaps, &self.gap), (vels, &self.vel)] {
-            let (out, _) = out[..tau.len()].as_chunks_mut::<LANES>();
-            // Block by block, each sum held in registers through all the
-            // orders: a short row would otherwise wait on memory each order.
-            for (j, (p, t)) in out.iter_mut().zip(taus).enumerate() {
-                let block = |k: usize| -> [f64; LANES] {
-                    let at = self.at(k, first + j * LANES);
-                    rows[at..at + LANES].try_into().expect("a block of a row")
-                };
-                let mut sum = block(self.order);
-                for k in (0..self.order).rev() {
-                    let c = block(k);
-                    sum = std::array::from_fn(|i| sum[i] * t[i] + c[i]);
+        let (gaps, _) = gaps[..tau.len()].as_chunks_mut::<LANES>();
+        let (vels, _) = vels[..tau.len()].as_chunks_mut::<LANES>();
+        let mut j = 0;
+        while j < taus.len() {
+            let column = first + j * LANES;
+            let out = (&mut gaps[j..], &mut vels[j..]);
+            j += match taus.len() - j {
+                1 => self.values_of::<1>(column, &taus[j..], out),
+                _ => self.values_of::<GROUP>(column, &taus[j..], out),
+            };
+        }
+    }
+
+    /// [`values`](Self::values) of the `G` blocks from `column`: the `2 G`
+    /// Horner sums (both rows) go through the orders side by side, held in
+    /// registers, so that each waits on its own last step only. Returns `G`.
+    #[inline(always)]
+    fn values_of<const G: usize>(
+        &self,
+        column: usize,
+        taus: &[[f64; LANES]],
+        (gaps, vels): (&mut [[f64; LANES]], &mut [[f64; LANES]]),
+    ) -> usize {
+        let t: &[[f64; LANES]; G] = taus[..G].try_into().expect("G blocks");
+        let mut sums = [[[0.0; LANES]; G]; 2];
+        for k in (0..=self.order).rev() {
+            let at = self.at(k, column);
+            for (sum, rows) in sums.iter_mut().zip([&self.gap, &self.vel]) {
+                let (row, _) = rows[at..at + G * LANES].as_chunks::<LANES>();
+                for ((s, c), t) in sum.iter_mut().zip(row).zip(t) {
+                    *s = std::array::from_fn(|i| mul_add(s[i], t[i], c[i]));
                 }
-                *p = sum;
             }
         }
+        let [g, v] = sums;
+        gaps[..G].copy_from_slice(&g);
+        vels[..G].copy_from_slice(&v);
+        G
     }
 
     /// Fill orders `1..=K` from order 0. The boundary columns are set here:
@@ -126,20 +164,31 @@ impl Series {
     /// by the unit left of it; a block from column 1 includes the wall
     /// and is at rest.
     pub fn expand(&mut self, ghost: f64, block: Option<usize>) {
-        let (w, s) = (self.width, self.stride);
-        let n = blocks(w - 2);
-        for k in 0..=self.order {
-            self.vel[k * s] = 0.0;
-            self.gap[k * s + w - 1] = if k == 0 { ghost } else { 0.0 };
+        // An impact's reach is a few blocks wide: with the count known
+        // here, the row loops unroll and lose their bounds checks.
+        match blocks(self.width - 2) / LANES {
+            1 => self.expand_blocks(1, ghost, block),
+            2 => self.expand_blocks(2, ghost, block),
+            3 => self.expand_blocks(3, ghost, block),
+            n => self.expand_blocks(n, ghost, block),
         }
-        for k in 0..self.order {
-            let inv = 1.0 / (k + 1) as f64;
-            let (done, next) = self.gap.split_at_mut((k + 1) * s);
-            let (gap, next_gap) = (&done[k * s..], &mut next[..s]);
-            let (done, next) = self.vel.split_at_mut((k + 1) * s);
-            let (vel, next_vel) = (&done[k * s..], &mut next[..s]);
+    }
+
+    #[inline(always)]
+    fn expand_blocks(&mut self, count: usize, ghost: f64, block: Option<usize>) {
+        let (w, s, n) = (self.width, self.stride, count * LANES);
+        let rows = self.order + 1;
+        let mut gaps = self.gap[..rows * s].chunks_exact_mut(s);
+        let mut vels = self.vel[..rows * s].chunks_exact_mut(s);
+        let (Some(mut gap), Some(mut vel)) = (gaps.next(), vels.next()) else {
+            return;
+        };
+        vel[0] = 0.0;
+        gap[w - 1] = ghost;
+        for ((next_gap, next_vel), inv) in gaps.zip(vels).zip(INVERSES) {
             // Delta_n' = u_n - u_{n-1},  u_n' = Delta_{n+1} - Delta_n.
             differences(&mut next_gap[1..=n], &mut next_vel[1..=n], gap, vel, inv);
+            next_vel[0] = 0.0;
             // The whole blocks ran over the ghost: it is zero past order 0.
             next_gap[w - 1] = 0.0;
             if let Some(b) = block.filter(|&b| b < w - 1) {
@@ -150,6 +199,7 @@ impl Series {
                 next_gap[b..w - 1].fill(0.0);
                 next_vel[(b - 1).max(1)..w - 1].fill(rigid);
             }
+            (gap, vel) = (next_gap, next_vel);
         }
     }
 
@@ -159,34 +209,61 @@ impl Series {
     /// zero and rises all along, `Delta_1 > sum_{k >= 2} k |Delta_k|
     /// span^(k-1)` (both padded for rounding), or it is constant.
     pub fn open_over(&self, first: usize, span: f64, open: &mut [bool]) {
-        for (j, open) in open.chunks_mut(LANES).enumerate() {
-            let block = |k: usize| -> [f64; LANES] {
-                let at = self.at(k, first + j * LANES);
-                self.gap[at..at + LANES]
-                    .try_into()
-                    .expect("a block of a row")
+        // What order k weighs in each bound: span^k, and k span^(k-1) from
+        // order 2 on.
+        let mut weights = [[0.0; 2]; MAX_COLUMN];
+        let mut power = 1.0;
+        for (k, weight) in (1..=self.order).zip(&mut weights[1..]) {
+            let turn = if k >= 2 { k as f64 * power } else { 0.0 };
+            power *= span;
+            *weight = [power, turn];
+        }
+        let mut j = 0;
+        while j < open.len() {
+            let column = first + j;
+            let open = &mut open[j..];
+            j += match open.len() {
+                ..=LANES => self.open_of::<1>(column, &weights, open),
+                _ => self.open_of::<GROUP>(column, &weights, open),
             };
-            // Block by block, the bounds held in registers through all the
-            // orders.
-            let (mut reach, mut turn) = ([0.0; LANES], [0.0; LANES]);
-            let mut power = 1.0; // span^(k - 1)
-            for k in 1..=self.order {
-                let c = block(k);
-                let factor = k as f64 * power;
-                if k >= 2 {
-                    turn = std::array::from_fn(|i| turn[i] + c[i].abs() * factor);
-                }
-                power *= span;
-                reach = std::array::from_fn(|i| reach[i] + c[i].abs() * power);
-            }
-            let (values, slopes) = (block(0), block(1));
-            for (i, o) in open.iter_mut().enumerate() {
-                let (c, b, t) = (values[i], reach[i], turn[i]);
-                let above = c - b * (1.0 + 1e-12) > 0.0 || b == 0.0;
-                let rising = c >= 0.0 && slopes[i] - t * (1.0 + 1e-12) > 0.0;
-                *o = above || rising;
+        }
+    }
+
+    /// [`open_over`](Self::open_over) of up to `G` blocks from `column`,
+    /// the `2 G` bounds held in registers through all the orders. Returns
+    /// the columns done.
+    #[inline(always)]
+    fn open_of<const G: usize>(
+        &self,
+        column: usize,
+        weights: &[[f64; 2]; MAX_COLUMN],
+        open: &mut [bool],
+    ) -> usize {
+        let row = |k: usize| -> &[[f64; LANES]] {
+            let at = self.at(k, column);
+            self.gap[at..at + G * LANES].as_chunks::<LANES>().0
+        };
+        let (mut reach, mut turn) = ([[0.0; LANES]; G], [[0.0; LANES]; G]);
+        for (k, &[to_reach, to_turn]) in (1..=self.order).zip(&weights[1..]) {
+            for ((r, t), c) in reach.iter_mut().zip(&mut turn).zip(row(k)) {
+                *r = std::array::from_fn(|i| mul_add(c[i].abs(), to_reach, r[i]));
+                *t = std::array::from_fn(|i| mul_add(c[i].abs(), to_turn, t[i]));
             }
         }
+        let (values, slopes) = (row(0), row(1));
+        let done = open.len().min(G * LANES);
+        for (j, open) in open[..done].chunks_mut(LANES).enumerate() {
+            // Without short cuts, so that the lanes' verdicts are computed
+            // side by side instead of branching on each.
+            let proven: [bool; LANES] = std::array::from_fn(|i| {
+                let (c, b, t) = (values[j][i], reach[j][i], turn[j][i]);
+                let above = (c - b * (1.0 + 1e-12) > 0.0) | (b == 0.0);
+                let rising = (c >= 0.0) & (slopes[j][i] - t * (1.0 + 1e-12) > 0.0);
+                above | rising
+            });
+            open.copy_from_slice(&proven[..open.len()]);
+        }
+        done
     }
 
     /// Copy columns `from..from + count` of `source` (same order) into
@@ -194,8 +271,14 @@ impl Series {
     pub fn copy_columns(&mut self, source: &Series, from: usize, to: usize, count: usize) {
         for k in 0..=self.order {
             let (dst, src) = (self.at(k, to), source.at(k, from));
-            self.gap[dst..dst + count].copy_from_slice(&source.gap[src..src + count]);
-            self.vel[dst..dst + count].copy_from_slice(&source.vel[src..src + count]);
+            copy_run(
+                &mut self.gap[dst..dst + count],
+                &source.gap[src..src + count],
+            );
+            copy_run(
+                &mut self.vel[dst..dst + count],
+                &source.vel[src..src + count],
+            );
         }
     }
 }
@@ -207,9 +290,10 @@ impl Series {
 /// `next_gap[i] = (vel[i + 1] - vel[i]) * scale` and `next_vel[i] =
 /// (gap[i + 2] - gap[i + 1]) * scale`, the rows of order `k` given from
 /// column 0 and the next ones from column 1.
-#[inline]
+#[inline(always)]
 fn differences(next_gap: &mut [f64], next_vel: &mut [f64], gap: &[f64], vel: &[f64], scale: f64) {
     let n = next_gap.len();
+    let (gap, vel) = (&gap[..n + 2], &vel[..n + 1]);
     let (next_gap, _) = next_gap.as_chunks_mut::<LANES>();
     let (next_vel, _) = next_vel[..n].as_chunks_mut::<LANES>();
     debug_assert_eq!(next_gap.len() * LANES, n, "whole blocks only");
@@ -223,6 +307,24 @@ fn differences(next_gap: &mut [f64], next_vel: &mut [f64], gap: &[f64], vel: &[f
         // Delta_n' = u_n - u_{n-1},  u_n' = Delta_{n+1} - Delta_n.
         *g = std::array::from_fn(|i| (here[i] - left[i]) * scale);
         *v = std::array::from_fn(|i| (right[i] - own[i]) * scale);
+    }
+}
+
+/// `to.copy_from_slice(from)`, inline for the one to two blocks an
+/// impact's reach is wide: as two blocks that overlap in the middle,
+/// where a call to `memcpy` for a few dozen bytes would cost more than the
+/// copy.
+#[inline(always)]
+fn copy_run(to: &mut [f64], from: &[f64]) {
+    let n = from.len();
+    if (LANES..=2 * LANES).contains(&n) && to.len() == n {
+        let block =
+            |at: usize| -> [f64; LANES] { from[at..at + LANES].try_into().expect("a block") };
+        let (head, tail) = (block(0), block(n - LANES));
+        to[..LANES].copy_from_slice(&head);
+        to[n - LANES..n].copy_from_slice(&tail);
+    } else {
+        to.copy_from_slice(from);
     }
 }
 
@@ -279,5 +381,122 @@ mod tests {
         assert!(!open[0]);
         s.open_over(1, 0.04, &mut open[..1]);
         assert!(open[0]);
+    }
+
+    /// Order 0 of `units` indices, from smooth but irregular profiles.
+    fn profile(units: usize) -> (Vec<f64>, Vec<f64>) {
+        let at = |i: usize, f: f64| (f * i as f64).sin() * 0.1 + 0.02 * (i % 3) as f64;
+        (
+            (1..=units).map(|i| at(i, 1.3)).collect(),
+            (1..=units).map(|i| at(i, 0.7)).collect(),
+        )
+    }
+
+    /// A series of `units` indices over rows left dirty by a wider one, as
+    /// the scratch series is between impacts.
+    fn dirty(order: usize, units: usize) -> Series {
+        let mut s = Series::new(order, 48);
+        s.gap.fill(7.0);
+        s.vel.fill(-3.0);
+        s.reset(units);
+        let (d, u) = profile(units);
+        s.gap[1..=units].copy_from_slice(&d);
+        s.vel[1..=units].copy_from_slice(&u);
+        s
+    }
+
+    #[test]
+    fn every_width_expands_as_the_plain_recursion() {
+        // Widths of one to six blocks: the short ones take the unrolled
+        // kernels, the rest the general one.
+        let (order, ghost) = (9, 0.3);
+        for units in 1..=44 {
+            let mut s = dirty(order, units);
+            s.expand(ghost, None);
+            // The recursion column by column, boundaries by hand.
+            let (d, u) = profile(units);
+            let mut gap = vec![vec![0.0; units + 2]; order + 1];
+            let mut vel = vec![vec![0.0; units + 2]; order + 1];
+            gap[0][1..=units].copy_from_slice(&d);
+            vel[0][1..=units].copy_from_slice(&u);
+            gap[0][units + 1] = ghost;
+            for k in 0..order {
+                let inv = 1.0 / (k + 1) as f64;
+                for i in 1..=units {
+                    gap[k + 1][i] = (vel[k][i] - vel[k][i - 1]) * inv;
+                    vel[k + 1][i] = (gap[k][i + 1] - gap[k][i]) * inv;
+                }
+            }
+            for k in 0..=order {
+                for i in 1..=units {
+                    assert_eq!(
+                        s.gap[s.at(k, i)],
+                        gap[k][i],
+                        "{units} units, gap {i}, order {k}"
+                    );
+                    assert_eq!(
+                        s.vel[s.at(k, i)],
+                        vel[k][i],
+                        "{units} units, vel {i}, order {k}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn every_width_evaluates_and_proves_as_each_column_alone() {
+        let order = 9;
+        for units in 1..=44 {
+            let mut s = dirty(order, units);
+            s.expand(0.3, None);
+            let n = blocks(units);
+            let tau: Vec<f64> = (0..n).map(|i| 0.004 * (i % 7) as f64).collect();
+            let (mut gaps, mut vels) = (vec![0.0; n], vec![0.0; n]);
+            s.values(1, &tau, &mut gaps, &mut vels);
+            for i in 0..units {
+                assert_eq!(
+                    gaps[i],
+                    s.value(&s.gap, i + 1, tau[i]),
+                    "{units} units, gap {i}"
+                );
+                assert_eq!(
+                    vels[i],
+                    s.value(&s.vel, i + 1, tau[i]),
+                    "{units} units, vel {i}"
+                );
+            }
+            // Each gap's bounds summed on its own, far from any tie.
+            let span = 0.6;
+            let mut open = vec![false; units];
+            s.open_over(1, span, &mut open);
+            for (i, &proven) in open.iter().enumerate() {
+                let mut column = [0.0; MAX_COLUMN];
+                let c = s.column(&s.gap, i + 1, &mut column);
+                let reach: f64 = (1..=order).map(|k| c[k].abs() * span.powi(k as i32)).sum();
+                let turn: f64 = (2..=order)
+                    .map(|k| k as f64 * c[k].abs() * span.powi(k as i32 - 1))
+                    .sum();
+                let expected =
+                    c[0] > reach * (1.0 + 1e-9) || c[0] >= 0.0 && c[1] > turn * (1.0 + 1e-9);
+                let refuted =
+                    c[0] < reach * (1.0 - 1e-9) && (c[0] < 0.0 || c[1] < turn * (1.0 - 1e-9));
+                assert!(expected || refuted, "{units} units, gap {i}: a near tie");
+                assert_eq!(proven, expected, "{units} units, gap {i}");
+            }
+            // Both verdicts occur, once there are a few gaps.
+            let both = open.contains(&true) && open.contains(&false);
+            assert!(both || units < 4, "{units} units: {open:?}");
+        }
+    }
+
+    #[test]
+    fn runs_of_any_length_copy_whole() {
+        let from: Vec<f64> = (0..20).map(f64::from).collect();
+        for n in 0..=20 {
+            let mut to = vec![-1.0; n];
+            copy_run(&mut to, &from[..n]);
+            assert_eq!(to, from[..n]);
+        }
     }
 }

@@ -52,13 +52,17 @@
 //! ways, so a unit on the edge is neither captured nor released over and
 //! over.
 
-use crate::engine::taylor::{first_fall, integral};
+use crate::engine::taylor::{first_fall, integral, search_fall};
 use crate::engine::{Direction, Fired, Guard, LocalModel};
 use crate::time::Time;
 
 use super::Chain;
 use super::collide::cascade;
 use super::series::{MAX_COLUMN, Series, blocks};
+
+/// A certified search for the first falling root of a series on an
+/// interval (see [`first_fall`]).
+type Search = fn(&[f64], f64, f64) -> Result<Option<f64>, String>;
 
 /// Window length in scaled time `omega t`: longer windows mean fewer full
 /// re-expansions but longer series and a wider reach per impact.
@@ -286,14 +290,22 @@ impl TaylorChain {
     }
 
     /// When `series`, which starts on unit `unit`'s clock, first falls
-    /// through zero at or after `now` within the window.
-    fn first_root(&self, unit: usize, series: &[f64], now: Time) -> Result<Option<Time>, String> {
+    /// through zero at or after `now` within the window, by `search`
+    /// ([`first_fall`], or [`search_fall`] for a gap whose open proof
+    /// failed: that proof is the cheap bound `first_fall` starts with).
+    fn first_root(
+        &self,
+        unit: usize,
+        series: &[f64],
+        now: Time,
+        search: Search,
+    ) -> Result<Option<Time>, String> {
         let origin = self.origin[unit];
         // An impact tied with the window's end may start a series a hair
         // past it; the time of a root may round to before `now`.
         let end = (WINDOW - origin).max(0.0);
         let from = (self.sigma(now) - origin).clamp(0.0, end);
-        let root = first_fall(series, from, end).map_err(|why| format!("unit {unit}: {why}"))?;
+        let root = search(series, from, end).map_err(|why| format!("unit {unit}: {why}"))?;
         Ok(root.map(|tau| {
             let t = self.start.after((origin + tau) / self.omega);
             if t < now { now } else { t }
@@ -626,7 +638,7 @@ impl LocalModel for TaylorChain {
             }
             // Released once the force is clearly below zero.
             force[0] -= self.ghost - self.force_noise(a);
-            return self.first_root(a - 1, &force[..len], now);
+            return self.first_root(a - 1, &force[..len], now, first_fall);
         }
         if self.block.is_some_and(|a| guard + 1 >= a) {
             // Resting in the end block: no impact until it is released.
@@ -636,7 +648,9 @@ impl LocalModel for TaylorChain {
         if self.open[unit] {
             return Ok(None);
         }
-        self.first_root(unit, self.gap_series(unit, &mut [0.0; MAX_COLUMN]), now)
+        let mut series = [0.0; MAX_COLUMN];
+        let series = self.gap_series(unit, &mut series);
+        self.first_root(unit, series, now, search_fall)
     }
 
     fn quiet(&self, guard: usize) -> bool {
