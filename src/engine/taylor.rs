@@ -16,6 +16,13 @@ use crate::engine::fused::mul_add;
 
 /// `(p(s), p'(s), p''(s))` of `p = sum c[k] s^k`.
 pub fn eval2(c: &[f64], s: f64) -> (f64, f64, f64) {
+    if s == 0.0 {
+        // A series searched from its own origin, the common case: the sums
+        // below would come to the same numbers, one dependent step per
+        // coefficient later.
+        let at = |k: usize| c.get(k).copied().unwrap_or(0.0);
+        return (at(0), at(1), 2.0 * at(2));
+    }
     let (mut p, mut d1, mut d2) = (0.0, 0.0, 0.0);
     for &ck in c.iter().rev() {
         d2 = mul_add(d2, s, 2.0 * d1);

@@ -178,19 +178,29 @@ impl Series {
     fn expand_blocks(&mut self, count: usize, ghost: f64, block: Option<usize>) {
         let (w, s, n) = (self.width, self.stride, count * LANES);
         let rows = self.order + 1;
+        // The boundary columns: set here for every order, not as each is
+        // computed (the next order would read them back at once; see
+        // `differences`).
+        for k in 0..rows {
+            self.vel[k * s] = 0.0;
+            self.gap[k * s + w - 1] = if k == 0 { ghost } else { 0.0 };
+        }
         let mut gaps = self.gap[..rows * s].chunks_exact_mut(s);
         let mut vels = self.vel[..rows * s].chunks_exact_mut(s);
         let (Some(mut gap), Some(mut vel)) = (gaps.next(), vels.next()) else {
             return;
         };
-        vel[0] = 0.0;
-        gap[w - 1] = ghost;
-        for ((next_gap, next_vel), inv) in gaps.zip(vels).zip(INVERSES) {
+        // Where the whole blocks run over the ghost, which is zero past
+        // order 0.
+        let ghost_column = (w - 1 <= n).then_some(w - 2);
+        for (k, ((next_gap, next_vel), inv)) in gaps.zip(vels).zip(INVERSES).enumerate() {
             // Delta_n' = u_n - u_{n-1},  u_n' = Delta_{n+1} - Delta_n.
-            differences(&mut next_gap[1..=n], &mut next_vel[1..=n], gap, vel, inv);
-            next_vel[0] = 0.0;
-            // The whole blocks ran over the ghost: it is zero past order 0.
-            next_gap[w - 1] = 0.0;
+            differences(
+                (&mut next_gap[1..=n], &mut next_vel[1..=n]),
+                (gap, vel),
+                (inv, ghost_column),
+                k % 2 == 0,
+            );
             if let Some(b) = block.filter(|&b| b < w - 1) {
                 let rigid = match b {
                     1 => 0.0,
@@ -289,23 +299,52 @@ impl Series {
 /// One order of the recursion over whole blocks from column 1:
 /// `next_gap[i] = (vel[i + 1] - vel[i]) * scale` and `next_vel[i] =
 /// (gap[i + 2] - gap[i + 1]) * scale`, the rows of order `k` given from
-/// column 0 and the next ones from column 1.
+/// column 0 and the next ones from column 1; `next_gap[ghost]`, if any, is
+/// left zero. `gap_first` says which row to compute first: alternate it
+/// from order to order, and each row reads, one column off, a row stored
+/// a whole row's pass earlier. On the short rows of an impact, a row read
+/// back right after it was stored would wait for the stores to reach
+/// memory (a load across two pending stores is not forwarded).
 #[inline(always)]
-fn differences(next_gap: &mut [f64], next_vel: &mut [f64], gap: &[f64], vel: &[f64], scale: f64) {
+fn differences(
+    (next_gap, next_vel): (&mut [f64], &mut [f64]),
+    (gap, vel): (&[f64], &[f64]),
+    (scale, ghost): (f64, Option<usize>),
+    gap_first: bool,
+) {
+    if gap_first {
+        gap_row(next_gap, vel, scale, ghost);
+        vel_row(next_vel, gap, scale);
+    } else {
+        vel_row(next_vel, gap, scale);
+        gap_row(next_gap, vel, scale, ghost);
+    }
+}
+
+/// `Delta_n' = u_n - u_{n-1}` over whole blocks (see [`differences`]).
+#[inline(always)]
+fn gap_row(next_gap: &mut [f64], vel: &[f64], scale: f64, ghost: Option<usize>) {
     let n = next_gap.len();
-    let (gap, vel) = (&gap[..n + 2], &vel[..n + 1]);
-    let (next_gap, _) = next_gap.as_chunks_mut::<LANES>();
-    let (next_vel, _) = next_vel[..n].as_chunks_mut::<LANES>();
-    debug_assert_eq!(next_gap.len() * LANES, n, "whole blocks only");
-    let block = |row: &[f64], at: usize| -> [f64; LANES] {
-        row[at..at + LANES].try_into().expect("a block of a row")
-    };
-    for (j, (g, v)) in next_gap.iter_mut().zip(next_vel).enumerate() {
-        let c = j * LANES;
-        let (left, here) = (block(vel, c), block(vel, c + 1));
-        let (own, right) = (block(gap, c + 1), block(gap, c + 2));
-        // Delta_n' = u_n - u_{n-1},  u_n' = Delta_{n+1} - Delta_n.
+    let (blocks, _) = next_gap.as_chunks_mut::<LANES>();
+    debug_assert_eq!(blocks.len() * LANES, n, "whole blocks only");
+    let (left, _) = vel[..n].as_chunks::<LANES>();
+    let (here, _) = vel[1..=n].as_chunks::<LANES>();
+    for ((g, left), here) in blocks.iter_mut().zip(left).zip(here) {
         *g = std::array::from_fn(|i| (here[i] - left[i]) * scale);
+    }
+    if let Some(at) = ghost {
+        next_gap[at] = 0.0;
+    }
+}
+
+/// `u_n' = Delta_{n+1} - Delta_n` over whole blocks (see [`differences`]).
+#[inline(always)]
+fn vel_row(next_vel: &mut [f64], gap: &[f64], scale: f64) {
+    let n = next_vel.len();
+    let (blocks, _) = next_vel.as_chunks_mut::<LANES>();
+    let (own, _) = gap[1..=n].as_chunks::<LANES>();
+    let (right, _) = gap[2..n + 2].as_chunks::<LANES>();
+    for ((v, own), right) in blocks.iter_mut().zip(own).zip(right) {
         *v = std::array::from_fn(|i| (right[i] - own[i]) * scale);
     }
 }
