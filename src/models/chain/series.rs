@@ -118,9 +118,10 @@ impl Series {
         while j < taus.len() {
             let column = first + j * LANES;
             let out = (&mut gaps[j..], &mut vels[j..]);
-            j += match taus.len() - j {
-                1 => self.values_of::<1>(column, &taus[j..], out),
-                _ => self.values_of::<GROUP>(column, &taus[j..], out),
+            j += if taus.len() - j >= GROUP {
+                self.values_of::<GROUP>(column, &taus[j..], out)
+            } else {
+                self.values_of::<1>(column, &taus[j..], out)
             };
         }
     }
@@ -232,9 +233,12 @@ impl Series {
         while j < open.len() {
             let column = first + j;
             let open = &mut open[j..];
-            j += match open.len() {
-                ..=LANES => self.open_of::<1>(column, &weights, open),
-                _ => self.open_of::<GROUP>(column, &weights, open),
+            // A group's blocks must hold a column each: rows are padded by
+            // one block only.
+            j += if open.len() > (GROUP - 1) * LANES {
+                self.open_of::<GROUP>(column, &weights, open)
+            } else {
+                self.open_of::<1>(column, &weights, open)
             };
         }
     }
