@@ -14,7 +14,11 @@
 //! column if need be (rows are allocated long enough): at an impact they
 //! are about 20 columns long, too short for the compiler's own unrolled
 //! loops, which would leave them to a scalar tail. What lands past the last
-//! column is never read back into it.
+//! column is never read back into it. The one to three blocks of an
+//! impact's reach get their own copies of the kernels (the count known, the
+//! loops unroll and lose their bounds checks), and the recursion computes
+//! one row, then the other, alternating from order to order, so that no
+//! row is read back one column off right after it was stored.
 
 use crate::engine::fused::mul_add;
 
