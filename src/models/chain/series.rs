@@ -179,6 +179,7 @@ impl Series {
         }
     }
 
+    /// [`expand`](Self::expand) over `count` blocks of columns.
     #[inline(always)]
     fn expand_blocks(&mut self, count: usize, ghost: f64, block: Option<usize>) {
         let (w, s, n) = (self.width, self.stride, count * LANES);
