@@ -6,7 +6,8 @@
 //! instruction calls a slow software routine, so the choice is made here
 //! at compile time.
 
-/// `a * b + c`: fused if the target has FMA, two roundings otherwise.
+/// `a * b + c`: fused if the build target has FMA (decided when compiling,
+/// not by the CPU it runs on), two roundings otherwise.
 #[inline(always)]
 pub fn mul_add(a: f64, b: f64, c: f64) -> f64 {
     #[cfg(target_feature = "fma")]

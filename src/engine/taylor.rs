@@ -109,7 +109,9 @@ pub fn first_fall(c: &[f64], a: f64, b: f64) -> Result<Option<f64>, String> {
 
 /// [`first_fall`] without its first, cheap proof that `p` stays above
 /// zero on `[0, b]` (`c_0 > sum_{k >= 1} |c_k| b^k`, or `p` constant), for a
-/// caller that has tried that proof already.
+/// caller that has tried that proof, or an equivalent one, already. The
+/// search is complete without it, only slower where it would have settled
+/// the question.
 pub fn search_fall(c: &[f64], a: f64, b: f64) -> Result<Option<f64>, String> {
     let (mut from, mut at) = (a, eval2(c, a));
     if at.0 <= 0.0 {
@@ -362,13 +364,17 @@ impl Piece<'_> {
                 }
                 break;
             }
-            // Newton's step leaves an error of about |p'' / (2 p')| times
-            // its square: below a quarter ulp of the root, the step lands
-            // on it and one more evaluation could only confirm it.
+            // Newton's step leaves an error of at most |p''| / (2 |p'|)
+            // times its square, |p''| taken over the step (its value here
+            // plus the bound on p''' times the step: near an inflection
+            // the value here alone could be zero). Below half an ulp of the
+            // root, the step lands on it and one more evaluation could
+            // only confirm it.
             let step = newton - x;
+            let curvature = d2.abs() + self.third * step.abs();
             if newton > lo
                 && newton < hi
-                && (d2 / d1).abs() * step * step <= 0.5 * f64::EPSILON * newton.abs()
+                && curvature / d1.abs() * step * step <= 0.5 * f64::EPSILON * newton.abs()
             {
                 x = newton;
                 break;
@@ -471,6 +477,30 @@ mod tests {
             (s - exact).abs() <= 8.0 * f64::EPSILON * exact,
             "{s} {exact}"
         );
+    }
+
+    #[test]
+    fn newton_does_not_stop_early_at_an_inflection() {
+        // p = 0.1 - u - 10 u^3, u = s - 0.5: falling everywhere, root near
+        // s = 0.5922, an inflection at s = 0.5 where p'' = 0. A first guess
+        // there (the bracket's start values are chosen to put it there)
+        // takes a Newton step of 0.1 whose error p'' alone would call zero.
+        // 0.1 - (s - 0.5) - 10 (s - 0.5)^3 in powers of s.
+        let c = [0.1 + 0.5 + 1.25, -1.0 - 7.5, 15.0, -10.0];
+        let p = |s: f64| eval(&c, s);
+        let piece = Piece {
+            c: &c,
+            third: third_derivative_bound(&c, 1.0),
+            budget: std::cell::Cell::new(MAX_PIECES),
+            gave_up: std::cell::Cell::new(false),
+        };
+        let (lo, hi) = (0.4, 1.0);
+        assert!(p(lo) > 0.0 && p(hi) < 0.0);
+        let root = piece.refine((lo, (0.1, -1.0, 0.0)), (hi, p(hi)));
+        // The root solves u + 10 u^3 = 0.1.
+        let u = root - 0.5;
+        assert!((u + 10.0 * u * u * u - 0.1).abs() < 1e-15, "{root}");
+        assert!(p(root).abs() <= 8.0 * f64::EPSILON * 3.0, "{root}");
     }
 
     #[test]

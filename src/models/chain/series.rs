@@ -186,7 +186,8 @@ impl Series {
         let rows = self.order + 1;
         // The boundary columns: set here for every order, not as each is
         // computed (the next order would read them back at once; see
-        // `differences`).
+        // `differences`). Only a ghost inside the blocks, which they run
+        // over, is put back after each gap row.
         for k in 0..rows {
             self.vel[k * s] = 0.0;
             self.gap[k * s + w - 1] = if k == 0 { ghost } else { 0.0 };
@@ -535,6 +536,54 @@ mod tests {
             // Both verdicts occur, once there are a few gaps.
             let both = open.contains(&true) && open.contains(&false);
             assert!(both || units < 4, "{units} units: {open:?}");
+        }
+    }
+
+    #[test]
+    fn an_end_block_stays_shut_and_rigid_at_every_order() {
+        let order = 9;
+        for units in [3, 8, 15, 16, 24, 30] {
+            for b in [1, 2, units / 2 + 1, units] {
+                let mut s = dirty(order, units);
+                s.gap[b..=units].fill(0.0);
+                s.expand(-0.2, Some(b));
+                for k in 1..=order {
+                    // Shut at every order, and one velocity from the node on
+                    // the block's left (the wall's zero if it starts at 1).
+                    let rigid = s.vel[s.at(k, (b - 1).max(1))];
+                    for i in b..=units {
+                        assert_eq!(
+                            s.gap[s.at(k, i)],
+                            0.0,
+                            "{units} units, block {b}, order {k}"
+                        );
+                        assert_eq!(
+                            s.vel[s.at(k, i)],
+                            rigid,
+                            "{units} units, block {b}, order {k}"
+                        );
+                    }
+                    if b == 1 {
+                        assert_eq!(rigid, 0.0, "{units} units: held at the wall");
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_run_from_inside_the_series_to_its_last_column_proves_as_the_whole() {
+        // The chain proves an impact's reach from a column inside its
+        // scratch series: the same verdicts as a proof over every column.
+        let units = 21;
+        let mut s = dirty(9, units);
+        s.expand(0.3, None);
+        let mut whole = vec![false; units];
+        s.open_over(1, 0.6, &mut whole);
+        for first in 2..=units {
+            let mut part = vec![false; units + 1 - first];
+            s.open_over(first, 0.6, &mut part);
+            assert_eq!(part, whole[first - 1..], "from column {first}");
         }
     }
 

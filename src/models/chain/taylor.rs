@@ -218,6 +218,7 @@ impl TaylorChain {
             *u = v / omega;
         }
         model.series.expand(ghost, None);
+        model.series.open_over(1, WINDOW, &mut model.open[1..=n]);
         Ok(model)
     }
 
@@ -292,7 +293,8 @@ impl TaylorChain {
     /// When `series`, which starts on unit `unit`'s clock, first falls
     /// through zero at or after `now` within the window, by `search`
     /// ([`first_fall`], or [`search_fall`] for a gap whose open proof
-    /// failed: that proof is the cheap bound `first_fall` starts with).
+    /// failed: that proof is equivalent to the cheap bound `first_fall`
+    /// starts with).
     fn first_root(
         &self,
         unit: usize,
