@@ -15,7 +15,7 @@
 //! smallest with `(2 theta)^(K+1) / (K+1)! < 2^-60` (theta = the window):
 //! the truncation error is below `2^-60 S`, far under round-off. Each
 //! unit's gap is then a polynomial on the window, and its next impact the
-//! first falling root of it ([`first_fall`]), found by certified bounds, so
+//! first falling root of it ([`search_fall`]), found by certified bounds, so
 //! none is missed and all come in strict time order through the engine's
 //! queue.
 //!
@@ -52,17 +52,13 @@
 //! ways, so a unit on the edge is neither captured nor released over and
 //! over.
 
-use crate::engine::taylor::{first_fall, integral, search_fall};
+use crate::engine::taylor::{integral, search_fall};
 use crate::engine::{Direction, Fired, Guard, LocalModel};
 use crate::time::Time;
 
 use super::Chain;
 use super::collide::cascade;
 use super::series::{MAX_COLUMN, Series, blocks};
-
-/// A certified search for the first falling root of a series on an
-/// interval (see [`first_fall`]).
-type Search = fn(&[f64], f64, f64) -> Result<Option<f64>, String>;
 
 /// Window length in scaled time `omega t`: longer windows mean fewer full
 /// re-expansions but longer series and a wider reach per impact.
@@ -291,23 +287,16 @@ impl TaylorChain {
     }
 
     /// When `series`, which starts on unit `unit`'s clock, first falls
-    /// through zero at or after `now` within the window, by `search`
-    /// ([`first_fall`], or [`search_fall`] for a gap whose open proof
-    /// failed: that proof is equivalent to the cheap bound `first_fall`
-    /// starts with).
-    fn first_root(
-        &self,
-        unit: usize,
-        series: &[f64],
-        now: Time,
-        search: Search,
-    ) -> Result<Option<Time>, String> {
+    /// through zero at or after `now` within the window. The search skips
+    /// `first_fall`'s cheap bound: for a gap it is the open proof, which
+    /// has failed when a gap is searched, and the release is rare.
+    fn first_root(&self, unit: usize, series: &[f64], now: Time) -> Result<Option<Time>, String> {
         let origin = self.origin[unit];
         // An impact tied with the window's end may start a series a hair
         // past it; the time of a root may round to before `now`.
         let end = (WINDOW - origin).max(0.0);
         let from = (self.sigma(now) - origin).clamp(0.0, end);
-        let root = search(series, from, end).map_err(|why| format!("unit {unit}: {why}"))?;
+        let root = search_fall(series, from, end).map_err(|why| format!("unit {unit}: {why}"))?;
         Ok(root.map(|tau| {
             let t = self.start.after((origin + tau) / self.omega);
             if t < now { now } else { t }
@@ -427,10 +416,10 @@ impl TaylorChain {
         self.reaches[j.clamp(1, REACH_STEPS) - 1]
     }
 
-    /// Units `lo - D ..= hi + D` (`D` the reach at `sigma`), and the whole end block with the node on
-    /// its left if the window their series draw on (the spread beyond) comes
-    /// to it: a rigid block passes a change on at once, and the free
-    /// recursion must not be run across it.
+    /// Units `lo - D ..= hi + D` (`D` the reach at `sigma`), and the whole
+    /// end block with the node on its left if the window their series draw
+    /// on (the spread beyond) comes to it: a rigid block passes a change on
+    /// at once, and the free recursion must not be run across it.
     fn reach_around(&self, lo: usize, hi: usize, sigma: f64) -> (usize, usize) {
         let (n, reach) = (self.chain.units, self.reach_at(sigma));
         let (r_lo, r_hi) = (lo.saturating_sub(reach).max(1), (hi + reach).min(n));
@@ -640,7 +629,7 @@ impl LocalModel for TaylorChain {
             }
             // Released once the force is clearly below zero.
             force[0] -= self.ghost - self.force_noise(a);
-            return self.first_root(a - 1, &force[..len], now, first_fall);
+            return self.first_root(a - 1, &force[..len], now);
         }
         if self.block.is_some_and(|a| guard + 1 >= a) {
             // Resting in the end block: no impact until it is released.
@@ -652,7 +641,7 @@ impl LocalModel for TaylorChain {
         }
         let mut series = [0.0; MAX_COLUMN];
         let series = self.gap_series(unit, &mut series);
-        self.first_root(unit, series, now, search_fall)
+        self.first_root(unit, series, now)
     }
 
     fn quiet(&self, guard: usize) -> bool {
