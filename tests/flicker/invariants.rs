@@ -24,9 +24,12 @@ proptest! {
         prop_assume!(outcome.status == Status::Completed);
         let h0 = m.energy(eps, rate);
         let scale = m.energy_scale(h0);
-        // Round-off per impact is ~1e-16 of the scale; 1e-13 leaves room for
-        // the largest runs here (a few thousand impacts).
-        prop_assert!(outcome.max_energy_error.unwrap() < 1e-13, "energy error {:?}", outcome.max_energy_error);
+        // Each impact and each flight rounds the state by about an ulp of
+        // the scale, and these errors may add up: allow four ulps per
+        // event (a fixed 1e-13 failed at 408 impacts, 1.28e-13: 1.4 ulps
+        // each, near eta = 1).
+        let allowed = 4.0 * f64::EPSILON * (outcome.events as f64 + 1.0);
+        prop_assert!(outcome.max_energy_error.unwrap() < allowed, "energy error {:?} over {} events", outcome.max_energy_error, outcome.events);
         let mut last = 0.0;
         for e in &log.events {
             prop_assert!(e.t >= last);
