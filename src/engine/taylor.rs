@@ -338,7 +338,16 @@ impl Piece<'_> {
         // root); the secant point if that root is not in the bracket.
         let (p_lo, d1, d2) = at_lo;
         let denominator = -d1 + (d1 * d1 - 2.0 * d2 * p_lo).max(0.0).sqrt();
-        let quadratic = lo + 2.0 * p_lo / denominator;
+        let mut quadratic = lo + 2.0 * p_lo / denominator;
+        if lo == 0.0 && self.c.len() > 4 {
+            // At the series' origin (most searches) the third- and
+            // fourth-order terms are at hand: a Newton step on the quartic
+            // leaves the guess off by the fifth-order term, so the first
+            // full evaluation's step most often lands within half an ulp.
+            let (h, c3, c4) = (quadratic, self.c[3], self.c[4]);
+            let slope = d1 + d2 * h + (3.0 * c3 + 4.0 * c4 * h) * h * h;
+            quadratic = h - (c3 + c4 * h) * h * h * h / slope;
+        }
         let secant = lo + (hi - lo) * p_lo / (p_lo - p_hi);
         let mut x = if quadratic > lo && quadratic < hi {
             quadratic
