@@ -20,6 +20,8 @@
 //! one row, then the other, alternating from order to order, so that no
 //! row is read back one column off right after it was stored.
 
+use wide::f64x4;
+
 use crate::engine::fused::mul_add;
 
 /// Longest series a column is gathered into (orders up to 15).
@@ -42,6 +44,52 @@ const INVERSES: [f64; MAX_COLUMN] = {
     }
     inverses
 };
+
+// The evaluation, the open proofs and the short copies hold their blocks
+// in explicit four-column registers: left to the compiler, their lanes
+// came out shuffled and partly scalar, with bounds checks in the order
+// loops. `f64x4::mul_add` fuses exactly where `mul_add` does (when the
+// build target has FMA), so both give the same bits.
+
+/// Registers of four columns per block.
+const QUADS: usize = LANES / 4;
+
+/// A block of columns in registers.
+type Block = [f64x4; QUADS];
+
+/// A block of columns into registers.
+#[inline(always)]
+fn load(block: &[f64; LANES]) -> Block {
+    std::array::from_fn(|q| f64x4::new(std::array::from_fn(|i| block[4 * q + i])))
+}
+
+/// Registers back into a block of columns.
+#[inline(always)]
+fn store(block: &mut [f64; LANES], registers: Block) {
+    for (q, x) in registers.into_iter().enumerate() {
+        block[4 * q..4 * q + 4].copy_from_slice(&x.to_array());
+    }
+}
+
+/// [`blocks_at`], to write.
+#[inline(always)]
+fn blocks_at_mut<const G: usize>(row: &mut [f64], at: usize) -> &mut [[f64; LANES]; G] {
+    row[at..at + G * LANES]
+        .as_chunks_mut::<LANES>()
+        .0
+        .try_into()
+        .expect("G blocks")
+}
+
+/// The blocks of `row` from column `at` on, `G` of them.
+#[inline(always)]
+fn blocks_at<const G: usize>(row: &[f64], at: usize) -> &[[f64; LANES]; G] {
+    row[at..at + G * LANES]
+        .as_chunks::<LANES>()
+        .0
+        .try_into()
+        .expect("G blocks")
+}
 
 /// `n` rounded up to whole blocks.
 pub fn blocks(n: usize) -> usize {
@@ -140,20 +188,22 @@ impl Series {
         taus: &[[f64; LANES]],
         (gaps, vels): (&mut [[f64; LANES]], &mut [[f64; LANES]]),
     ) -> usize {
-        let t: &[[f64; LANES]; G] = taus[..G].try_into().expect("G blocks");
-        let mut sums = [[[0.0; LANES]; G]; 2];
+        let t: [Block; G] = std::array::from_fn(|b| load(&taus[b]));
+        let mut sums = [[[f64x4::ZERO; QUADS]; G]; 2];
         for k in (0..=self.order).rev() {
             let at = self.at(k, column);
             for (sum, rows) in sums.iter_mut().zip([&self.gap, &self.vel]) {
-                let (row, _) = rows[at..at + G * LANES].as_chunks::<LANES>();
-                for ((s, c), t) in sum.iter_mut().zip(row).zip(t) {
-                    *s = std::array::from_fn(|i| mul_add(s[i], t[i], c[i]));
+                for ((s, t), c) in sum.iter_mut().zip(&t).zip(blocks_at::<G>(rows, at)) {
+                    let c = load(c);
+                    *s = std::array::from_fn(|q| s[q].mul_add(t[q], c[q]));
                 }
             }
         }
         let [g, v] = sums;
-        gaps[..G].copy_from_slice(&g);
-        vels[..G].copy_from_slice(&v);
+        for b in 0..G {
+            store(&mut gaps[b], g[b]);
+            store(&mut vels[b], v[b]);
+        }
         G
     }
 
@@ -259,29 +309,36 @@ impl Series {
         weights: &[[f64; 2]; MAX_COLUMN],
         open: &mut [bool],
     ) -> usize {
-        let row = |k: usize| -> &[[f64; LANES]] {
-            let at = self.at(k, column);
-            self.gap[at..at + G * LANES].as_chunks::<LANES>().0
-        };
-        let (mut reach, mut turn) = ([[0.0; LANES]; G], [[0.0; LANES]; G]);
+        let row = |k: usize| blocks_at::<G>(&self.gap, self.at(k, column));
+        let (mut reach, mut turn) = ([[f64x4::ZERO; QUADS]; G], [[f64x4::ZERO; QUADS]; G]);
         for (k, &[to_reach, to_turn]) in (1..=self.order).zip(&weights[1..]) {
-            for ((r, t), c) in reach.iter_mut().zip(&mut turn).zip(row(k)) {
-                *r = std::array::from_fn(|i| mul_add(c[i].abs(), to_reach, r[i]));
-                *t = std::array::from_fn(|i| mul_add(c[i].abs(), to_turn, t[i]));
+            let (to_reach, to_turn) = (f64x4::splat(to_reach), f64x4::splat(to_turn));
+            let row = row(k);
+            for ((r, t), c) in reach.iter_mut().zip(&mut turn).zip(row) {
+                for (q, c) in load(c).into_iter().enumerate() {
+                    let c = c.abs();
+                    r[q] = c.mul_add(to_reach, r[q]);
+                    t[q] = c.mul_add(to_turn, t[q]);
+                }
             }
         }
+        // Every lane's verdict at once, without short cuts, as one bit per
+        // column.
         let (values, slopes) = (row(0), row(1));
+        let (zero, pad) = (f64x4::ZERO, f64x4::splat(1.0 + 1e-12));
+        let mut proven = 0u32;
+        for b in 0..G {
+            let (c, s) = (load(&values[b]), load(&slopes[b]));
+            for q in 0..QUADS {
+                let (reach, turn) = (reach[b][q], turn[b][q]);
+                let above = (c[q] - reach * pad).simd_gt(zero) | reach.simd_eq(zero);
+                let rising = c[q].simd_ge(zero) & (s[q] - turn * pad).simd_gt(zero);
+                proven |= (above | rising).to_bitmask() << (b * LANES + 4 * q);
+            }
+        }
         let done = open.len().min(G * LANES);
-        for (j, open) in open[..done].chunks_mut(LANES).enumerate() {
-            // Without short cuts, so that the lanes' verdicts are computed
-            // side by side instead of branching on each.
-            let proven: [bool; LANES] = std::array::from_fn(|i| {
-                let (c, b, t) = (values[j][i], reach[j][i], turn[j][i]);
-                let above = (c - b * (1.0 + 1e-12) > 0.0) | (b == 0.0);
-                let rising = (c >= 0.0) & (slopes[j][i] - t * (1.0 + 1e-12) > 0.0);
-                above | rising
-            });
-            open.copy_from_slice(&proven[..open.len()]);
+        for (i, open) in open[..done].iter_mut().enumerate() {
+            *open = proven >> i & 1 == 1;
         }
         done
     }
@@ -367,11 +424,10 @@ fn vel_row(next_vel: &mut [f64], gap: &[f64], scale: f64) {
 fn copy_run(to: &mut [f64], from: &[f64]) {
     let n = from.len();
     if (LANES..=2 * LANES).contains(&n) && to.len() == n {
-        let block =
-            |at: usize| -> [f64; LANES] { from[at..at + LANES].try_into().expect("a block") };
-        let (head, tail) = (block(0), block(n - LANES));
-        to[..LANES].copy_from_slice(&head);
-        to[n - LANES..n].copy_from_slice(&tail);
+        let (head, tail) = (blocks_at::<1>(from, 0), blocks_at::<1>(from, n - LANES));
+        let (head, tail) = (load(&head[0]), load(&tail[0]));
+        store(&mut blocks_at_mut::<1>(to, 0)[0], head);
+        store(&mut blocks_at_mut::<1>(to, n - LANES)[0], tail);
     } else {
         to.copy_from_slice(from);
     }
