@@ -43,9 +43,46 @@ pub fn cascade(first: usize, shut: &[bool], v: &mut [f64]) -> (Option<RangeInclu
     (touched.map(|(a, b)| a..=b), wall)
 }
 
+/// The impact of `unit` while every other unit in reach is open: its two
+/// nodes' velocities `[v_{unit-1}, v_unit]` after it, if it closes (swapped;
+/// node 1's flipped against the wall), or `None`. The same as [`cascade`]
+/// with this unit the only one shut, without its bookkeeping.
+pub fn alone(unit: usize, v: [f64; 2]) -> Option<[f64; 2]> {
+    if v[0] - v[1] <= 0.0 {
+        return None;
+    }
+    Some(if unit == 1 {
+        [v[0], -v[1]]
+    } else {
+        [v[1], v[0]]
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_lone_unit_collides_as_in_a_cascade_of_one() {
+        let speeds = [-2.5, -1.0, -0.0, 0.0, 1e-300, 0.75, 3.0];
+        for unit in [1, 2, 7] {
+            for &a in &speeds {
+                for &b in &speeds {
+                    // Node 0 is the wall, at rest.
+                    let a = if unit == 1 { 0.0 } else { a };
+                    let mut v = [a, b];
+                    let (touched, wall) = cascade(unit, &[true], &mut v);
+                    let expected = touched.map(|_| v);
+                    let got = alone(unit, [a, b]);
+                    let bits = |x: Option<[f64; 2]>| x.map(|v| v.map(f64::to_bits));
+                    assert_eq!(bits(got), bits(expected), "unit {unit}: {a} {b}");
+                    if let Some([_, right]) = got.filter(|_| unit == 1) {
+                        assert_eq!(right - b, wall, "{b}");
+                    }
+                }
+            }
+        }
+    }
 
     #[test]
     fn a_node_into_a_packed_block_passes_its_speed_through() {

@@ -279,11 +279,12 @@ impl Series {
         // What order k weighs in each bound: span^k, and k span^(k-1) from
         // order 2 on.
         let mut weights = [[0.0; 2]; MAX_COLUMN];
-        let mut power = 1.0;
-        for (k, weight) in (1..=self.order).zip(&mut weights[1..]) {
-            let turn = if k >= 2 { k as f64 * power } else { 0.0 };
+        let (mut power, mut k) = (1.0, 1.0);
+        for weight in &mut weights[1..=self.order] {
+            let turn = if k >= 2.0 { k * power } else { 0.0 };
             power *= span;
             *weight = [power, turn];
+            k += 1.0;
         }
         let mut j = 0;
         while j < open.len() {

@@ -57,7 +57,7 @@ use crate::engine::{Direction, Fired, Guard, LocalModel};
 use crate::time::Time;
 
 use super::Chain;
-use super::collide::cascade;
+use super::collide::{alone, cascade};
 use super::series::{MAX_COLUMN, Series, blocks};
 
 /// Window length in scaled time `omega t`: longer windows mean fewer full
@@ -337,35 +337,61 @@ impl TaylorChain {
             let u_at = |node: usize, v: &[f64]| if node == 0 { 0.0 } else { v[col(node)] };
             let rel_velocity =
                 self.omega * (u_at(unit - 1, &self.scratch.vel) - u_at(unit, &self.scratch.vel));
-            let mut shut = std::mem::take(&mut self.scratch_shut);
-            shut.clear();
-            shut.extend(
-                (r_lo..=r_hi).map(|i| i == unit || self.scratch.gap[col(i)] <= self.shut_below),
-            );
-            let mut v = std::mem::take(&mut self.scratch_nodes);
-            v.clear();
-            v.extend((r_lo - 1..=r_hi).map(|i| u_at(i, &self.scratch.vel)));
             // Not closing after all (a graze within round-off, or a unit
             // coming to rest shut) changes no velocity, but the unit is
             // still re-expanded from here with its gap clamped to zero, so
             // that its series agrees with the state it was found in.
-            let (touched, wall) = cascade(r_lo, &shut, &mut v);
-            self.scratch_shut = shut;
-            let touched = touched.unwrap_or(unit..=unit);
-            if *touched.start() < lo || *touched.end() > hi {
+            let others_shut = (r_lo..=r_hi).fold(false, |any, i| {
+                any | ((i != unit) & (self.scratch.gap[col(i)] <= self.shut_below))
+            });
+            let (touched, wall) = if others_shut {
+                let mut shut = std::mem::take(&mut self.scratch_shut);
+                shut.clear();
+                shut.extend(
+                    (r_lo..=r_hi).map(|i| i == unit || self.scratch.gap[col(i)] <= self.shut_below),
+                );
+                let mut v = std::mem::take(&mut self.scratch_nodes);
+                v.clear();
+                v.extend((r_lo - 1..=r_hi).map(|i| u_at(i, &self.scratch.vel)));
+                let (touched, wall) = cascade(r_lo, &shut, &mut v);
+                self.scratch_shut = shut;
+                if let Some(touched) = touched.as_ref()
+                    && (*touched.start() < lo || *touched.end() > hi)
+                {
+                    self.scratch_nodes = v;
+                    // A packed block passed the impact on: widen the reach
+                    // and start again from the state before it.
+                    lo = lo.min(*touched.start());
+                    hi = hi.max(*touched.end());
+                    continue;
+                }
+                for (k, node) in (r_lo - 1..=r_hi).enumerate().filter(|(_, node)| *node > 0) {
+                    self.scratch.vel[col(node)] = v[k];
+                }
                 self.scratch_nodes = v;
-                // A packed block passed the impact on: widen the reach and
-                // start again from the state before it.
-                lo = lo.min(*touched.start());
-                hi = hi.max(*touched.end());
-                continue;
-            }
+                (touched, wall)
+            } else {
+                // The common case, a unit closing between open ones: the
+                // cascade's first pass, without its bookkeeping.
+                let nodes = [
+                    u_at(unit - 1, &self.scratch.vel),
+                    u_at(unit, &self.scratch.vel),
+                ];
+                match alone(unit, nodes) {
+                    Some([left, right]) => {
+                        if unit > 1 {
+                            self.scratch.vel[col(unit - 1)] = left;
+                        }
+                        self.scratch.vel[col(unit)] = right;
+                        let wall = if unit == 1 { right - nodes[1] } else { 0.0 };
+                        (Some(unit..=unit), wall)
+                    }
+                    None => (None, 0.0),
+                }
+            };
+            let touched = touched.unwrap_or(unit..=unit);
             // Momentum the wall gave (flips of node 1 only).
             self.wall_impulse += self.chain.mass * self.omega * wall;
-            for (k, node) in (r_lo - 1..=r_hi).enumerate().filter(|(_, node)| *node > 0) {
-                self.scratch.vel[col(node)] = v[k];
-            }
-            self.scratch_nodes = v;
             for i in touched.clone().chain(std::iter::once(unit)) {
                 let g = &mut self.scratch.gap[col(i)];
                 // Shut means zero: drop the round-off overlap.
