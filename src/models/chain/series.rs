@@ -45,8 +45,7 @@ const INVERSES: [f64; MAX_COLUMN] = {
     inverses
 };
 
-// The evaluation, the open proofs and the short copies hold their blocks
-// in explicit four-column registers: left to the compiler, their lanes
+// The row kernels hold their blocks in explicit four-column registers: left to the compiler, their lanes
 // came out shuffled and partly scalar, with bounds checks in the order
 // loops. `f64x4::mul_add` fuses exactly where `mul_add` does (when the
 // build target has FMA), so both give the same bits.
@@ -397,8 +396,10 @@ fn gap_row(next_gap: &mut [f64], vel: &[f64], scale: f64, ghost: Option<usize>) 
     debug_assert_eq!(blocks.len() * LANES, n, "whole blocks only");
     let (left, _) = vel[..n].as_chunks::<LANES>();
     let (here, _) = vel[1..=n].as_chunks::<LANES>();
+    let scale = f64x4::splat(scale);
     for ((g, left), here) in blocks.iter_mut().zip(left).zip(here) {
-        *g = std::array::from_fn(|i| (here[i] - left[i]) * scale);
+        let (left, here) = (load(left), load(here));
+        store(g, std::array::from_fn(|q| (here[q] - left[q]) * scale));
     }
     if let Some(at) = ghost {
         next_gap[at] = 0.0;
@@ -412,8 +413,10 @@ fn vel_row(next_vel: &mut [f64], gap: &[f64], scale: f64) {
     let (blocks, _) = next_vel.as_chunks_mut::<LANES>();
     let (own, _) = gap[1..=n].as_chunks::<LANES>();
     let (right, _) = gap[2..n + 2].as_chunks::<LANES>();
+    let scale = f64x4::splat(scale);
     for ((v, own), right) in blocks.iter_mut().zip(own).zip(right) {
-        *v = std::array::from_fn(|i| (right[i] - own[i]) * scale);
+        let (own, right) = (load(own), load(right));
+        store(v, std::array::from_fn(|q| (right[q] - own[q]) * scale));
     }
 }
 
