@@ -61,12 +61,27 @@ pub fn integral(c: &[f64], s: f64) -> f64 {
         * s
 }
 
+/// `k (k-1) (k-2)` for the orders of the series most models use, tabled:
+/// a chain's root searches would otherwise convert each order to a float.
+const FALLING: [f64; 32] = {
+    let mut falling = [0.0; 32];
+    let mut k = 3;
+    while k < 32 {
+        falling[k] = (k * (k - 1) * (k - 2)) as f64;
+        k += 1;
+    }
+    falling
+};
+
 /// A bound on `|p'''|` over `[0, b]`: `sum |c_k| k (k-1) (k-2) b^(k-3)`.
 fn third_derivative_bound(c: &[f64], b: f64) -> f64 {
     let mut bound = 0.0;
     for (k, &ck) in c.iter().enumerate().skip(3).rev() {
-        let k = k as f64;
-        bound = mul_add(bound, b, ck.abs() * k * (k - 1.0) * (k - 2.0));
+        let weight = FALLING.get(k).copied().unwrap_or_else(|| {
+            let k = k as f64;
+            k * (k - 1.0) * (k - 2.0)
+        });
+        bound = mul_add(bound, b, ck.abs() * weight);
     }
     // Rounding in the sum above is relative and tiny; pad it all the same.
     bound * (1.0 + 1e-12)

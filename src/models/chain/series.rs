@@ -346,16 +346,12 @@ impl Series {
     /// Copy columns `from..from + count` of `source` (same order) into
     /// columns `to..` of this series, every order.
     pub fn copy_columns(&mut self, source: &Series, from: usize, to: usize, count: usize) {
-        for k in 0..=self.order {
-            let (dst, src) = (self.at(k, to), source.at(k, from));
-            copy_run(
-                &mut self.gap[dst..dst + count],
-                &source.gap[src..src + count],
-            );
-            copy_run(
-                &mut self.vel[dst..dst + count],
-                &source.vel[src..src + count],
-            );
+        let (rows, stride) = (self.order + 1, self.stride);
+        for (dst, src) in [(&mut self.gap, &source.gap), (&mut self.vel, &source.vel)] {
+            let dst = dst.chunks_exact_mut(stride).take(rows);
+            for (dst, src) in dst.zip(src.chunks_exact(source.stride)) {
+                copy_run(&mut dst[to..to + count], &src[from..from + count]);
+            }
         }
     }
 }
