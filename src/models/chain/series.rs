@@ -59,15 +59,13 @@ type Block = [f64x4; QUADS];
 /// A block of columns into registers.
 #[inline(always)]
 fn load(block: &[f64; LANES]) -> Block {
-    std::array::from_fn(|q| f64x4::new(std::array::from_fn(|i| block[4 * q + i])))
+    bytemuck::cast(*block)
 }
 
 /// Registers back into a block of columns.
 #[inline(always)]
 fn store(block: &mut [f64; LANES], registers: Block) {
-    for (q, x) in registers.into_iter().enumerate() {
-        block[4 * q..4 * q + 4].copy_from_slice(&x.to_array());
-    }
+    *block = bytemuck::cast(registers);
 }
 
 /// [`blocks_at`], to write.
