@@ -395,12 +395,13 @@ impl Piece<'_> {
             // plus the bound on p''' times the step: near an inflection
             // the value here alone could be zero). Below half an ulp of the
             // root, the step lands on it and one more evaluation could
-            // only confirm it.
+            // only confirm it. (Multiplied out: a second division would
+            // wait on the first.)
             let step = newton - x;
             let curvature = d2.abs() + self.third * step.abs();
             if newton > lo
                 && newton < hi
-                && curvature / d1.abs() * step * step <= 0.5 * f64::EPSILON * newton.abs()
+                && curvature * step * step <= 0.5 * f64::EPSILON * newton.abs() * d1.abs()
             {
                 x = newton;
                 break;
