@@ -2,7 +2,7 @@
 //! coefficient-major: row `k` holds the order-`k` coefficients of every
 //! index side by side, so the recursion, the evaluation of a whole window
 //! and the cheap proof that a gap stays open are each a stencil or a
-//! pointwise update along a row, which the compiler vectorizes.
+//! pointwise update along a row, four columns to a register.
 //!
 //! Column `c` is chain index `first + c - 1`: the gap `Delta` of that unit
 //! and the scaled velocity `u` of its node (the unit's end away from the
@@ -45,10 +45,12 @@ const INVERSES: [f64; MAX_COLUMN] = {
     inverses
 };
 
-// The row kernels hold their blocks in explicit four-column registers: left to the compiler, their lanes
-// came out shuffled and partly scalar, with bounds checks in the order
-// loops. `f64x4::mul_add` fuses exactly where `mul_add` does (when the
-// build target has FMA), so both give the same bits.
+// The row kernels hold their blocks in explicit four-column registers
+// (`wide::f64x4`, moved in and out with `bytemuck::cast`): left to the
+// compiler, their lanes came out shuffled and partly scalar, and its choices
+// moved with unrelated changes elsewhere in the crate. `f64x4::mul_add`
+// fuses exactly where `mul_add` does (when the build target has FMA), so
+// both give the same bits.
 
 /// Registers of four columns per block.
 const QUADS: usize = LANES / 4;
