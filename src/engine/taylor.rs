@@ -441,6 +441,24 @@ mod tests {
     }
 
     #[test]
+    fn the_third_derivative_bound_sums_each_order_weighed_alone() {
+        // Orders past the tabled ones too: both ways of weighing agree.
+        let c: Vec<f64> = (0..40)
+            .map(|k| (-0.7f64).powi(k) / (k + 1) as f64)
+            .collect();
+        let b: f64 = 0.9;
+        let by_hand: f64 = (3..c.len())
+            .map(|k| {
+                let k_f = k as f64;
+                c[k].abs() * k_f * (k_f - 1.0) * (k_f - 2.0) * b.powi(k as i32 - 3)
+            })
+            .sum();
+        let bound = third_derivative_bound(&c, b);
+        assert!(bound >= by_hand, "{bound} < {by_hand}");
+        assert!(bound <= by_hand * (1.0 + 1e-10), "{bound} > {by_hand}");
+    }
+
+    #[test]
     fn evaluation_with_derivatives_matches_the_expanded_forms() {
         let c = [1.0, -2.0, 0.5, 3.0];
         let s: f64 = 0.7;
