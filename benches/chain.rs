@@ -3,7 +3,7 @@
 //!
 //! `cargo bench --bench chain` prints, as medians of several runs (log off):
 //! - wall time per impact for N = 25 ... 3200 in the release scene of
-//!   PHYSICS.md s.6 (traction-free reading) to t = 3 (about 1.1 N^2
+//!   docs/physics.md s.6 (traction-free reading) to t = 3 (about 1.1 N^2
 //!   impacts per unit time; 3 runs at N = 1600, 1 at N = 3200), and in a
 //!   chain rattling sparsely all along from the start (every unit at strain
 //!   0.05, node velocities alternating +-0.05, load F_cr: about 0.15 N^2

@@ -1,4 +1,4 @@
-//! The continuum's cost against the chain's on the release of PHYSICS.md
+//! The continuum's cost against the chain's on the release of docs/physics.md
 //! s.6 to t = 3, in one run, for both readings.
 //!
 //! `cargo bench --bench continuum` prints medians of several runs (log

@@ -1,5 +1,5 @@
 //! The chain of mechanisms through the library: the release scene of
-//! PHYSICS.md s.6 at N = 400 in both readings, run with the exact
+//! docs/physics.md s.6 at N = 400 in both readings, run with the exact
 //! event-local flow, sampled as it goes for the coarse-grained fields.
 //!
 //! `cargo run --release --example chain` prints, every 0.5 time units, the

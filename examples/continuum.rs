@@ -1,5 +1,5 @@
 //! The continuum through the library: the traction-free release of
-//! PHYSICS.md s.6 as the paper's incompressible string (exact front
+//! docs/physics.md s.6 as the paper's incompressible string (exact front
 //! tracking) and as the homogenized string (finite volumes with the
 //! rattling kept), beside the chain it should describe.
 //!

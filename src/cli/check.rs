@@ -85,7 +85,7 @@ pub fn check(path: &Path) -> Result<Code, Failure> {
     Ok(Code::Ok)
 }
 
-/// Which regime of PHYSICS.md s.2 an orbit of energy `h0` is in.
+/// Which regime of docs/physics.md s.2 an orbit of energy `h0` is in.
 fn regime(m: Mechanism, h0: f64, t_end: f64) -> String {
     let c = m.centre();
     let resolution = flicker::engine::zeno::resolution(0.0, t_end);

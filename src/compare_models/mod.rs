@@ -1,5 +1,5 @@
 //! One release scene as the dense chain at several N and as each continuum,
-//! compared by the reproducible quantities of PHYSICS.md s.6-7: the loaded
+//! compared by the reproducible quantities of docs/physics.md s.6-7: the loaded
 //! end's displacement, the front, the coarse-grained strain, velocity and
 //! hidden energy, and the energy, all measured against the densest chain
 //! (the ground truth a continuum must converge to).

@@ -1,4 +1,4 @@
-//! The reproducibility horizon of a chain scene (PHYSICS.md s.7): copies
+//! The reproducibility horizon of a chain scene (docs/physics.md s.7): copies
 //! of the run with each initial strain moved by up to `perturb` times the
 //! scene's largest initial strain, run in parallel, compared at the
 //! scene's sample times.
@@ -50,7 +50,7 @@ pub struct Spread {
     pub window_velocity: f64,
     pub hidden_energy: f64,
     pub right_end: f64,
-    /// `None` while some copy has no front (PHYSICS.md s.6) yet.
+    /// `None` while some copy has no front (docs/physics.md s.6) yet.
     pub front: Option<f64>,
 }
 

@@ -1,4 +1,4 @@
-//! The keys of a chain scene (PHYSICS.md s.4, scene units).
+//! The keys of a chain scene (docs/physics.md s.4, scene units).
 //!
 //! ```json
 //! {"model": "chain", "units": 200, "length": 2.0, "wave_speed": 1.0,
@@ -63,7 +63,7 @@ pub struct ChainScene {
 }
 
 impl ChainScene {
-    /// The scene's chain (PHYSICS.md s.4 scene units, the load after the
+    /// The scene's chain (docs/physics.md s.4 scene units, the load after the
     /// release), with the constraint on or off.
     pub fn chain(&self, constraint: bool) -> Chain {
         Chain::in_scene_units(

@@ -1,5 +1,5 @@
 //! The keys of a continuum scene: the chain scene's string without its
-//! units (PHYSICS.md s.5, scene units).
+//! units (docs/physics.md s.5, scene units).
 //!
 //! ```json
 //! {"model": "continuum", "variant": "paper", "length": 2.0, "wave_speed": 1.0,

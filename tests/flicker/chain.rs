@@ -86,7 +86,7 @@ fn cradles_of_two_to_five_units_keep_momentum_and_energy() {
 #[test]
 fn the_unconstrained_chain_matches_its_modes() {
     // Released from the homogeneous static strain of eta = 1.1 with the
-    // load dropped to zero (PHYSICS.md s.6), constraint off.
+    // load dropped to zero (docs/physics.md s.6), constraint off.
     let units = 10;
     let chain = Chain::in_scene_units(units, 2.0, 1.0, 0.0, false);
     let x0 = chain.homogeneous(0.1);

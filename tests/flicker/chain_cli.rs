@@ -75,7 +75,7 @@ fn a_release_run_writes_summary_log_profiles_and_trace() {
     let e0 = summary["energy_initial"].as_f64().unwrap();
     assert!(rows.iter().all(|r| (r[1] - e0).abs() < 1e-12 * e0));
     // Momentum falls as -(1.1 - 0) t until the wall feels the release
-    // (PHYSICS.md s.6). Collision pulses run ahead of c_b = 1: the end
+    // (docs/physics.md s.6). Collision pulses run ahead of c_b = 1: the end
     // unit first closes at about 0.45 (its node's speed), and a pulse
     // travels at about node speed / strain ahead = 4.5, so the wall, 2
     // away, feels nothing before t = 2 / 4.5 = 0.44.
@@ -137,7 +137,10 @@ fn the_ode_path_runs_the_same_scene_from_the_command_line() {
             .collect();
         assert_eq!(seqs, vec![1, 2], "numbered across the legs between samples");
         let profiles = read_json(&out.join("profiles.json"));
-        // After the t = 0 cascade node 1's speed sits on node 4 (worked by hand).
+        // At t = 1 (worked by hand): node 1's speed went through the shut
+        // block to node 4 at t = 0, and on to node 5 when unit 5 closed near
+        // t = 0.5. Velocities list nodes 1..=5, so v[0] is node 1, now about
+        // at rest, and v[4] is node 5, the end, carrying the speed.
         let v = &profiles["snapshots"][1]["velocity"];
         assert!(
             (v[0].as_f64().unwrap()).abs() < 0.01 && v[4].as_f64().unwrap() > 0.99,
@@ -249,7 +252,7 @@ fn an_ensemble_finds_the_horizon_reproducibly() {
     );
     let c = ensemble("c", "8", "2");
     assert_ne!(a["spread"], c["spread"], "another seed, other copies");
-    // PHYSICS.md s.7: 1e-12 grows to O(1) within a time of order one.
+    // docs/physics.md s.7: 1e-12 grows to O(1) within a time of order one.
     let horizon = a["horizon"]
         .as_f64()
         .expect("the copies part before t = 1.5");
@@ -261,7 +264,8 @@ fn an_ensemble_finds_the_horizon_reproducibly() {
         first["unit_strain"].as_f64().unwrap() <= 2e-13,
         "1e-12 of 0.1 at most"
     );
-    // Before the horizon every field agrees to far better than 1e-3.
+    // Before the horizon the copies' unit strains and end displacements
+    // agree to within 1e-3.
     for s in spread.iter().filter(|s| s["t"].as_f64().unwrap() < horizon) {
         assert!(s["unit_strain"].as_f64().unwrap() <= 1e-3);
         assert!(s["right_end"].as_f64().unwrap() <= 1e-3);

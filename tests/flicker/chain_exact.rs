@@ -113,7 +113,7 @@ fn the_unconstrained_chain_matches_its_modes_to_round_off() {
     }
 }
 
-/// The release scene of PHYSICS.md s.6 at `units`, reading `after`.
+/// The release scene of docs/physics.md s.6 at `units`, reading `after`.
 fn release(units: usize, after: f64) -> (Chain, TaylorChain) {
     let chain = Chain::in_scene_units(units, 2.0, 1.0, after, true);
     let x0 = chain.homogeneous(0.1);
@@ -229,7 +229,7 @@ fn bad_initial_states_are_refused_with_a_reason() {
 fn a_unit_pushed_shut_rests_and_the_pair_bounces_off_the_wall_as_one() {
     // Two units (m = k = F_cr = 1, so omega = 1 and the unit length is 1),
     // the end load gone (F = 0): unit 2 starts shut and at rest, pushed
-    // shut by F_cr (PHYSICS.md s.4: resting contact), unit 1 open at 0.1.
+    // shut by F_cr (docs/physics.md s.4: resting contact), unit 1 open at 0.1.
     // By hand: nodes 1 and 2 move as one body of mass 2 under -F_cr, so
     // Delta_1'' = (-1 - Delta_1) / 2 and Delta_1 = -1 + 1.1 cos(t / sqrt 2)
     // reaches 0 at t1 = sqrt 2 arccos(1 / 1.1); the wall sends the pair
@@ -305,7 +305,7 @@ fn a_resting_block_releases_when_its_neighbour_pulls_hard_enough() {
 #[test]
 fn a_chain_of_one_unit_is_the_single_mechanism() {
     // One unit against the wall under F = eta F_cr is the mechanism of
-    // PHYSICS.md s.2 (omega^2 = k / m, strain = gap / (F_cr / k)): its
+    // docs/physics.md s.2 (omega^2 = k / m, strain = gap / (F_cr / k)): its
     // impacts must come at the closed form's times, to t = 200.
     use flicker::models::mechanism::{ExactOrbit, Mechanism};
     for (eta, strain, rate) in [(1.2, 0.5, 0.0), (0.8, 0.1, 0.3), (1.5, 0.0, 0.2)] {

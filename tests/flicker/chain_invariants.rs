@@ -57,7 +57,7 @@ proptest! {
         // Relative to the initial energy, which may be tiny (a unit
         // chattering near rest); round-off is relative to the depth of the
         // load's potential well, N k f^2 / 2 with f = (F - F_cr) / k (as the
-        // mechanism's scale (eta - 1)^2 / 2 in PHYSICS.md s.2).
+        // mechanism's scale (eta - 1)^2 / 2 in docs/physics.md s.2).
         let f = (chain.load - chain.critical_load) / chain.stiffness;
         let well = chain.units as f64 * chain.stiffness * f * f / 2.0;
         let e0 = o.energy_initial.unwrap().abs();

@@ -1,6 +1,6 @@
 //! `flicker compare-models`: the chain at several N and the continuum on
 //! one release, sampled alike; the paper's continuum found where
-//! PHYSICS.md s.6 says it is (a front at exactly c_b; in the traction-free
+//! docs/physics.md s.6 says it is (a front at exactly c_b; in the traction-free
 //! reading an end that moves too slowly), and scenes it cannot compare
 //! refused.
 

@@ -133,7 +133,7 @@ fn the_classical_string_agrees_with_the_characteristic_lattice() {
 
 #[test]
 fn the_paper_release_is_a_front_at_the_wave_speed_then_one_impact_at_the_wall() {
-    // PHYSICS.md s.6, eta -> 1: eps = 0.1 at rest ahead of a front at
+    // docs/physics.md s.6, eta -> 1: eps = 0.1 at rest ahead of a front at
     // x = 1 - t, eps = 0 and v = -0.1 behind it; at t = 2 the whole shut
     // string strikes the wall and bounces (v -> +0.1, (A.12)), and a front
     // leaves the wall restoring eps = 0.1 at rest.

@@ -1,7 +1,7 @@
-//! The strain formulation against the closed form of PHYSICS.md s.2: impact
-//! counts exact, states to 1e-9 (1e-8 after 10^7 impacts), energy to 1e-12,
-//! and every regime ending cleanly: loose, impacting, grazing, chattering,
-//! resting.
+//! The strain formulation against the closed form of docs/physics.md s.2:
+//! impact counts exact, states to 1e-9 (1e-8 after 10^7 impacts), energy
+//! to 1e-12, and every regime ending cleanly: loose, impacting, grazing,
+//! chattering, resting.
 
 use flicker::engine::{Options, Recorder, Status, simulate};
 use flicker::models::mechanism::strain::{FLIGHT, RESTING};

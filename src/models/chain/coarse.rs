@@ -1,4 +1,4 @@
-//! Coarse-grained fields of a chain (PHYSICS.md s.6): the averages over
+//! Coarse-grained fields of a chain (docs/physics.md s.6): the averages over
 //! many units that stay reproducible past the chaos horizon, and by which a
 //! chain is compared with a continuum.
 //!

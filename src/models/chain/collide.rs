@@ -1,4 +1,4 @@
-//! Simultaneous impacts (PHYSICS.md s.4): every shut unit that is closing
+//! Simultaneous impacts (docs/physics.md s.4): every shut unit that is closing
 //! swaps its two nodes' velocities (unit 1 flips node 1's against the wall),
 //! again and again until no shut unit closes. With equal masses each swap
 //! puts one pair of a packed block in order, so the result is the sorted

@@ -1,4 +1,4 @@
-//! A chain of N mechanisms (PHYSICS.md s.4; paper (54)-(55)), as hybrid
+//! A chain of N mechanisms (docs/physics.md s.4; paper (54)-(55)), as hybrid
 //! models on the generic engine.
 //!
 //! Nodes `y_0 = 0` (fixed) to `y_N`; unit `n` joins nodes `n - 1` and `n`
@@ -31,7 +31,7 @@ pub mod taylor;
 pub use modal::modal;
 pub use taylor::TaylorChain;
 
-/// The chain's parameters, in the scene units of PHYSICS.md s.4 or any.
+/// The chain's parameters, in the scene units of docs/physics.md s.4 or any.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Chain {
     pub units: usize,
@@ -73,7 +73,7 @@ impl Chain {
         }
     }
 
-    /// The chain of PHYSICS.md s.4's scene units: length `length`, wave
+    /// The chain of docs/physics.md s.4's scene units: length `length`, wave
     /// speed `c`, so `m = L / N`, `F_cr = c^2`, `k = F_cr N / L`, end load
     /// `eta F_cr`.
     pub fn in_scene_units(
@@ -97,7 +97,7 @@ impl Chain {
 
     /// The state with every unit at `strain`, at rest: the homogeneous
     /// static deformation (Cauchy-Born) a release starts from. The unit
-    /// length `2 l` is `critical_load / stiffness` (PHYSICS.md s.4).
+    /// length `2 l` is `critical_load / stiffness` (docs/physics.md s.4).
     pub fn homogeneous(&self, strain: f64) -> Vec<f64> {
         let delta = strain * self.unit_length();
         let positions = (1..=self.units).map(|n| delta * n as f64);

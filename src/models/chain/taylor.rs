@@ -39,18 +39,17 @@
 //! costs O(K D) whatever N is, and only the `2D + 1` guards within the
 //! reach are re-predicted (those proven open to the window's end at once).
 //!
-//! Resting contact (PHYSICS.md s.4): a shut unit is pushed shut only at the
-//! loaded end with `F < F_cr` (inside, `Delta_n'' = omega^2 (Delta_{n+1} +
-//! Delta_{n-1}) >= 0` at a shut unit), so units resting shut form one end
-//! block `a..=N` whose nodes `a - 1..=N` move as a rigid body; the series
-//! recursion gives them the block's acceleration. Its contact force is
-//! least in unit `a`; a `release` guard watches it and frees unit `a` when
-//! it would pull. An impact reaching the block breaks it up, and the end
-//! may come to rest again at once; units chattering shut at the end faster
-//! than the run can resolve are settled into it when the engine's Zeno
-//! watch asks. Contact forces within round-off of zero count as zero both
-//! ways, so a unit on the edge is neither captured nor released over and
-//! over.
+//! Resting contact (docs/physics.md s.4): a shut unit is pushed shut only at
+//! the loaded end with `F < F_cr` (inside, `Delta_n'' = omega^2 (Delta_{n+1} +
+//! Delta_{n-1}) >= 0` at a shut unit), so units resting shut form one end block
+//! `a..=N` whose nodes `a - 1..=N` move as a rigid body; the series recursion
+//! gives them the block's acceleration. Its contact force is least in unit `a`;
+//! a `release` guard watches it and frees unit `a` when it would pull. An
+//! impact reaching the block breaks it up, and the end may come to rest again
+//! at once; units chattering shut at the end faster than the run can resolve
+//! are settled into it when the engine's Zeno watch asks. Contact forces within
+//! round-off of zero count as zero both ways, so a unit on the edge is neither
+//! captured nor released over and over.
 
 use crate::engine::taylor::{integral, search_fall};
 use crate::engine::{Direction, Fired, Guard, LocalModel};
@@ -513,7 +512,7 @@ impl TaylorChain {
     }
 
     /// If units at the loaded end are shut, at no relative speed, and
-    /// pushed shut (PHYSICS.md s.4: resting contact), make them the end
+    /// pushed shut (docs/physics.md s.4: resting contact), make them the end
     /// block: their nodes then move as one. Works on the scratch window
     /// (order 0), which reaches the end; the block stays inside
     /// `r_lo + 1..` (or starts at the wall) so that it is re-expanded.

@@ -471,7 +471,7 @@ impl StringModel for FrontTracking {
         self.momentum_initial + self.string.end_force() * t + self.wall_given_until(t)
     }
 
-    /// The coarse-grained fields of PHYSICS.md s.6 at window centres
+    /// The coarse-grained fields of docs/physics.md s.6 at window centres
     /// `centres` and time `t`, by exact integrals over the pieces: windows
     /// of [`WINDOW_WIDTH`] clipped at the ends; mean strain and velocity;
     /// hidden energy = the window's energy less that of its means, per unit

@@ -100,7 +100,7 @@ mod tests {
 
     #[test]
     fn the_free_end_shock_of_the_release_keeps_its_jump_conditions() {
-        // PHYSICS.md s.6, traction-free: eps 0.1 at rest, force 1.1; the
+        // docs/physics.md s.6, traction-free: eps 0.1 at rest, force 1.1; the
         // end carries nothing. Worked by hand from the same law: a front at
         // about 4.7 c_b, the end at about -0.235.
         let ahead = [0.1, 0.0, 0.1 + 0.005];

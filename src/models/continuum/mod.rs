@@ -1,6 +1,6 @@
-//! The continuum limit of the chain (PHYSICS.md s.5; paper (58)-(86)): the
+//! The continuum limit of the chain (docs/physics.md s.5; paper (58)-(86)): the
 //! incompressible string, `y_tt = c^2 y_xx` with the strain `eps = y_x >= 0`,
-//! in the scene units of PHYSICS.md s.4 (`rho = 1`, `F_cr = c^2`).
+//! in the scene units of docs/physics.md s.4 (`rho = 1`, `F_cr = c^2`).
 //!
 //! The string lies on `x in [-L/2, L/2]`: the wall holds `y = 0` at
 //! `x = -L/2`, the load acts at `x = L/2`. A state is a [`Piece`], a
@@ -41,7 +41,7 @@ pub trait StringModel: LocalModel {
     /// The initial momentum plus what the end force and the wall have
     /// given since: what [`StringModel::momentum`] must equal.
     fn momentum_by_impulses(&self, t: Time) -> f64;
-    /// The coarse-grained fields of PHYSICS.md s.6 at window centres.
+    /// The coarse-grained fields of docs/physics.md s.6 at window centres.
     fn coarse(&self, centres: &[f64], t: Time) -> Coarse;
     /// The loaded end's displacement.
     fn right_end(&self, t: Time) -> f64 {

@@ -1,5 +1,5 @@
 //! The equation of state of a rattling string, from the single mechanism's
-//! closed form (PHYSICS.md s.2): what a unit does on average when it
+//! closed form (docs/physics.md s.2): what a unit does on average when it
 //! carries an axial force `sigma = eta F_cr` and holds an energy it cannot
 //! show as mean motion.
 //!

@@ -1,5 +1,5 @@
 //! The mechanism in the angle formulation: the smooth equation (8) in
-//! `theta`, integrated numerically (PHYSICS.md s.3).
+//! `theta`, integrated numerically (docs/physics.md s.3).
 //!
 //! `theta'' = [-omega^2 (sec theta - eta) - theta'^2 (1 + sin^2 theta) / cos^3 theta]
 //!            * cos^2 theta / sin theta`

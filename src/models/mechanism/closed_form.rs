@@ -1,4 +1,4 @@
-//! The single bistable mechanism in closed form (PHYSICS.md s.2; paper
+//! The single bistable mechanism in closed form (docs/physics.md s.2; paper
 //! (32), (45)-(47)).
 //!
 //! Between impacts the strain is a linear oscillator about `eta - 1`:

@@ -1,6 +1,6 @@
 //! The mechanism in the strain formulation: a hybrid automaton with the exact
 //! flow of the linear oscillator, the guard `eps = 0` while closing, and the
-//! elastic reset `eps' -> -eps'` (PHYSICS.md s.2).
+//! elastic reset `eps' -> -eps'` (docs/physics.md s.2).
 //!
 //! Below the critical load (`eta < 1`) the trivial state is stable and sits
 //! on the constraint: orbits with small energy chatter against it, and the
