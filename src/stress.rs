@@ -19,32 +19,86 @@ use crate::scene::{self, Formulation, Scene, SceneError};
 pub const TOLERANCE: f64 = 1e-9;
 /// Stormer-Verlet's step in the suite, as a fraction of the period.
 pub const STEP_FRACTION: f64 = 1.0 / 200.0;
-/// A zeno run is verified if it settles this close to the exact state.
-const SETTLED_TOLERANCE: f64 = 1e-6;
 
 /// How one run of one method on one case ended.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Verdict {
-    /// Same events as the exact answer (or the same Zeno point), with this
-    /// final-state error.
-    Passed { final_error: f64 },
+    /// The exact answer's events (or the same Zeno point), with the final
+    /// state and every event time within the bounds the run stated.
+    Passed,
     /// The run said it could not be trusted, and why.
     Failed { reason: String },
-    /// A numerical run that completed with a different event count than the
-    /// exact answer: accumulated integration error, which its summary states
-    /// (`error_bound`). Only long runs may drift.
+    /// The exact answer's events, but a final state or an event time
+    /// further off than the run's own bound: the bound was wrong.
     Drifted { why: String },
     /// A different answer given without complaint.
     Wrong { why: String },
 }
 
+/// One run measured against the exact answer: what [`classify`] judges.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Measured {
+    pub status: Status,
+    pub reason: Option<String>,
+    /// Events logged (impacts), and the exact answer's count.
+    pub events: u64,
+    pub reference_events: u64,
+    /// Largest difference of a final state component from the exact one.
+    pub final_error: f64,
+    /// Largest difference of an event time from the exact one, over the
+    /// events both have.
+    pub time_error: Option<f64>,
+    /// The bounds the run stated (`error_bound`, `event_time_bound`).
+    pub error_bound: f64,
+    pub event_time_bound: Option<f64>,
+}
+
+/// The verdict on a run: `passed` only if its errors are within the bounds
+/// it stated itself, `failed` if it said it could not be trusted,
+/// `drifted` if it kept the exact answer's events but not its own bounds,
+/// `wrong` if it completed with other events.
+pub fn classify(m: &Measured) -> Verdict {
+    if matches!(m.status, Status::Failed | Status::Interrupted) {
+        return Verdict::Failed {
+            reason: m.reason.clone().unwrap_or_default(),
+        };
+    }
+    // A Zeno run settles after the events it can resolve; the exact
+    // answer counts them on (for chattering, without end).
+    if m.status != Status::Zeno && m.events != m.reference_events {
+        return Verdict::Wrong {
+            why: format!(
+                "{} events where the exact answer has {}",
+                m.events, m.reference_events
+            ),
+        };
+    }
+    if !(m.final_error <= m.error_bound) {
+        return Verdict::Drifted {
+            why: format!(
+                "final state {:.1e} off, beyond its stated bound {:.1e}",
+                m.final_error, m.error_bound
+            ),
+        };
+    }
+    match (m.time_error, m.event_time_bound) {
+        (Some(e), Some(bound)) if !(e <= bound) => Verdict::Drifted {
+            why: format!("an event time {e:.1e} off, beyond its stated bound {bound:.1e}"),
+        },
+        (Some(_), None) => Verdict::Drifted {
+            why: "the run states no bound on its event times".into(),
+        },
+        _ => Verdict::Passed,
+    }
+}
+
+/// One run of the table.
 #[derive(Debug, Clone)]
 pub struct Row {
     pub case: String,
     pub method: String,
     pub verdict: Verdict,
-    pub events: u64,
-    pub reference_events: u64,
+    pub measured: Measured,
     pub energy_error: Option<f64>,
     pub wall_seconds: f64,
 }
@@ -121,67 +175,164 @@ pub fn run_case(
     let report = runner::run(&scene, &control, &mut times)?;
     let wall = start.elapsed().as_secs_f64();
     let o = &report.outcome;
-    let final_error = report
-        .final_state
-        .iter()
-        .zip(&reference.final_state)
-        .map(|((_, a), b)| (a - b).abs())
-        .fold(0.0, f64::max);
-    let verdict = match (o.status, &o.reason) {
-        (Status::Failed | Status::Interrupted, reason) => Verdict::Failed {
-            reason: reason.clone().unwrap_or_default(),
-        },
-        (Status::Zeno, _) if final_error <= SETTLED_TOLERANCE => Verdict::Passed { final_error },
-        (Status::Zeno, _) => Verdict::Wrong {
-            why: format!("settled {final_error:.1e} away from the exact state"),
-        },
-        _ if times.0.len() as u64 != reference.events && o.error_bound > 0.0 => Verdict::Drifted {
-            why: format!(
-                "{} events where the exact answer has {}; the run's integration error bound is {:.1e}",
-                times.0.len(),
-                reference.events,
-                o.error_bound
-            ),
-        },
-        _ if times.0.len() as u64 != reference.events => Verdict::Wrong {
-            why: format!(
-                "{} events where the exact answer has {}",
-                times.0.len(),
-                reference.events
-            ),
-        },
-        _ => Verdict::Passed { final_error },
+    let measured = Measured {
+        status: o.status,
+        reason: o.reason.clone(),
+        events: times.0.len() as u64,
+        reference_events: reference.events,
+        final_error: report
+            .final_state
+            .iter()
+            .zip(&reference.final_state)
+            .map(|((_, a), b)| (a - b).abs())
+            .fold(0.0, f64::max),
+        time_error: reference.largest_time_error(&times.0),
+        error_bound: o.error_bound,
+        event_time_bound: o.event_time_bound,
     };
     Ok(Row {
         case: case.to_string(),
         method: report.method.to_string(),
-        verdict,
-        events: o.events,
-        reference_events: reference.events,
+        verdict: classify(&measured),
+        measured,
         energy_error: o.max_energy_error,
         wall_seconds: wall,
     })
 }
 
-/// The table of outcomes, as Markdown.
+/// The table of outcomes, as Markdown: each run's errors beside the
+/// bounds it stated.
 pub fn markdown(rows: &[Row]) -> String {
     let mut text = String::from(
-        "| case | method | outcome | final error | energy error | events (exact) | wall s |\n|---|---|---|---|---|---|---|\n",
+        "| case | method | outcome | final error | error bound | event-time error | event-time bound | energy error | events (exact) | wall s |\n\
+         |---|---|---|---|---|---|---|---|---|---|\n",
     );
+    let number = |x: Option<f64>| x.map_or("-".into(), |e| format!("{e:.1e}"));
     for r in rows {
-        let (outcome, error) = match &r.verdict {
-            Verdict::Passed { final_error } => ("passed".to_string(), format!("{final_error:.1e}")),
-            Verdict::Failed { reason } => {
-                (format!("failed: {}", reason.replace('|', "/")), "-".into())
-            }
-            Verdict::Drifted { why } => (format!("drifted: {why}"), "-".into()),
-            Verdict::Wrong { why } => (format!("WRONG: {why}"), "-".into()),
+        let m = &r.measured;
+        let outcome = match &r.verdict {
+            Verdict::Passed => "passed".to_string(),
+            Verdict::Failed { reason } => format!("failed: {}", reason.replace('|', "/")),
+            Verdict::Drifted { why } => format!("DRIFTED: {why}"),
+            Verdict::Wrong { why } => format!("WRONG: {why}"),
         };
-        let energy = r.energy_error.map_or("-".into(), |e| format!("{e:.1e}"));
+        let reference = match m.reference_events {
+            u64::MAX => "unbounded".to_string(),
+            n => n.to_string(),
+        };
         text += &format!(
-            "| {} | {} | {} | {} | {} | {} ({}) | {:.2} |\n",
-            r.case, r.method, outcome, error, energy, r.events, r.reference_events, r.wall_seconds
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} ({}) | {:.2} |\n",
+            r.case,
+            r.method,
+            outcome,
+            number(Some(m.final_error)),
+            number(Some(m.error_bound)),
+            number(m.time_error),
+            number(m.event_time_bound),
+            number(r.energy_error),
+            m.events,
+            reference,
+            r.wall_seconds
         );
     }
     text
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A run that completed with the exact answer's 32 events, within its
+    /// bounds: each test below breaks one thing.
+    fn sound() -> Measured {
+        Measured {
+            status: Status::Completed,
+            reason: None,
+            events: 32,
+            reference_events: 32,
+            final_error: 1e-9,
+            time_error: Some(1e-8),
+            error_bound: 2e-9,
+            event_time_bound: Some(2e-8),
+        }
+    }
+
+    #[test]
+    fn a_run_within_its_bounds_passes() {
+        assert_eq!(classify(&sound()), Verdict::Passed);
+    }
+
+    #[test]
+    fn a_final_state_beyond_its_bound_drifted() {
+        let m = Measured {
+            final_error: 1.7e-4,
+            ..sound()
+        };
+        assert!(matches!(classify(&m), Verdict::Drifted { .. }));
+        let m = Measured {
+            final_error: f64::NAN,
+            ..sound()
+        };
+        assert!(matches!(classify(&m), Verdict::Drifted { .. }));
+    }
+
+    #[test]
+    fn a_shifted_event_time_drifted() {
+        let m = Measured {
+            time_error: Some(9.6e-4),
+            ..sound()
+        };
+        assert!(matches!(classify(&m), Verdict::Drifted { .. }));
+        let m = Measured {
+            event_time_bound: None,
+            ..sound()
+        };
+        assert!(matches!(classify(&m), Verdict::Drifted { .. }));
+    }
+
+    #[test]
+    fn a_dropped_or_extra_event_is_wrong_whatever_the_bounds() {
+        for events in [31, 33] {
+            let m = Measured {
+                events,
+                error_bound: f64::INFINITY,
+                event_time_bound: Some(f64::INFINITY),
+                ..sound()
+            };
+            assert!(matches!(classify(&m), Verdict::Wrong { .. }), "{events}");
+        }
+    }
+
+    #[test]
+    fn a_run_that_says_it_failed_is_failed_with_its_reason() {
+        let m = Measured {
+            status: Status::Failed,
+            reason: Some("grazes zero".into()),
+            events: 3,
+            final_error: 1.0,
+            ..sound()
+        };
+        assert_eq!(
+            classify(&m),
+            Verdict::Failed {
+                reason: "grazes zero".into()
+            }
+        );
+    }
+
+    #[test]
+    fn a_settled_zeno_run_is_judged_by_its_state_not_its_count() {
+        let settled = Measured {
+            status: Status::Zeno,
+            events: 10,
+            reference_events: u64::MAX,
+            ..sound()
+        };
+        assert_eq!(classify(&settled), Verdict::Passed);
+        let elsewhere = Measured {
+            final_error: 1e-3,
+            ..settled
+        };
+        assert!(matches!(classify(&elsewhere), Verdict::Drifted { .. }));
+    }
 }

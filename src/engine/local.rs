@@ -155,6 +155,7 @@ pub fn simulate_local<M: LocalModel + ?Sized, O: Observer + ?Sized>(
         final_state: Vec::new(),
         flow_evaluations: run.evaluations,
         error_bound: 0.0,
+        event_time_bound: None,
         wall_seconds: started.elapsed().as_secs_f64(),
     }
 }

@@ -5,6 +5,7 @@
 pub mod adaptive;
 pub mod dop853;
 pub mod dopri5;
+pub mod error_set;
 pub mod fused;
 pub mod integrator;
 pub mod linear;
@@ -14,6 +15,7 @@ pub mod model;
 pub mod observer;
 pub mod queue;
 pub mod simulation;
+pub mod tangent;
 pub mod taylor;
 pub mod verlet;
 pub mod zeno;

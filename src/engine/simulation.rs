@@ -23,12 +23,14 @@ use std::time::Instant;
 
 use crate::engine::adaptive::{StepFailure, Tolerances};
 use crate::engine::dop853::Crossing;
+use crate::engine::error_set::ErrorSet;
 use crate::engine::integrator::{Integrator, Method, Motion, motion};
 use crate::engine::locate::scan_step;
 use crate::engine::model::{Affects, Direction, HybridModel, Mode};
 use crate::engine::observer::{EventRecord, Observer, SETTLE};
 use crate::engine::queue::EventQueue;
-use crate::engine::zeno::ZenoWatch;
+use crate::engine::tangent::Tangents;
+use crate::engine::zeno::{self, ZenoWatch};
 use crate::time::Time;
 
 /// How to run a model.
@@ -113,10 +115,18 @@ pub struct Outcome {
     /// Evaluations of the flow: right-hand sides and propagators of
     /// numerical methods, flow maps and crossing times of exact ones.
     pub flow_evaluations: u64,
-    /// Sum of the local error estimates of numerical steps: what the state
-    /// error could have grown to if they all added up without amplification
-    /// (0 for exact flows). Phase errors of oscillations do add up so.
+    /// The largest error any state component may carry at the end: the
+    /// numerical steps' local errors carried through the flow and across
+    /// every event (see [`ErrorSet`]), plus a round-off allowance of
+    /// [`ROUNDOFF_ULPS`] ulps of the state's size per event. Above
+    /// [`TRACKED`](crate::engine::error_set::TRACKED) state components,
+    /// the plain sum of the local errors instead.
     pub error_bound: f64,
+    /// The largest error any event time may carry: each event's share of
+    /// the state error divided by its closing speed, plus a round-off
+    /// allowance of [`ROUNDOFF_ULPS`] ulps of the time reached; `None`
+    /// where the errors are not tracked.
+    pub event_time_bound: Option<f64>,
     pub wall_seconds: f64,
 }
 
@@ -185,13 +195,22 @@ struct Run<'m, M: HybridModel + ?Sized> {
     motions: Vec<Option<Motion>>,
     /// Flow maps and crossing times asked of exact flows.
     exact_evaluations: u64,
-    /// Sum of squared local error estimates of the numerical steps so far:
-    /// its root is the graze check's (optimistic) error scale.
-    error_squares: f64,
-    /// Sum of the local error estimates (see [`Outcome::error_bound`]).
-    error_sum: f64,
-    /// Guard sensitivities of a mode (see [`Run::measure_sensitivity`]).
-    sensitivity: (Option<Mode>, Vec<f64>),
+    /// The state errors the numerical steps may have left so far.
+    errors: ErrorSet,
+    tangents: Tangents,
+    /// Scratch: a tangent or saltation matrix, and a guard's gradient.
+    matrix: Vec<f64>,
+    gradient: Vec<f64>,
+    /// Gradients of a mode's affine guards (see [`Run::gradients`]).
+    affine_gradients: (Option<Mode>, Vec<f64>),
+    /// The largest event-time error so far, the last event's, and when the
+    /// last logged event fired.
+    event_time_bound: f64,
+    last_time_bound: f64,
+    last_event: Option<Time>,
+    /// The largest state component seen (initial state and events): the
+    /// round-off allowance's scale.
+    state_scale: f64,
     /// When the integrator's current step ends, for stepped modes.
     step_end: Option<Time>,
     /// Whether the integrator's last step starts at the current origin.
@@ -233,9 +252,15 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
             motion: Motion::Frozen,
             motions: Vec::new(),
             exact_evaluations: 0,
-            error_squares: 0.0,
-            error_sum: 0.0,
-            sensitivity: (None, Vec::new()),
+            errors: ErrorSet::new(n),
+            tangents: Tangents::new(n),
+            matrix: vec![0.0; n * n],
+            gradient: vec![0.0; n],
+            affine_gradients: (None, Vec::new()),
+            event_time_bound: 0.0,
+            last_time_bound: 0.0,
+            last_event: None,
+            state_scale: largest(x0),
             stepped: false,
             step_end: None,
             fresh: Some(None),
@@ -299,6 +324,7 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
                     self.fire(slot, t, observer)
                 }
                 (None, t) => {
+                    self.close_segment(t.since(self.origin));
                     self.integrator.end(&mut self.state);
                     self.origin = t;
                     self.start_segment()
@@ -357,6 +383,7 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
         let mut before = std::mem::take(&mut self.before);
         self.state_at(t.since(self.origin), &mut before);
         let t = self.sharpen(slot, t, &mut before);
+        self.close_segment(t.since(self.origin));
         self.after.copy_from_slice(&before);
         let jump = model.reset(mode, slot, &mut self.after);
         let recorded = if !all_finite(&before) || !all_finite(&self.after) {
@@ -367,6 +394,8 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
                 before,
                 self.after
             )))
+        } else if let Err(end) = self.carry_errors(slot, t, &before, jump.mode) {
+            Err(end)
         } else if guard.internal {
             Ok(())
         } else {
@@ -542,6 +571,14 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
             });
         };
         let before = std::mem::take(&mut self.state);
+        // The resting state stands in for an orbit it is not exactly on:
+        // the jump to it is an error the run carries on.
+        let jump = before
+            .iter()
+            .zip(&self.after)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        self.errors.widen(jump);
         self.settles += 1;
         let recorded = self.record(SETTLE, t, rest, &before, (None, None), observer);
         self.state = before;
@@ -585,13 +622,9 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
                     return Err(self.step_failed(failure));
                 }
                 let local = self.integrator.local_error();
-                self.error_squares += local * local;
-                self.error_sum += local;
                 let h = self.integrator.h();
                 let interpolant = self.integrator.interpolant();
-                let bound = self.error_squares.sqrt();
-                self.measure_sensitivity();
-                let sensitivity = std::mem::take(&mut self.sensitivity.1);
+                let n = self.state.len();
                 for (g, guard) in guards.iter().enumerate() {
                     let check_start = fresh.is_some_and(|fired| {
                         if fired == Some(g) {
@@ -600,12 +633,16 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
                             model.guard(mode, g, &self.state) == 0.0
                         }
                     });
-                    let (step, x) = (&self.integrator, &mut self.before);
+                    // What the errors so far, and this step's, may shift the
+                    // guard by.
                     let uncertainty = if guard.internal {
                         0.0
                     } else {
-                        sensitivity[g] * bound
+                        self.gradient_of(g);
+                        self.errors.along(&self.gradient)
+                            + self.gradient.iter().map(|d| d.abs()).sum::<f64>() * local
                     };
+                    let (step, x) = (&self.integrator, &mut self.before[..n]);
                     let scan = scan_step(guard, check_start, interpolant, uncertainty, |s| {
                         step.eval(s * h, x);
                         model.guard(mode, g, x)
@@ -617,7 +654,6 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
                         self.queue.schedule(g, self.origin.after(s * h));
                     }
                 }
-                self.sensitivity.1 = sensitivity;
                 self.step_end = Some(self.origin.after(h));
                 Ok(())
             }
@@ -642,30 +678,135 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
         Ok(decided)
     }
 
-    /// For each guard of the current mode, how much it can change when each
-    /// state component changes by one: `sum |dg/dx_i|`, exact for affine
-    /// guards. Times the integration error bound (root-sum-square of the
-    /// local error estimates, as if independent) it says how far the guard
-    /// may be off. Kept until the mode changes.
-    fn measure_sensitivity(&mut self) {
-        let (model, mode) = (self.model, self.mode);
-        if self.sensitivity.0 != Some(mode) {
-            let mut x = self.state.clone();
-            let values = (0..model.guards(mode).len())
-                .map(|g| {
-                    let base = model.guard(mode, g, &x);
-                    (0..x.len())
-                        .map(|i| {
-                            x[i] += 1.0;
-                            let change = (model.guard(mode, g, &x) - base).abs();
-                            x[i] = self.state[i];
-                            change
-                        })
-                        .sum()
-                })
-                .collect();
-            self.sensitivity = (Some(mode), values);
+    /// The gradient of guard `g` of the current mode at the current state,
+    /// into `self.gradient`: computed once per mode for affine guards, at
+    /// every segment for the others.
+    fn gradient_of(&mut self, g: usize) {
+        let (model, mode, n) = (self.model, self.mode, self.state.len());
+        if !model.guards(mode)[g].affine {
+            self.tangents
+                .gradient(model, mode, g, &self.state, &mut self.gradient);
+            return;
         }
+        if self.affine_gradients.0 != Some(mode) {
+            let guards = model.guards(mode).len();
+            let mut all = vec![0.0; guards * n];
+            for (g, row) in all.chunks_mut(n).enumerate() {
+                self.tangents.gradient(model, mode, g, &self.state, row);
+            }
+            self.affine_gradients = (Some(mode), all);
+        }
+        self.gradient
+            .copy_from_slice(&self.affine_gradients.1[g * n..(g + 1) * n]);
+    }
+
+    /// Carry the state errors over the `tau` of the current segment that
+    /// has passed: along the flow's tangent, with a numerical step's local
+    /// error added. Nothing to do while the run has made no error.
+    fn close_segment(&mut self, tau: f64) {
+        let (model, mode) = (self.model, self.mode);
+        match self.motion {
+            Motion::Stepped if self.stepped => {
+                // The part of the step passed leaves its share of the local
+                // error (none for an event at the step's start).
+                let h = self.integrator.h();
+                let local = self.integrator.local_error() * (tau / h).min(1.0);
+                if self.errors.tracked() {
+                    let step = &self.integrator;
+                    self.tangents
+                        .ode(model, mode, tau, |s, x| step.eval(s, x), &mut self.matrix);
+                }
+                self.errors.map(&self.matrix, local);
+            }
+            Motion::Exact if self.errors.tracked() && !self.errors.is_empty() => {
+                self.tangents
+                    .exact(model, mode, &self.state, tau, &mut self.matrix);
+                self.errors.map(&self.matrix, 0.0);
+            }
+            _ => {}
+        }
+    }
+
+    /// Carry the state errors across the event of guard `slot` at `t`
+    /// (state `before`, `self.after` after the reset, in `mode_after`) by
+    /// its saltation matrix, and bound the event's time. A run whose error
+    /// leaves an event's time uncertain by half the interval since the
+    /// previous event can no longer tell the events' order or count, and
+    /// stops; so does one that meets an event at zero closing speed (a
+    /// graze) with an error it cannot carry across.
+    fn carry_errors(
+        &mut self,
+        slot: usize,
+        t: Time,
+        before: &[f64],
+        mode_after: Mode,
+    ) -> Result<(), End> {
+        let (model, mode) = (self.model, self.mode);
+        let guard = model.guards(mode)[slot];
+        if !guard.internal {
+            self.state_scale = self
+                .state_scale
+                .max(largest(before))
+                .max(largest(&self.after));
+        }
+        if !self.errors.tracked() || self.errors.is_empty() {
+            return Ok(());
+        }
+        self.tangents
+            .gradient(model, mode, slot, before, &mut self.gradient);
+        let along = self.errors.along(&self.gradient);
+        let closing = self.tangents.saltation(
+            model,
+            mode,
+            slot,
+            before,
+            &self.gradient,
+            mode_after,
+            &self.after,
+            &mut self.matrix,
+        );
+        let shift = along / closing.abs();
+        let since = self.last_event.map(|last| t.since(last));
+        // Events closer than the run can resolve are the Zeno watch's to
+        // judge (it settles them or stops), not the error bound's: their
+        // order and any state at them are equally unresolvable.
+        let resolution = zeno::resolution(t.value(), self.options.t_end);
+        if since.is_some_and(|since| since <= resolution) {
+            if self.matrix.iter().all(|m| m.is_finite()) {
+                self.errors.map(&self.matrix, 0.0);
+            }
+            return Ok(());
+        }
+        if !guard.internal {
+            self.last_event = Some(t);
+            self.last_time_bound = shift;
+            self.event_time_bound = self.event_time_bound.max(shift);
+        }
+        if !shift.is_finite() {
+            return Err(End::failed(format!(
+                "the `{}` event at t = {} comes at zero closing speed (a graze) with an integration \
+                 error of {along:.2e} in its guard: whether and when it fires cannot be told, so {} \
+                 cannot be trusted past here; tighten the method or use an exact one",
+                guard.name,
+                t.value(),
+                self.integrator.name()
+            )));
+        }
+        if let Some(since) = since.filter(|since| !guard.internal && shift > 0.5 * since) {
+            return Err(End::failed(format!(
+                "the `{}` event at t = {} may be off by {shift:.2e} in time (its guard by {along:.2e}, \
+                 closing at {:.2e}), more than half the {since:.3e} since the previous event: the \
+                 integration error so far ({:.2e} in the state) leaves the events' order and count \
+                 uncertain, so {} cannot be trusted past here; tighten the method or use an exact one",
+                guard.name,
+                t.value(),
+                closing.abs(),
+                self.errors.state_bound(),
+                self.integrator.name()
+            )));
+        }
+        self.errors.map(&self.matrix, 0.0);
+        Ok(())
     }
 
     /// A graze or near miss closer than the integration error can resolve.
@@ -745,6 +886,25 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
     }
 
     fn finish_at(&mut self, t: Time) -> End {
+        self.close_segment(t.since(self.origin));
+        // An event within its time error of the end may or may not belong
+        // to the run: its count and final state are then uncertain.
+        let next = self.queue.peek().map(|(_, next)| next.since(t));
+        let around = [self.last_event.map(|last| t.since(last)), next];
+        if self.last_time_bound > 0.0
+            && let Some(gap) = around
+                .into_iter()
+                .flatten()
+                .find(|gap| *gap <= self.last_time_bound)
+        {
+            return End::failed(format!(
+                "an event lies {gap:.2e} from t_end = {}, within the time error of the events \
+                 ({:.2e}): whether it happens before the end is uncertain, so the final state cannot \
+                 be trusted; tighten the method or move t_end",
+                t.value(),
+                self.last_time_bound
+            ));
+        }
         let mut x = std::mem::take(&mut self.before);
         self.state_at(t.since(self.origin), &mut x);
         self.state.copy_from_slice(&x);
@@ -760,6 +920,13 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
                 reason: None,
             },
         }
+    }
+
+    /// The round-off allowance of the state: [`ROUNDOFF_ULPS`] ulps of its
+    /// size per event and at the start. An estimate of how round-off grows
+    /// (linearly, as in an exact run over 10^7 impacts), not a bound.
+    fn roundoff(&self) -> f64 {
+        ROUNDOFF_ULPS * f64::EPSILON * self.state_scale * (1 + self.events) as f64
     }
 
     fn outcome(self, end: End) -> Outcome {
@@ -780,6 +947,10 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
         if run.settles > 0 {
             events_by_guard.insert(SETTLE, run.settles);
         }
+        let error_bound = run.errors.state_bound() + run.roundoff();
+        let event_time_bound = run.errors.tracked().then(|| {
+            run.event_time_bound + ROUNDOFF_ULPS * f64::EPSILON * run.origin.value().abs()
+        });
         Outcome {
             zeno: end.status == Status::Zeno || run.zeno_reason.is_some(),
             status: end.status,
@@ -796,17 +967,26 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
             final_state_names: model.state_names(run.mode).to_vec(),
             final_state: run.state,
             flow_evaluations: run.integrator.evaluations() + run.exact_evaluations,
-            error_bound: run.error_sum,
+            error_bound,
+            event_time_bound,
             wall_seconds: run.started.elapsed().as_secs_f64(),
         }
     }
 }
+
+/// Round-off allowed per event, in ulps of the state's size (and of the
+/// time's for event times); see [`Outcome::error_bound`].
+pub const ROUNDOFF_ULPS: f64 = 16.0;
 
 /// Turns of the loop between two progress reports.
 const PROGRESS_EVERY: u64 = 1 << 14;
 
 /// Events between two projections of the event budget.
 const BUDGET_CHECK: u64 = 1 << 20;
+
+fn largest(x: &[f64]) -> f64 {
+    x.iter().fold(0.0, |m: f64, v| m.max(v.abs()))
+}
 
 fn all_finite(x: &[f64]) -> bool {
     x.iter().all(|v| v.is_finite())

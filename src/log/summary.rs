@@ -5,7 +5,9 @@
 //! `scene`, `events`, `events_by_guard`, `t_end`, `t_reached`,
 //! `energy_initial`, `energy_final`, `max_energy_error` (relative, against
 //! the model's energy scale), `final_state` (named components), `final_mode`,
-//! `zeno`, `flow_evaluations`, `error_bound`, `wall_seconds`, `log` (path of the event log or
+//! `zeno`, `flow_evaluations`, `error_bound` (the largest error a state
+//! component may carry), `event_time_bound` (the same for event times, null
+//! where not tracked), `wall_seconds`, `log` (path of the event log or
 //! null); for chains, `momentum` (total, at the end) and
 //! `momentum_balance_error` (against the end load's and the wall's
 //! impulses, relative; exact path only), null for other models.
@@ -44,6 +46,7 @@ pub fn summary(report: &Report, model: &str, scene: &Path, log: Option<&Path>) -
         "zeno": o.zeno,
         "flow_evaluations": o.flow_evaluations,
         "error_bound": o.error_bound,
+        "event_time_bound": o.event_time_bound,
         "wall_seconds": o.wall_seconds,
         "log": log.map(|p| p.display().to_string()),
         "momentum": report.fields.as_ref().map(|c| c.momentum),

@@ -319,7 +319,10 @@ fn combine(mut a: Outcome, b: Outcome) -> Outcome {
         energy_final: b.energy_final,
         final_state: b.final_state,
         flow_evaluations: a.flow_evaluations + b.flow_evaluations,
+        // Each leg starts its error set afresh, so neither the sum nor an
+        // event-time bound carries the first leg's error through the second.
         error_bound: a.error_bound + b.error_bound,
+        event_time_bound: None,
         wall_seconds: a.wall_seconds + b.wall_seconds,
         ..a
     }

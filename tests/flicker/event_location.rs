@@ -2,9 +2,10 @@
 //! enters and leaves inside a single step.
 
 use flicker::engine::{
-    Direction, Flow, Guard, HybridModel, Jump, Mode, Options, Recorder, Status, Tolerances,
-    simulate,
+    Direction, Flow, Guard, HybridModel, Jump, Method, Mode, Options, Outcome, Recorder, Status,
+    Tolerances, simulate,
 };
+use proptest::prelude::*;
 
 /// A harmonic oscillator `x'' = -x` whose guard `x = level` is reached only
 /// briefly near each crest: with a loose tolerance the integrator takes a
@@ -44,42 +45,104 @@ impl HybridModel for Crest {
     }
 }
 
-#[test]
-fn a_crossing_in_and_out_within_one_step_is_found() {
-    let model = Crest { level: 0.999 };
-    let mut options = Options::until(20.0 * std::f64::consts::TAU);
-    options.tolerances = Tolerances {
-        rtol: 1e-5,
-        atol: 1e-5,
-    };
+/// The exact rising crossings of `x = level` by `x = cos(t + phase)` in
+/// `(0, t_end]`: `t + phase = 2 pi k - acos(level)`.
+fn crest_times(level: f64, phase: f64, t_end: f64) -> Vec<f64> {
+    let (tau, dip) = (std::f64::consts::TAU, level.acos());
+    (0..)
+        .map(|k| k as f64 * tau - dip - phase)
+        .skip_while(|t| *t <= 0.0)
+        .take_while(|t| *t <= t_end)
+        .collect()
+}
+
+/// Run the crest model from phase `phase` with `method`; the outcome and
+/// the event times.
+fn run_crest(level: f64, phase: f64, method: Method, periods: f64) -> (Outcome, Vec<f64>) {
+    let model = Crest { level };
+    let mut options = Options::until(periods * std::f64::consts::TAU);
+    options.method = method;
     let mut log = Recorder::default();
-    let outcome = simulate(&model, 0, &[1.0, 0.0], &options, &mut log);
-    assert_eq!(outcome.status, Status::Completed);
-    // Rising crossings of x = 0.999 happen just before each crest at t = 2 pi k.
-    assert_eq!(
-        log.events.len(),
-        20,
-        "times {:?}",
-        log.events.iter().map(|e| e.t).collect::<Vec<_>>()
-    );
-    let dip = (0.999f64).acos();
-    for (k, e) in log.events.iter().enumerate() {
-        let exact = (k + 1) as f64 * std::f64::consts::TAU - dip;
-        // At rtol 1e-5 the amplitude drifts by ~1e-4 over these periods; the
-        // guard's slope at the crossing is sqrt(1 - 0.999^2) = 0.045, so the
-        // time may move by ~2e-3.
+    let outcome = simulate(&model, 0, &[phase.cos(), -phase.sin()], &options, &mut log);
+    (outcome, log.events.iter().map(|e| e.t).collect())
+}
+
+/// A completed run found exactly the crossings of the exact solution, each
+/// within the event-time bound the run stated.
+fn assert_exact_crossings(outcome: &Outcome, times: &[f64], exact: &[f64]) {
+    assert_eq!(times.len(), exact.len(), "times {times:?}, exact {exact:?}");
+    let bound = outcome
+        .event_time_bound
+        .expect("a 2-state run states its event-time bound");
+    for (k, (t, want)) in times.iter().zip(exact).enumerate() {
         assert!(
-            (e.t - exact).abs() < 1e-2,
-            "event {k} at {} not {exact}",
-            e.t
+            (t - want).abs() <= bound,
+            "crossing {k} at {t}, exact {want}: off by {:.2e}, stated bound {bound:.2e}",
+            (t - want).abs()
         );
     }
-    // The test is only meaningful if steps really straddle the crests: the
-    // time above the level, 2 acos(0.999) = 0.09 per period, must be far
-    // shorter than a typical step.
+}
+
+#[test]
+fn a_crossing_in_and_out_within_one_step_is_found() {
+    let level = 0.998;
+    let tol = Tolerances {
+        rtol: 1e-6,
+        atol: 1e-6,
+    };
+    let (outcome, times) = run_crest(level, 0.0, Method::Dopri5(tol), 20.0);
+    assert_eq!(outcome.status, Status::Completed, "{:?}", outcome.reason);
+    assert_exact_crossings(&outcome, &times, &crest_times(level, 0.0, outcome.t_end));
+    assert_eq!(times.len(), 20);
+    // The test is only meaningful if steps straddle the crests: the time
+    // above the level, 2 acos(0.998) = 0.126 per period, must be well below
+    // a typical step (at most 26 steps per period: 0.24).
     let steps_per_period = outcome.flow_evaluations as f64 / 6.0 / 20.0;
     assert!(
-        steps_per_period < 20.0,
+        steps_per_period < 26.0,
         "{steps_per_period} steps per period"
     );
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig {
+        cases: 64,
+        rng_seed: proptest::test_runner::RngSeed::Fixed(20261125),
+        ..ProptestConfig::default()
+    })]
+
+    /// Over crest heights down to a near graze, tolerances and phases, each
+    /// embedded pair either finds exactly the exact solution's crossings,
+    /// each within its stated time bound, or says that it cannot tell.
+    #[test]
+    fn no_crossing_is_missed_or_misplaced_without_a_word(
+        depth in -7.0f64..-2.0,
+        log_tol in -11.0f64..-5.0,
+        phase in 0.0f64..std::f64::consts::TAU,
+        pair in 0..2usize,
+    ) {
+        let level = 1.0 - 10f64.powf(depth);
+        let tol = Tolerances { rtol: 10f64.powf(log_tol), atol: 10f64.powf(log_tol) };
+        let method = [Method::Dopri5(tol), Method::Dop853(tol)][pair];
+        let (outcome, times) = run_crest(level, phase, method, 10.0);
+        match outcome.status {
+            Status::Completed => {
+                assert_exact_crossings(&outcome, &times, &crest_times(level, phase, outcome.t_end));
+                // The final state is within the stated bound too.
+                let t = outcome.t_end + phase;
+                let exact = [t.cos(), -t.sin()];
+                for (x, want) in outcome.final_state.iter().zip(exact) {
+                    prop_assert!((x - want).abs() <= outcome.error_bound, "{x} vs {want}, bound {}", outcome.error_bound);
+                }
+            }
+            Status::Failed => {
+                let reason = outcome.reason.unwrap_or_default();
+                prop_assert!(reason.contains("cannot"), "{reason}");
+                // What it found before it stopped is right.
+                let exact = crest_times(level, phase, outcome.t_reached);
+                prop_assert!(times.len() <= exact.len() + 1);
+            }
+            other => prop_assert!(false, "{other:?}: {:?}", outcome.reason),
+        }
+    }
 }
