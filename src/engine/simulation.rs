@@ -755,7 +755,7 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
         self.tangents
             .gradient(model, mode, slot, before, &mut self.gradient);
         let along = self.errors.along(&self.gradient);
-        let closing = self.tangents.saltation(
+        let (closing, jump) = self.tangents.saltation(
             model,
             mode,
             slot,
@@ -805,7 +805,19 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
                 self.integrator.name()
             )));
         }
-        self.errors.map(&self.matrix, 0.0);
+        // Where the event was located, the guard is not exactly zero: the
+        // reset came that residual's time early or late (rounding at
+        // least), which leaves `f+ - R f-` times it in the state.
+        let residual = model.guard(mode, slot, before).abs()
+            + f64::EPSILON
+                * self
+                    .gradient
+                    .iter()
+                    .zip(before)
+                    .map(|(g, x)| (g * x).abs())
+                    .sum::<f64>();
+        self.errors
+            .map(&self.matrix, jump * residual / closing.abs());
         Ok(())
     }
 

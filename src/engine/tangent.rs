@@ -203,7 +203,9 @@ impl Tangents {
     /// the reset's Jacobian and `f-`, `f+` the rates before and after. An
     /// error `d` before the event moves it by `-grad(g) . d / (grad(g) .
     /// f-)` in time and leaves `S d` after it. Returns the closing speed
-    /// `grad(g) . f-` (zero at a graze, where `S` is not defined).
+    /// `grad(g) . f-` (zero at a graze, where `S` is not defined) and the
+    /// largest component of `f+ - R f-`: what firing the event a time `dt`
+    /// late leaves in the state, per unit of `dt`.
     #[allow(clippy::too_many_arguments)]
     pub fn saltation<M: HybridModel + ?Sized>(
         &mut self,
@@ -215,7 +217,7 @@ impl Tangents {
         mode_after: Mode,
         after: &[f64],
         out: &mut [f64],
-    ) -> f64 {
+    ) -> (f64, f64) {
         let n = self.n;
         let mut reset = std::mem::take(&mut self.a);
         // The reset's Jacobian, by central differences.
@@ -237,8 +239,10 @@ impl Tangents {
         self.rate(model, mode, before, &mut rate_before);
         self.rate(model, mode_after, after, &mut rate_after);
         let closing: f64 = gradient.iter().zip(&rate_before).map(|(g, f)| g * f).sum();
+        let mut largest_jump: f64 = 0.0;
         for i in 0..n {
             let pushed: f64 = (0..n).map(|k| reset[i * n + k] * rate_before[k]).sum();
+            largest_jump = largest_jump.max((rate_after[i] - pushed).abs());
             let jump = (rate_after[i] - pushed) / closing;
             for j in 0..n {
                 out[i * n + j] = reset[i * n + j] + jump * gradient[j];
@@ -247,7 +251,7 @@ impl Tangents {
         self.a = reset;
         self.up = rate_before;
         self.down = rate_after;
-        closing
+        (closing, largest_jump)
     }
 }
 

@@ -11,6 +11,7 @@ mod compare_models;
 mod continuum;
 mod convergence;
 mod engine_generic;
+mod error_bound;
 mod event_location;
 mod fuzz_regressions;
 mod homogenized;
