@@ -95,11 +95,13 @@ impl ErrorSet {
         }
         // Longest error columns first: Q's first direction follows the
         // dominant error.
-        let length = |j: usize, p: &[f64]| (0..n).map(|i| p[j * n + i].powi(2)).sum::<f64>().sqrt();
-        let radii = &self.radii;
-        self.order.sort_by(|&a, &b| {
-            (length(b, product) * radii[b]).total_cmp(&(length(a, product) * radii[a]))
-        });
+        let mut weight = [0.0; TRACKED];
+        for (j, w) in weight[..n].iter_mut().enumerate() {
+            let column = &product[j * n..(j + 1) * n];
+            *w = column.iter().map(|x| x * x).sum::<f64>() * self.radii[j] * self.radii[j];
+        }
+        self.order
+            .sort_unstable_by(|&a, &b| weight[b].total_cmp(&weight[a]));
         orthonormalize(n, product, &self.order, q);
         // New radii: |Q^T product| r + |Q^T| local.
         let mut radii = [0.0; TRACKED];

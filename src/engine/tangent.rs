@@ -19,6 +19,9 @@ pub struct Tangents {
     /// The exact Jacobian of the last mode asked about, if its flow is
     /// linear.
     linear: Option<(Mode, Option<Vec<f64>>)>,
+    /// The last tangent of a linear flow and its `tau`: a fixed-step method
+    /// asks for the same one at every step.
+    linear_tangent: Option<(f64, Vec<f64>)>,
     x: Vec<f64>,
     up: Vec<f64>,
     down: Vec<f64>,
@@ -37,6 +40,7 @@ impl Tangents {
         Tangents {
             n,
             linear: None,
+            linear_tangent: None,
             x: vec![0.0; n],
             up: vec![0.0; n],
             down: vec![0.0; n],
@@ -55,6 +59,7 @@ impl Tangents {
                 .linear(mode)
                 .map(|(a, _)| (0..n * n).map(|k| a[(k / n, k % n)]).collect());
             self.linear = Some((mode, exact));
+            self.linear_tangent = None;
         }
         self.linear.as_ref().and_then(|(_, a)| a.as_deref())
     }
@@ -84,9 +89,9 @@ impl Tangents {
     }
 
     /// The tangent map of `tau` of an ODE flow in `mode` along the states
-    /// `at(s)` of a step (its dense output, `s` in `[0, tau]`): the
-    /// fourth-order Magnus expansion from the Jacobians at the two Gauss
-    /// points, exponentiated. Exact for a linear flow.
+    /// `at(s)` of a step (its dense output, `s` in `[0, tau]`):
+    /// `exp(tau J(at(tau / 2)))`, second order in `tau`. Exact for a linear
+    /// flow.
     pub fn ode<M: HybridModel + ?Sized>(
         &mut self,
         model: &M,
@@ -99,32 +104,39 @@ impl Tangents {
         let mut first = std::mem::take(&mut self.a);
         let mut second = std::mem::take(&mut self.b);
         let mut x = std::mem::take(&mut self.c);
-        if let Some(a) = self.linear_part(model, mode) {
+        if self.linear_part(model, mode).is_some() {
             // A linear flow: the tangent is exp(tau A), no states needed.
-            for (o, a) in x.iter_mut().zip(a) {
-                *o = tau * a;
+            if let Some((known, tangent)) = &self.linear_tangent
+                && *known == tau
+            {
+                out.copy_from_slice(tangent);
+                (self.a, self.b, self.c) = (first, second, x);
+                return;
             }
-        } else {
-            let offset = 3f64.sqrt() / 6.0;
-            at((0.5 - offset) * tau, &mut x[..n]);
-            self.jacobian(model, mode, &x[..n], &mut first);
-            at((0.5 + offset) * tau, &mut x[..n]);
-            self.jacobian(model, mode, &x[..n], &mut second);
-            // Omega = tau/2 (J1 + J2) + sqrt(3)/12 tau^2 (J2 J1 - J1 J2).
-            let commutator = 3f64.sqrt() / 12.0 * tau * tau;
-            for i in 0..n {
-                for j in 0..n {
-                    let (mut j2j1, mut j1j2) = (0.0, 0.0);
-                    for k in 0..n {
-                        j2j1 += second[i * n + k] * first[k * n + j];
-                        j1j2 += first[i * n + k] * second[k * n + j];
-                    }
-                    x[i * n + j] = 0.5 * tau * (first[i * n + j] + second[i * n + j])
-                        + commutator * (j2j1 - j1j2);
+            if let Some((_, Some(a))) = &self.linear {
+                for (o, a) in x.iter_mut().zip(a) {
+                    *o = tau * a;
                 }
             }
+            exp(n, &x, out, &mut first, &mut second);
+            match &mut self.linear_tangent {
+                Some((known, tangent)) => {
+                    *known = tau;
+                    tangent.copy_from_slice(out);
+                }
+                None => self.linear_tangent = Some((tau, out.to_vec())),
+            }
+        } else {
+            // The midpoint's Jacobian: a second-order tangent (exp of the
+            // Magnus expansion's first term), which is plenty for a bound
+            // and costs half the two Gauss points' differences.
+            at(0.5 * tau, &mut x[..n]);
+            self.jacobian(model, mode, &x[..n], &mut first);
+            for (o, j) in x.iter_mut().zip(first.iter()) {
+                *o = tau * j;
+            }
+            exp(n, &x, out, &mut first, &mut second);
         }
-        exp(n, &x, out, &mut first, &mut second);
         self.a = first;
         self.b = second;
         self.c = x;
@@ -256,8 +268,9 @@ impl Tangents {
 }
 
 /// `out = exp(a)` for a row-major `n x n` matrix: Taylor's series to degree
-/// 12 on `a / 2^s` with `|a / 2^s| <= 1/2`, then `s` squarings (truncation
-/// below 1e-13 relative, far within what an error bound needs).
+/// 12 (fewer once a term falls below round-off) on `a / 2^s` with
+/// `|a / 2^s| <= 1/2`, then `s` squarings (truncation below 1e-13 relative,
+/// far within what an error bound needs).
 fn exp(n: usize, a: &[f64], out: &mut [f64], term: &mut [f64], next: &mut [f64]) {
     let norm = (0..n)
         .map(|i| (0..n).map(|j| a[i * n + j].abs()).sum::<f64>())
@@ -275,6 +288,10 @@ fn exp(n: usize, a: &[f64], out: &mut [f64], term: &mut [f64], next: &mut [f64])
         term[i * n + i] = 1.0;
     }
     for k in 1..=12 {
+        // Terms fall at least as 2^-k / k!: stop once one is below round-off.
+        if term.iter().all(|t| t.abs() <= 1e-17) {
+            break;
+        }
         let factor = scale / k as f64;
         for i in 0..n {
             for j in 0..n {
