@@ -3,7 +3,7 @@
 //!
 //! A row per run: its cost (wall time, the median of a few repeats, and flow
 //! evaluations) beside its errors (final state, event times and energy,
-//! against the [`Reference`]). [`chart`] draws error against cost.
+//! against the [`Reference`]) and the bounds the run stated on them. [`chart`] draws error against cost.
 
 pub mod chart;
 pub mod reference;
@@ -36,6 +36,9 @@ pub struct Row {
     pub final_error: f64,
     pub max_event_time_error: Option<f64>,
     pub energy_error: Option<f64>,
+    /// The bounds the run stated on its final state and event times.
+    pub error_bound: f64,
+    pub event_time_bound: Option<f64>,
     /// `completed`, `zeno`, `failed: <reason>` or `events differ: ...`.
     pub status: String,
 }
@@ -161,6 +164,8 @@ fn measure(scene: &Scene, setting: &SolverSpec, reference: &Reference) -> Result
         final_error,
         max_event_time_error,
         energy_error: o.max_energy_error,
+        error_bound: o.error_bound,
+        event_time_bound: o.event_time_bound,
         status,
     })
 }

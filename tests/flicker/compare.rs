@@ -38,7 +38,7 @@ fn compare_writes_rows_that_rank_the_methods() {
         .map(str::to_string)
         .collect();
     assert_eq!(
-        &header[..9],
+        &header[..11],
         [
             "method",
             "tolerance",
@@ -48,7 +48,9 @@ fn compare_writes_rows_that_rank_the_methods() {
             "events",
             "final_error",
             "max_event_time_error",
-            "energy_error"
+            "energy_error",
+            "error_bound",
+            "event_time_bound"
         ]
     );
     let rows: Vec<csv::StringRecord> = reader.records().map(|r| r.unwrap()).collect();
@@ -93,9 +95,14 @@ fn compare_writes_rows_that_rank_the_methods() {
         "verlet {verlet:?}"
     );
     assert!(
-        rows.iter().all(|r| &r[9] == "completed"),
+        rows.iter().all(|r| &r[11] == "completed"),
         "every run agrees on the impact count"
     );
+    // Each run's final error is within the bound it stated.
+    for r in &rows {
+        let (error, bound) = (r[6].parse::<f64>().unwrap(), r[9].parse::<f64>().unwrap());
+        assert!(error <= bound, "{}: error {error:e} above its bound {bound:e}", &r[0]);
+    }
     let svg = std::fs::read_to_string(out.join("compare.svg")).unwrap();
     for text in [
         "final error against the exact answer",
