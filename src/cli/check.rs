@@ -5,10 +5,14 @@ use std::path::Path;
 
 use flicker::models::mechanism::Mechanism;
 use flicker::scene::{self, Formulation, Scene};
+use flicker::sweep;
 
 use crate::cli::exit::{Code, Failure};
 
 pub fn check(path: &Path) -> Result<Code, Failure> {
+    if is_sweep(path) {
+        return check_sweep(path);
+    }
     let scene = scene::load(path).map_err(Failure::bad_input)?;
     match &scene {
         Scene::Mechanism(m) => {
@@ -119,4 +123,40 @@ fn string_line(
         "  length {length}, wave speed {wave_speed}, load {before} -> {after} (F / F_cr), constraint {}, t_end {t_end}",
         if constraint { "on" } else { "off" }
     );
+}
+
+/// Whether `path` holds a sweep (an object with `scene` and `grid`) rather
+/// than a scene; an unreadable file is left to the scene's own errors.
+fn is_sweep(path: &Path) -> bool {
+    std::fs::read_to_string(path)
+        .ok()
+        .and_then(|text| serde_json::from_str::<serde_json::Value>(&text).ok())
+        .is_some_and(|v| v.get("grid").is_some() && v.get("scene").is_some())
+}
+
+/// Validate a sweep file (its base scene and every axis) and say what it
+/// would run.
+fn check_sweep(path: &Path) -> Result<Code, Failure> {
+    let spec = sweep::load(path).map_err(Failure::bad_input)?;
+    let model = spec
+        .base
+        .get("model")
+        .and_then(|m| m.as_str())
+        .unwrap_or("?");
+    say!(
+        "{}: a valid sweep of {} {model} scenes (run it with `flicker sweep`)",
+        path.display(),
+        spec.points()
+    );
+    for axis in &spec.axes {
+        let (first, last) = (axis.values.first(), axis.values.last());
+        say!(
+            "  {}: {} values from {} to {}",
+            axis.key,
+            axis.values.len(),
+            first.map_or("-".into(), |v| v.to_string()),
+            last.map_or("-".into(), |v| v.to_string())
+        );
+    }
+    Ok(Code::Ok)
 }

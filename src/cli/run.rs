@@ -248,6 +248,7 @@ pub fn run(args: RunArgs) -> Result<Code, Failure> {
     }
     if let Some(why) = ensemble_failed {
         say!("  ensemble failed: {why}");
+        eprintln!("flicker: the ensemble failed: {why}");
         let interrupted = control
             .stop
             .as_ref()
@@ -257,6 +258,20 @@ pub fn run(args: RunArgs) -> Result<Code, Failure> {
         } else {
             Code::Untrusted
         });
+    }
+    // A run that cannot be trusted says why on stderr too, where a caller
+    // that keeps only the errors (`2>err`) looks.
+    if matches!(report.outcome.status, Status::Failed | Status::Interrupted) {
+        eprintln!(
+            "flicker: the run {} at t = {}: {}",
+            report.outcome.status.as_str(),
+            report.outcome.t_reached,
+            report
+                .outcome
+                .reason
+                .as_deref()
+                .unwrap_or("no reason given")
+        );
     }
     Ok(match report.outcome.status {
         Status::Completed | Status::Zeno => Code::Ok,

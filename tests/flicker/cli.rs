@@ -127,6 +127,37 @@ fn a_failing_method_exits_3_with_its_reason() {
             .contains("singular at theta = 0")
     );
     assert!(summary["t_reached"].as_f64().unwrap() < 100.0);
+    // The reason is on stderr too, for a caller that keeps only errors.
+    let stderr = String::from_utf8_lossy(&result.stderr);
+    assert!(stderr.contains("singular at theta = 0"), "stderr: {stderr}");
+}
+
+#[test]
+fn check_recognises_a_sweep_file_and_checks_it_as_one() {
+    let result = flicker(&["check", &models("sweeps/impact_period.json")]);
+    let stdout = String::from_utf8_lossy(&result.stdout);
+    assert_eq!(result.status.code(), Some(0), "{stdout}");
+    // 100 x 100 points, as the file's two axes say.
+    assert!(
+        stdout.contains("a valid sweep of 10000 mechanism scenes"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("eta: 100 values from 0.5 to 1.5"),
+        "{stdout}"
+    );
+    // A broken axis is still bad input, named.
+    let dir = tempfile::tempdir().unwrap();
+    let broken = scene(
+        dir.path(),
+        "sweep.json",
+        r#"{"scene": {"model": "mechanism", "eta": 1.0, "omega": 1.0, "initial": {"strain": 0.1, "strain_rate": 0.0}, "t_end": 1.0},
+            "grid": [{"key": "eta", "from": 0.5, "to": 1.5, "count": 0}]}"#,
+    );
+    let result = flicker(&["check", broken.to_str().unwrap()]);
+    assert_eq!(result.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&result.stderr);
+    assert!(stderr.contains("count"), "{stderr}");
 }
 
 #[test]

@@ -101,7 +101,11 @@ fn compare_writes_rows_that_rank_the_methods() {
     // Each run's final error is within the bound it stated.
     for r in &rows {
         let (error, bound) = (r[6].parse::<f64>().unwrap(), r[9].parse::<f64>().unwrap());
-        assert!(error <= bound, "{}: error {error:e} above its bound {bound:e}", &r[0]);
+        assert!(
+            error <= bound,
+            "{}: error {error:e} above its bound {bound:e}",
+            &r[0]
+        );
     }
     let svg = std::fs::read_to_string(out.join("compare.svg")).unwrap();
     for text in [
