@@ -108,45 +108,156 @@ fn a_release_run_writes_summary_log_profiles_and_trace() {
     assert!(map.contains("every") && map.matches("<circle").count() <= 20_000);
 }
 
-#[test]
-fn the_ode_path_runs_the_same_scene_from_the_command_line() {
-    // Both adaptive pairs. After the t = 0 cascade units 2-4 sit shut with
-    // zero closing speed and open again; a fit's noise in their rate must
-    // not read as closing (DOP853 once stopped here as Zeno).
-    for method in ["dopri5", "dop853"] {
-        let dir = tempfile::tempdir().unwrap();
-        let out = dir.path().join("cradle");
-        let o = run(
-            &models("chain_cradle.json"),
-            &out,
-            &["--method", method, "--rtol", "1e-12", "--atol", "1e-14"],
-        );
-        assert!(
-            o.status.success(),
-            "{method}: {}",
-            String::from_utf8_lossy(&o.stderr)
-        );
-        let summary = read_json(&out.join("summary.json"));
-        assert_eq!(summary["method"], method);
-        assert_eq!(summary["events"], 2, "{method}");
-        let log = std::fs::read_to_string(out.join("events.jsonl")).unwrap();
-        let seqs: Vec<u64> = log
-            .lines()
-            .map(|l| {
-                serde_json::from_str::<serde_json::Value>(l).unwrap()["seq"]
-                    .as_u64()
+/// `(seq, unit, t, rel_velocity)` of every line of a run's log.
+fn logged_impacts(out: &Path) -> Vec<(u64, u64, f64, f64)> {
+    std::fs::read_to_string(out.join("events.jsonl"))
+        .unwrap()
+        .lines()
+        .map(|l| {
+            let e: serde_json::Value = serde_json::from_str(l).unwrap();
+            let number = |key: &str| e[key].as_f64().unwrap();
+            (
+                e["seq"].as_u64().unwrap(),
+                e["unit"].as_u64().unwrap(),
+                number("t"),
+                number("rel_velocity"),
+            )
+        })
+        .collect()
+}
+
+/// Every number of every snapshot of a run's `profiles.json`, in order.
+fn profile_numbers(out: &Path) -> Vec<f64> {
+    let profiles = read_json(&out.join("profiles.json"));
+    let mut numbers = Vec::new();
+    for snapshot in profiles["snapshots"].as_array().unwrap() {
+        for key in ["strain", "displacement", "velocity"] {
+            numbers.extend(
+                snapshot[key]
+                    .as_array()
                     .unwrap()
-            })
-            .collect();
-        assert_eq!(seqs, vec![1, 2], "numbered across the legs between samples");
-        let profiles = read_json(&out.join("profiles.json"));
-        // After the t = 0 cascade node 1's speed sits on node 4 (worked by hand).
-        let v = &profiles["snapshots"][1]["velocity"];
-        assert!(
-            (v[0].as_f64().unwrap()).abs() < 0.01 && v[4].as_f64().unwrap() > 0.99,
-            "{method}: {v}"
-        );
+                    .iter()
+                    .map(|x| x.as_f64().unwrap()),
+            );
+        }
     }
+    numbers
+}
+
+#[test]
+fn the_ode_path_finds_the_exact_paths_impacts_event_by_event() {
+    // The cradle (after the t = 0 cascade units 2-4 sit shut with zero
+    // closing speed and open again: a fit's noise in their rate must not
+    // read as closing; DOP853 once stopped there as Zeno) and a release of
+    // 20 units to t = 1, before its chaos horizon (hundreds of impacts).
+    let dir = tempfile::tempdir().unwrap();
+    let release = dir.path().join("release20.json");
+    std::fs::write(
+        &release,
+        r#"{"model": "chain", "units": 20, "length": 2.0, "wave_speed": 1.0,
+            "load": {"before": 1.1, "after": 0.0}, "constraint": true,
+            "t_end": 1.0, "snapshots": [0.5, 1.0], "samples": 11}"#,
+    )
+    .unwrap();
+    for (name, scene, least) in [
+        ("cradle", models("chain_cradle.json"), 2),
+        ("release", release.to_str().unwrap().to_string(), 300),
+    ] {
+        let exact_out = dir.path().join(format!("{name}-exact"));
+        let o = run(&scene, &exact_out, &[]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        assert_eq!(
+            read_json(&exact_out.join("summary.json"))["method"],
+            "exact"
+        );
+        let exact = logged_impacts(&exact_out);
+        assert!(exact.len() >= least, "{name}: {} impacts", exact.len());
+        for method in ["dopri5", "dop853"] {
+            let out = dir.path().join(format!("{name}-{method}"));
+            let o = run(
+                &scene,
+                &out,
+                &["--method", method, "--rtol", "1e-12", "--atol", "1e-14"],
+            );
+            assert!(
+                o.status.success(),
+                "{name}, {method}: {}",
+                String::from_utf8_lossy(&o.stderr)
+            );
+            let summary = read_json(&out.join("summary.json"));
+            assert_eq!(summary["method"], method);
+            // Each accepted step keeps its local error below
+            // rtol |x| + atol, with |x| <= 1 here (speeds up to 1,
+            // displacements up to 0.2); a step takes at least 6 evaluations.
+            // Before the horizon these errors are not amplified much, so
+            // the state is off by at most `bound`, an impact's time by
+            // bound / closing speed, a closing speed by 2 bound.
+            let steps = summary["flow_evaluations"].as_f64().unwrap() / 6.0;
+            let bound = steps * (1e-12 + 1e-14);
+            let ode = logged_impacts(&out);
+            assert_eq!(ode.len(), exact.len(), "{name}, {method}: impacts");
+            for (k, (a, b)) in exact.iter().zip(&ode).enumerate() {
+                assert_eq!(
+                    b.0,
+                    k as u64 + 1,
+                    "{name}, {method}: numbered across the legs between samples"
+                );
+                assert_eq!(
+                    a.1, b.1,
+                    "{name}, {method}: impact {k} at t = {}: unit",
+                    a.2
+                );
+                assert!(
+                    (a.2 - b.2).abs() * a.3 <= bound,
+                    "{name}, {method}: impact {k} at t = {} vs {} (closing speed {}, bound {bound:e})",
+                    a.2,
+                    b.2,
+                    a.3
+                );
+                assert!(
+                    (a.3 - b.3).abs() <= 2.0 * bound,
+                    "{name}, {method}: impact {k}: closing speed {} vs {}",
+                    a.3,
+                    b.3
+                );
+            }
+            // The snapshots too, every unit: displacements and speeds to
+            // the bound, strains (gaps over a unit length of 0.1 or 1) to
+            // ten times it.
+            let (p, q) = (profile_numbers(&exact_out), profile_numbers(&out));
+            assert_eq!(p.len(), q.len());
+            let worst = p
+                .iter()
+                .zip(&q)
+                .map(|(x, y)| (x - y).abs())
+                .fold(0.0, f64::max);
+            assert!(
+                worst <= 10.0 * bound,
+                "{name}, {method}: snapshots differ by {worst:e}"
+            );
+            eprintln!(
+                "DBG {name} {method} worst {:e} bound {bound:e} t {:e} v {:e}",
+                worst,
+                exact
+                    .iter()
+                    .zip(&ode)
+                    .map(|(a, b)| (a.2 - b.2).abs() * a.3)
+                    .fold(0.0, f64::max),
+                exact
+                    .iter()
+                    .zip(&ode)
+                    .map(|(a, b)| (a.3 - b.3).abs())
+                    .fold(0.0, f64::max)
+            );
+        }
+    }
+    // After the t = 0 cascade node 1's speed sits on node 4 (worked by hand).
+    let profiles = read_json(&dir.path().join("cradle-exact/profiles.json"));
+    let v = &profiles["snapshots"][1]["velocity"];
+    assert!(
+        (v[0].as_f64().unwrap()).abs() < 0.01 && v[4].as_f64().unwrap() > 0.99,
+        "{v}"
+    );
 }
 
 #[test]
