@@ -6,7 +6,7 @@
 
 use std::path::Path;
 
-use crate::support::{flicker, models, read_json};
+use crate::support::{SvgChart, flicker, models, read_json};
 
 fn run(scene: &str, out: &Path, extra: &[&str]) -> std::process::Output {
     let mut args = vec!["run", scene, "--out", out.to_str().unwrap(), "--quiet"];
@@ -102,6 +102,48 @@ fn a_release_run_writes_summary_log_profiles_and_trace() {
             let size = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
             assert!(size > 1000, "{} is missing or empty", path.display());
         }
+    }
+    // What two of them plot, read back through their tick labels: the
+    // loaded end's displacement is the trace's right_end over t, the first
+    // strain snapshot is profiles.json's (both drawn first, in palette
+    // colour 0, width 2). Pixels are whole numbers and the axes are fitted
+    // to whole-pixel ticks: a point may be a pixel off, no more.
+    let blue = "#1F77B4";
+    let chart = SvgChart::read(&out.join("end_displacement.svg"));
+    let drawn = &chart.polylines(blue, "2")[0];
+    assert_eq!(drawn.len(), rows.len());
+    for (&(px, py), r) in drawn.iter().zip(&rows) {
+        let (x, y) = chart.pixel((r[0], r[3]));
+        assert!(
+            (px - x).abs() <= 1.0 && (py - y).abs() <= 1.0,
+            "end displacement {} at t = {} drawn at ({px}, {py}), not ({x}, {y})",
+            r[3],
+            r[0]
+        );
+    }
+    // A pixel is 0.005 in y here: the drawn start reads 0.2 (0.1 L).
+    let (_, size) = chart.pixel_size();
+    assert!(size < 0.01, "{size}");
+    assert!((chart.pixel((0.0, 0.2)).1 - drawn[0].1).abs() <= 1.0);
+    let chart = SvgChart::read(&out.join("snapshots.svg"));
+    let drawn = &chart.polylines(blue, "2")[0];
+    let snapshot = &profiles["snapshots"][0];
+    let values = |key: &str| -> Vec<f64> {
+        snapshot[key]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect()
+    };
+    let (x, strain) = (values("x"), values("strain"));
+    assert_eq!(drawn.len(), x.len());
+    for ((&(px, py), &x), &e) in drawn.iter().zip(&x).zip(&strain) {
+        let (gx, gy) = chart.pixel((x, e));
+        assert!(
+            (px - gx).abs() <= 1.0 && (py - gy).abs() <= 1.0,
+            "strain {e} at x = {x} drawn at ({px}, {py}), not ({gx}, {gy})"
+        );
     }
     // Thinned to a picture's worth of dots, and said so.
     let map = std::fs::read_to_string(out.join("impacts.svg")).unwrap();
