@@ -39,6 +39,10 @@ pub enum Plane {
 #[derive(Debug, Clone)]
 pub struct Portrait {
     pub figure: Figure,
+    /// `(level, points)` of each drawn level-set curve (a set split at
+    /// `theta = 0` gives two), the same points as in the figure, with the
+    /// level at full precision (labels round it).
+    pub level_sets: Vec<(f64, Vec<(f64, f64)>)>,
     /// `(level, points)` of each simulated trajectory.
     pub trajectories: Vec<(f64, Vec<(f64, f64)>)>,
     plane: Plane,
@@ -64,6 +68,7 @@ impl Portrait {
                 style: Style::Constraint,
             });
         }
+        let mut level_sets = Vec::new();
         for &level in &levels {
             let style = if Some(level) == separatrix {
                 Style::Separatrix
@@ -79,7 +84,12 @@ impl Portrait {
             } else {
                 value
             });
-            curves.extend(level_set(mechanism, plane, level, label, style));
+            for curve in level_set(mechanism, plane, level, label, style) {
+                if curve.style != Style::Jump {
+                    level_sets.push((level, curve.points.clone()));
+                }
+                curves.push(curve);
+            }
         }
         let trajectories: Vec<(f64, Vec<(f64, f64)>)> = simulated_levels(mechanism, plane, &levels)
             .into_iter()
@@ -118,6 +128,7 @@ impl Portrait {
                 curves,
                 y_limit,
             },
+            level_sets,
             trajectories,
             plane,
             mechanism,

@@ -1,11 +1,13 @@
 //! The `flicker` binary: exit codes, the files a run writes, one-line errors
-//! that name the file and the field, and nothing lost on bad input.
+//! that name the file and the field, nothing lost on bad input, and
+//! `flicker events` keeping exactly the logged events its filter selects.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use serde_json::Value;
 
+use crate::oscillator::Unit;
 use crate::support::{flicker, models, read_json};
 
 fn scene(dir: &Path, name: &str, text: &str) -> PathBuf {
@@ -72,15 +74,13 @@ fn a_run_writes_a_summary_and_a_log_that_agree() {
         let jump = line["energy_after"].as_f64().unwrap() - line["energy_before"].as_f64().unwrap();
         assert!(jump.abs() < 1e-15);
     }
-    // The final state is the closed form's (eta 1.2, H0 0.05 from the apex).
-    let m = flicker::models::mechanism::Mechanism {
+    // The final state is the arc's from the last impact (eta 1.2, H0 0.05
+    // from the apex), written out in crate::oscillator.
+    let u = Unit {
         eta: 1.2,
         omega: 1.0,
     };
-    let (e0, r0) = m
-        .state_with_energy(0.05, flicker::models::mechanism::Phase::Apex)
-        .unwrap();
-    let (eps, rate) = flicker::models::mechanism::ExactOrbit::new(m, e0, r0).state_at(1000.0);
+    let (eps, rate) = u.state_at(u.apex(0.05), 1000.0);
     assert!((summary["final_state"]["strain"].as_f64().unwrap() - eps).abs() < 1e-12);
     assert!((summary["final_state"]["strain_rate"].as_f64().unwrap() - rate).abs() < 1e-12);
 }
@@ -285,8 +285,100 @@ fn a_missing_scene_file_is_bad_input() {
     assert!(String::from_utf8_lossy(&result.stderr).contains("/nonexistent/scene.json"));
 }
 
+/// The lines `flicker events LOG ARGS` prints.
+fn filtered(log: &Path, args: &[&str]) -> Vec<String> {
+    let mut all = vec!["events", log.to_str().unwrap()];
+    all.extend_from_slice(args);
+    let o = flicker(&all);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    String::from_utf8(o.stdout)
+        .unwrap()
+        .lines()
+        .map(str::to_string)
+        .collect()
+}
+
+/// The lines of `log` whose guard and time pass, read independently of
+/// the tool: each line parsed as JSON.
+fn expected(log: &Path, guard: Option<&str>, from: f64, to: f64) -> Vec<String> {
+    std::fs::read_to_string(log)
+        .unwrap()
+        .lines()
+        .filter(|line| {
+            let e: Value = serde_json::from_str(line).unwrap();
+            let t = e["t"].as_f64().unwrap();
+            guard.is_none_or(|g| e["guard"] == g) && from <= t && t <= to
+        })
+        .map(str::to_string)
+        .collect()
+}
+
 #[test]
-fn events_filters_and_summarises_a_log() {
+fn events_keeps_exactly_the_events_of_its_window_and_guard() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |scene: &str, name: &str, t_end: &str| {
+        let out = dir.path().join(name);
+        let o = flicker(&[
+            "run",
+            &models(scene),
+            "--out",
+            out.to_str().unwrap(),
+            "--t-end",
+            t_end,
+        ]);
+        assert_eq!(o.status.code(), Some(0), "{scene}");
+        out.join("events.jsonl")
+    };
+    let log = run("mechanism_impacting.json", "impacting", "100");
+    let times: Vec<f64> = std::fs::read_to_string(&log)
+        .unwrap()
+        .lines()
+        .map(|l| {
+            serde_json::from_str::<Value>(l).unwrap()["t"]
+                .as_f64()
+                .unwrap()
+        })
+        .collect();
+    assert!(times.len() > 20, "{} impacts", times.len());
+    // Windows with round ends, and with ends exactly on events (kept: the
+    // filter is t >= from and t <= to), given as the shortest decimal that
+    // reads back as the logged time.
+    let (t5, t12) = (times[4].to_string(), times[11].to_string());
+    for (args, guard, from, to) in [
+        (
+            vec!["--guard", "impact", "--from", "10", "--to", "50"],
+            Some("impact"),
+            10.0,
+            50.0,
+        ),
+        (vec!["--from", &t5, "--to", &t12], None, times[4], times[11]),
+        (vec!["--from", &t12], None, times[11], f64::INFINITY),
+        (vec!["--to", &t5], None, f64::NEG_INFINITY, times[4]),
+        (vec!["--from", &t5, "--to", &t5], None, times[4], times[4]),
+        (vec![], None, f64::NEG_INFINITY, f64::INFINITY),
+    ] {
+        let want = expected(&log, guard, from, to);
+        assert!(!want.is_empty(), "{args:?}");
+        assert_eq!(filtered(&log, &args), want, "{args:?}");
+    }
+    assert_eq!(expected(&log, None, times[4], times[11]).len(), 8);
+    // Guards: a chattering run logs impacts, then one settle.
+    let log = run("mechanism_chattering.json", "chattering", "100");
+    for guard in ["impact", "settle"] {
+        let want = expected(&log, Some(guard), f64::NEG_INFINITY, f64::INFINITY);
+        assert!(!want.is_empty(), "{guard}");
+        assert_eq!(filtered(&log, &["--guard", guard]), want, "{guard}");
+    }
+    assert!(filtered(&log, &["--guard", "nothing"]).is_empty());
+}
+
+#[test]
+fn events_summarises_a_log() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("run");
     let o = out.to_str().unwrap();
@@ -300,21 +392,7 @@ fn events_filters_and_summarises_a_log() {
     ]);
     let log = out.join("events.jsonl");
     let l = log.to_str().unwrap();
-    let all = flicker(&["events", l]);
-    assert_eq!(all.status.code(), Some(0));
-    let total = String::from_utf8_lossy(&all.stdout).lines().count();
-    let window = flicker(&[
-        "events", l, "--guard", "impact", "--from", "10", "--to", "50",
-    ]);
-    let kept: Vec<Value> = String::from_utf8_lossy(&window.stdout)
-        .lines()
-        .map(|l| serde_json::from_str(l).unwrap())
-        .collect();
-    assert!(!kept.is_empty() && kept.len() < total);
-    assert!(
-        kept.iter()
-            .all(|e| (10.0..=50.0).contains(&e["t"].as_f64().unwrap()))
-    );
+    let total = std::fs::read_to_string(&log).unwrap().lines().count();
     let summary = flicker(&["events", l, "--summary"]);
     let s: Value = serde_json::from_slice(&summary.stdout).unwrap();
     assert_eq!(s["events"].as_u64().unwrap() as usize, total);
@@ -322,12 +400,13 @@ fn events_filters_and_summarises_a_log() {
         s["by_guard"]["impact"]["count"].as_u64().unwrap() as usize,
         total
     );
-    // Impacts are periodic: every interval equals the closed-form period.
-    let m = flicker::models::mechanism::Mechanism {
+    // Impacts are periodic: every interval is the period of eta 1.2,
+    // H0 0.05, written out (a flight's time to some ulps).
+    let period = Unit {
         eta: 1.2,
         omega: 1.0,
-    };
-    let period = m.impact_period(0.05);
+    }
+    .period_atan2(0.05);
     for key in ["min", "max"] {
         assert!((s["intervals"][key].as_f64().unwrap() - period).abs() < 1e-12);
     }

@@ -18,6 +18,7 @@ mod homogenized;
 mod invariants;
 mod mechanism_angle;
 mod mechanism_strain;
+mod oscillator;
 mod phase;
 mod reproducible;
 mod scenes;

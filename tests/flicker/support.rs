@@ -1,4 +1,5 @@
-//! Helpers shared by the test modules that drive the `flicker` binary.
+//! Helpers shared by the test modules that drive the `flicker` binary, and
+//! a reader for the SVG charts it draws.
 
 use std::path::Path;
 use std::process::{Command, Output};
@@ -21,4 +22,99 @@ pub fn models(name: &str) -> String {
 /// A JSON file, parsed.
 pub fn read_json(path: &Path) -> Value {
     serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+/// What a plotters SVG chart draws, read back: its tick labels place values
+/// on the pixel axes, so its polylines turn back into data.
+pub struct SvgChart {
+    text: String,
+    /// `pixel = offset + slope * value` for x and for y.
+    x_axis: (f64, f64),
+    y_axis: (f64, f64),
+}
+
+/// `name="value"` of an SVG element's attributes.
+fn attribute<'a>(element: &'a str, name: &str) -> Option<&'a str> {
+    let start = element.find(&format!(" {name}=\""))? + name.len() + 3;
+    Some(&element[start..start + element[start..].find('"')?])
+}
+
+/// Least-squares `pixel = offset + slope * value` through the ticks; no
+/// tick may sit more than a pixel off it (positions are whole pixels).
+fn axis(ticks: &[(f64, f64)]) -> (f64, f64) {
+    assert!(ticks.len() >= 3, "ticks {ticks:?}");
+    let n = ticks.len() as f64;
+    let (mv, mp) = ticks
+        .iter()
+        .fold((0.0, 0.0), |(a, b), (v, p)| (a + v / n, b + p / n));
+    let svv: f64 = ticks.iter().map(|(v, _)| (v - mv).powi(2)).sum();
+    let svp: f64 = ticks.iter().map(|(v, p)| (v - mv) * (p - mp)).sum();
+    let slope = svp / svv;
+    let offset = mp - slope * mv;
+    for (v, p) in ticks {
+        assert!((offset + slope * v - p).abs() <= 1.0, "tick {v} at {p}");
+    }
+    (offset, slope)
+}
+
+impl SvgChart {
+    pub fn read(path: &Path) -> Self {
+        let text = std::fs::read_to_string(path).unwrap();
+        let (mut xs, mut ys) = (Vec::new(), Vec::new());
+        for piece in text.split("<text").skip(1) {
+            let (element, rest) = piece.split_once('>').unwrap();
+            let content = rest.split("</text>").next().unwrap().trim();
+            let Ok(value) = content.parse::<f64>() else {
+                continue;
+            };
+            let at = |name| attribute(element, name).unwrap().parse::<f64>().unwrap();
+            // Tick labels: below the x axis (top-aligned, centred), left
+            // of the y axis (centred on the tick, right-aligned).
+            match (attribute(element, "dy"), attribute(element, "text-anchor")) {
+                (Some("0.76em"), Some("middle")) => xs.push((value, at("x"))),
+                (Some("0.5ex"), Some("end")) => ys.push((value, at("y"))),
+                _ => {}
+            }
+        }
+        SvgChart {
+            x_axis: axis(&xs),
+            y_axis: axis(&ys),
+            text,
+        }
+    }
+
+    /// The points, in pixels, of the polylines drawn in `stroke` (`#RRGGBB`)
+    /// at `width`, in drawing order.
+    pub fn polylines(&self, stroke: &str, width: &str) -> Vec<Vec<(f64, f64)>> {
+        self.text
+            .split("<polyline")
+            .skip(1)
+            .map(|piece| piece.split_once("/>").unwrap().0)
+            .filter(|e| attribute(e, "stroke") == Some(stroke))
+            .filter(|e| attribute(e, "stroke-width") == Some(width))
+            .map(|e| {
+                attribute(e, "points")
+                    .unwrap()
+                    .split_whitespace()
+                    .map(|p| {
+                        let (x, y) = p.split_once(',').unwrap();
+                        (x.parse().unwrap(), y.parse().unwrap())
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+
+    /// The pixel at which the chart draws the data point `(x, y)`.
+    pub fn pixel(&self, (x, y): (f64, f64)) -> (f64, f64) {
+        (
+            self.x_axis.0 + self.x_axis.1 * x,
+            self.y_axis.0 + self.y_axis.1 * y,
+        )
+    }
+
+    /// The data values one pixel spans on each axis.
+    pub fn pixel_size(&self) -> (f64, f64) {
+        (1.0 / self.x_axis.1.abs(), 1.0 / self.y_axis.1.abs())
+    }
 }
