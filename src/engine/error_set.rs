@@ -24,7 +24,7 @@
 //! would dominate a large ODE): there the bound is the plain sum of the
 //! local errors, without amplification, and no event-time bound is stated.
 //!
-//! [`tangent::saltation`]: crate::engine::tangent::saltation
+//! [`tangent::saltation`]: crate::engine::tangent::Tangents::saltation
 
 /// Largest state dimension whose errors are carried through flows and
 /// events.
