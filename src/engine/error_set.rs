@@ -34,33 +34,35 @@ pub const TRACKED: usize = 8;
 #[derive(Debug, Clone)]
 pub struct ErrorSet {
     n: usize,
-    /// Orthonormal directions, column-major `n x n`.
-    basis: Vec<f64>,
+    /// Orthonormal directions, column-major `n x n` (fixed arrays: the
+    /// map below runs at every step, and small copies of slices of
+    /// unknown length are calls).
+    basis: [f64; TRACKED * TRACKED],
     /// Half-widths along each direction.
-    radii: Vec<f64>,
+    radii: [f64; TRACKED],
     /// Sum of the local errors added (the untracked bound), and of their
     /// squares (the untracked graze check's scale).
     sum: f64,
     squares: f64,
-    scratch: Vec<f64>,
-    order: Vec<usize>,
+    order: [usize; TRACKED],
 }
 
 impl ErrorSet {
     /// No error yet, in dimension `n`.
     pub fn new(n: usize) -> Self {
-        let mut basis = vec![0.0; n * n];
-        for i in 0..n {
-            basis[i * n + i] = 1.0;
+        let mut basis = [0.0; TRACKED * TRACKED];
+        if n <= TRACKED {
+            for i in 0..n {
+                basis[i * n + i] = 1.0;
+            }
         }
         ErrorSet {
             n,
             basis,
-            radii: vec![0.0; n],
+            radii: [0.0; TRACKED],
             sum: 0.0,
             squares: 0.0,
-            scratch: vec![0.0; 2 * n * n],
-            order: (0..n).collect(),
+            order: std::array::from_fn(|i| i),
         }
     }
 
@@ -85,8 +87,7 @@ impl ErrorSet {
             return;
         }
         let n = self.n;
-        let (product, rest) = self.scratch.split_at_mut(n * n);
-        let (q, _) = rest.split_at_mut(n * n);
+        let mut product = [0.0; TRACKED * TRACKED];
         // product = m * basis, column-major.
         for j in 0..n {
             for i in 0..n {
@@ -100,9 +101,21 @@ impl ErrorSet {
             let column = &product[j * n..(j + 1) * n];
             *w = column.iter().map(|x| x * x).sum::<f64>() * self.radii[j] * self.radii[j];
         }
-        self.order
-            .sort_unstable_by(|&a, &b| weight[b].total_cmp(&weight[a]));
-        orthonormalize(n, product, &self.order, q);
+        // The old basis is spent: the new one is written over it.
+        if n == 2 {
+            // The common case (one degree of freedom): the frame is the
+            // heavier column's direction and its perpendicular.
+            let first = usize::from(weight[1] > weight[0]);
+            let (c, s) = direction(&product[2 * first..2 * first + 2])
+                .or_else(|| direction(&product[2 - 2 * first..4 - 2 * first]))
+                .unwrap_or((1.0, 0.0));
+            self.basis[..4].copy_from_slice(&[c, s, -s, c]);
+        } else {
+            let order = &mut self.order[..n];
+            order.sort_unstable_by(|&a, &b| weight[b].total_cmp(&weight[a]));
+            orthonormalize(n, &product, order, &mut self.basis);
+        }
+        let q = &self.basis;
         // New radii: |Q^T product| r + |Q^T| local.
         let mut radii = [0.0; TRACKED];
         for (a, r) in radii[..n].iter_mut().enumerate() {
@@ -116,8 +129,7 @@ impl ErrorSet {
             let added: f64 = qa.iter().map(|x| x.abs()).sum::<f64>() * local;
             *r = carried + added;
         }
-        self.basis.copy_from_slice(q);
-        self.radii.copy_from_slice(&radii[..n]);
+        self.radii = radii;
     }
 
     /// Add an error box of half-width `local` where the state stands (a
@@ -158,6 +170,12 @@ impl ErrorSet {
             })
             .sum()
     }
+}
+
+/// The unit vector along a plane vector, if it has a direction.
+fn direction(v: &[f64]) -> Option<(f64, f64)> {
+    let length = v[0].hypot(v[1]);
+    (length > 0.0 && length.is_finite()).then(|| (v[0] / length, v[1] / length))
 }
 
 /// Orthonormal columns `q` (column-major) spanning the columns of `m` taken

@@ -703,7 +703,17 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
     /// Carry the state errors over the `tau` of the current segment that
     /// has passed: along the flow's tangent, with a numerical step's local
     /// error added. Nothing to do while the run has made no error.
+    #[inline(always)]
     fn close_segment(&mut self, tau: f64) {
+        if self.motion != Motion::Stepped && self.errors.is_empty() {
+            return;
+        }
+        self.close_stretch(tau);
+    }
+
+    /// [`Run::close_segment`] once there is something to carry.
+    #[inline(never)]
+    fn close_stretch(&mut self, tau: f64) {
         let (model, mode) = (self.model, self.mode);
         match self.motion {
             Motion::Stepped if self.stepped => {
@@ -734,7 +744,31 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
     /// previous event can no longer tell the events' order or count, and
     /// stops; so does one that meets an event at zero closing speed (a
     /// graze) with an error it cannot carry across.
+    #[inline(always)]
     fn carry_errors(
+        &mut self,
+        slot: usize,
+        t: Time,
+        before: &[f64],
+        mode_after: Mode,
+    ) -> Result<(), End> {
+        // The round-off allowance's scale: a plain loop, as this runs at
+        // every event of an exact run too.
+        for x in before {
+            let size = x.abs();
+            if size > self.state_scale {
+                self.state_scale = size;
+            }
+        }
+        if self.errors.is_empty() || !self.errors.tracked() {
+            return Ok(());
+        }
+        self.carry_across(slot, t, before, mode_after)
+    }
+
+    /// [`Run::carry_errors`] once there are errors to carry.
+    #[inline(never)]
+    fn carry_across(
         &mut self,
         slot: usize,
         t: Time,
@@ -743,15 +777,6 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
     ) -> Result<(), End> {
         let (model, mode) = (self.model, self.mode);
         let guard = model.guards(mode)[slot];
-        if !guard.internal {
-            self.state_scale = self
-                .state_scale
-                .max(largest(before))
-                .max(largest(&self.after));
-        }
-        if !self.errors.tracked() || self.errors.is_empty() {
-            return Ok(());
-        }
         self.tangents
             .gradient(model, mode, slot, before, &mut self.gradient);
         let along = self.errors.along(&self.gradient);
