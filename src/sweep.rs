@@ -23,10 +23,9 @@ use rayon::prelude::*;
 use serde_json::Value;
 
 use crate::engine::{EventRecord, Observer, SETTLE, Status};
-use crate::models::mechanism::ExactOrbit;
-use crate::runner::{self, Control};
+use crate::runner::Control;
 use crate::scene::fields::Fields;
-use crate::scene::{self, Scene, SceneError};
+use crate::scene::{self, SceneError};
 
 /// The largest grid a sweep file may describe.
 const MAX_POINTS: usize = 100_000_000;
@@ -306,7 +305,7 @@ impl Sweep {
             Err(e) => return failed(e.to_string()),
         };
         let mut times = FirstAndLast::default();
-        let report = match runner::run(&scene, &Control::default(), &mut times) {
+        let report = match scene.run(&Control::default(), &mut times) {
             Ok(report) => report,
             Err(e) => return failed(e.to_string()),
         };
@@ -317,15 +316,7 @@ impl Sweep {
             }
             _ => None,
         };
-        let exact_period = match &scene {
-            Scene::Mechanism(m) => {
-                let (eps, rate) = m.initial_strain;
-                let h0 = m.mechanism.energy(eps, rate);
-                let impacts = ExactOrbit::new(m.mechanism, eps, rate).impacts_until(m.t_end);
-                (h0 > 0.0 && impacts > 0).then(|| m.mechanism.impact_period(h0))
-            }
-            Scene::Chain(_) | Scene::Continuum(_) => None,
-        };
+        let exact_period = scene.period();
         let status = match (o.status, &o.reason) {
             (Status::Completed, _) | (_, None) => o.status.as_str().to_string(),
             (status, Some(reason)) => format!("{}: {reason}", status.as_str()),

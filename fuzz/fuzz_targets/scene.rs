@@ -3,8 +3,8 @@
 //! closed form (energy, regime) and run briefly (chains up to 10^4 units).
 #![no_main]
 
-use flicker::runner::{Control, run};
-use flicker::scene::{self, Scene};
+use flicker::runner::Control;
+use flicker::scene::{self, ChainScene};
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
@@ -15,7 +15,7 @@ fuzz_target!(|data: &[u8]| {
         return;
     };
     // Keep runs short: the fuzzer is after panics, not long simulations.
-    if let Scene::Chain(c) = &scene
+    if let Some(c) = scene.downcast_ref::<ChainScene>()
         && c.units > 10_000
     {
         return;
@@ -26,6 +26,6 @@ fuzz_target!(|data: &[u8]| {
             stop: None,
             max_wall_seconds: Some(0.05),
         };
-        let _ = run(&scene, &control, &mut ());
+        let _ = scene.run(&control, &mut ());
     }
 });

@@ -20,7 +20,7 @@ use flicker::compare_models::{
 use flicker::engine::Status;
 use flicker::models::continuum::Variant;
 use flicker::runner::Control;
-use flicker::scene::{self, Scene};
+use flicker::scene::{self, ChainScene};
 
 use crate::cli::exit::{Code, Failure};
 
@@ -43,7 +43,7 @@ pub struct AdviseArgs {
 
 pub fn advise(args: AdviseArgs) -> Result<Code, Failure> {
     let scene = scene::load(&args.scene).map_err(Failure::bad_input)?;
-    let Scene::Chain(chain) = &scene else {
+    let Some(chain) = scene.downcast_ref::<ChainScene>() else {
         return Err(Failure::bad_input(format!(
             "{}: advise weighs a chain scene against its continua; this is not a chain scene",
             args.scene.display()

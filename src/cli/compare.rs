@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use flicker::compare::{Plan, Row, TOLERANCES, chart, compare as run_compare, write_csv};
 use flicker::scene::solver::METHODS;
-use flicker::scene::{self, Formulation, Scene};
+use flicker::scene::{self, Scene};
 
 use crate::cli::exit::{Code, Failure};
 
@@ -74,15 +74,7 @@ pub fn compare(
 
 /// The methods a scene's model can run.
 fn applicable(scene: &Scene) -> Vec<String> {
-    let names: &[&str] = match scene {
-        Scene::Mechanism(m) if m.formulation == Formulation::Strain => {
-            &["exact", "linear", "dopri5", "dop853", "verlet"]
-        }
-        Scene::Mechanism(_) => &["dopri5", "dop853"],
-        Scene::Chain(_) => &["exact", "linear", "dopri5", "dop853", "verlet"],
-        Scene::Continuum(_) => &["exact"],
-    };
-    names.iter().map(|s| s.to_string()).collect()
+    scene.methods().into_iter().map(str::to_string).collect()
 }
 
 fn line(row: &Row) -> String {

@@ -11,9 +11,9 @@ use flicker::log::JsonlWriter;
 use flicker::log::field_files;
 use flicker::log::summary::{summary, write_atomically};
 use flicker::runner::ensemble::{check as check_ensemble, run_ensemble};
-use flicker::runner::{Control, Report, run as run_scene};
+use flicker::runner::{Control, Report};
 use flicker::scene::solver::SolverSpec;
-use flicker::scene::{self, Scene};
+use flicker::scene::{self, ChainScene, Scene};
 
 use crate::cli::exit::{Code, Failure};
 use crate::cli::progress::WithProgress;
@@ -115,9 +115,13 @@ pub fn run(args: RunArgs) -> Result<Code, Failure> {
             ))
         })?;
     }
-    let ensemble_scene = match (&scene, ensemble.ensemble) {
+    // Ensembles are the chain's (a tool for one kind: asked for by name).
+    let chain = scene
+        .downcast_ref::<ChainScene>()
+        .filter(|c| matches!(c.method, Method::Auto | Method::Exact));
+    let ensemble_scene = match (chain, ensemble.ensemble) {
         (_, None) => None,
-        (Scene::Chain(c), Some(copies)) if matches!(c.method, Method::Auto | Method::Exact) => {
+        (Some(c), Some(copies)) => {
             check_ensemble(c, copies, ensemble.perturb)
                 .map_err(|e| Failure::bad_input(format!("--ensemble: {}", e.reason)))?;
             Some(c.clone())
@@ -143,7 +147,7 @@ pub fn run(args: RunArgs) -> Result<Code, Failure> {
         })?;
         let mut observer =
             WithProgress::new(JsonlWriter::new(BufWriter::new(file)), scene.t_end(), quiet);
-        let report = run_scene(&scene, &control, &mut observer);
+        let report = scene.run(&control, &mut observer);
         observer.finish();
         let mut report = report.map_err(|e| Failure::bad_input(e.in_path(scene_path)))?;
         // A log that could not be written spoils the run, but its summary
@@ -166,7 +170,7 @@ pub fn run(args: RunArgs) -> Result<Code, Failure> {
         report
     } else {
         let mut observer = WithProgress::new((), scene.t_end(), quiet);
-        let report = run_scene(&scene, &control, &mut observer);
+        let report = scene.run(&control, &mut observer);
         observer.finish();
         report.map_err(|e| Failure::bad_input(e.in_path(scene_path)))?
     };
@@ -183,7 +187,7 @@ pub fn run(args: RunArgs) -> Result<Code, Failure> {
             })?;
         written.extend([profiles, trace]);
     }
-    let mut summary = summary(&report, model_name(&scene), scene_path, log);
+    let mut summary = summary(&report, scene.model(), scene_path, log);
     let mut horizon = None;
     let mut ensemble_failed = None;
     // The copies run only after a run that completed: an interrupted or
@@ -287,14 +291,6 @@ fn default_out(scene: &Path) -> PathBuf {
     Path::new("out").join(stem)
 }
 
-fn model_name(scene: &Scene) -> &'static str {
-    match scene {
-        Scene::Mechanism(_) => "mechanism",
-        Scene::Chain(_) => "chain",
-        Scene::Continuum(_) => "continuum",
-    }
-}
-
 fn print_report(
     report: &Report,
     scene: &Scene,
@@ -305,7 +301,7 @@ fn print_report(
     let o = &report.outcome;
     say!(
         "{} {} at t = {} of {}",
-        model_name(scene),
+        scene.model(),
         o.status.as_str(),
         o.t_reached,
         o.t_end

@@ -58,7 +58,7 @@ pub fn compare(
     plan: &Plan,
     progress: &mut dyn FnMut(&Row),
 ) -> Result<(Reference, Vec<Row>), SceneError> {
-    let reference = Reference::of(scene)?;
+    let reference = scene.reference()?;
     let mut rows = Vec::new();
     for method in &plan.methods {
         let settings: Vec<SolverSpec> = match method.as_str() {
@@ -73,7 +73,7 @@ pub fn compare(
                 .unwrap_or_else(|| {
                     STEP_FRACTIONS
                         .iter()
-                        .map(|f| f * scene_period(scene))
+                        .map(|f| f * scene.time_scale())
                         .collect()
                 })
                 .into_iter()
@@ -116,24 +116,15 @@ fn spec(method: &str, tolerance: Option<f64>, step: Option<f64>) -> SolverSpec {
     }
 }
 
-/// The natural time scale of a scene: one period of its linear flow.
-fn scene_period(scene: &Scene) -> f64 {
-    match scene {
-        Scene::Mechanism(m) => std::f64::consts::TAU / m.mechanism.omega,
-        Scene::Chain(c) => c.length / c.wave_speed,
-        Scene::Continuum(c) => c.length / c.wave_speed,
-    }
-}
-
 /// Repeats of a run for its timing: at least 3, and until 50 ms have passed.
 fn measure(scene: &Scene, setting: &SolverSpec, reference: &Reference) -> Result<Row, SceneError> {
     let mut times = EventTimes::default();
     let start = Instant::now();
-    let report = runner::run(scene, &runner::Control::default(), &mut times)?;
+    let report = scene.run(&runner::Control::default(), &mut times)?;
     let mut walls = vec![start.elapsed().as_secs_f64()];
     while walls.len() < 3 || (walls.iter().sum::<f64>() < 0.05 && walls.len() < 1000) {
         let start = Instant::now();
-        runner::run(scene, &runner::Control::default(), &mut ())?;
+        scene.run(&runner::Control::default(), &mut ())?;
         walls.push(start.elapsed().as_secs_f64());
     }
     walls.sort_by(f64::total_cmp);

@@ -1,23 +1,43 @@
 //! The exact answer a comparison measures against.
 
-use crate::models::mechanism::ExactOrbit;
-use crate::scene::{Scene, SceneError};
+use std::fmt;
+use std::sync::Arc;
 
-/// The final state and event times of the exact solution.
-#[derive(Debug, Clone)]
+/// The final state and event times of the exact solution, as a scene's
+/// model gives them ([`SceneModel::reference`]).
+///
+/// [`SceneModel::reference`]: crate::scene::SceneModel::reference
+#[derive(Clone)]
 pub struct Reference {
     /// How the reference was obtained, for the output.
     pub kind: &'static str,
     pub final_state: Vec<f64>,
     /// Events up to the end (saturating for chattering orbits).
     pub events: u64,
-    orbit: ExactOrbit,
+    /// The time of event number `k` (from 0).
+    event_time: Arc<dyn Fn(u64) -> f64 + Send + Sync>,
 }
 
 impl Reference {
+    /// A reference with these final state and event count, whose `k`-th
+    /// event (from 0) happens at `event_time(k)`.
+    pub fn new(
+        kind: &'static str,
+        final_state: Vec<f64>,
+        events: u64,
+        event_time: impl Fn(u64) -> f64 + Send + Sync + 'static,
+    ) -> Self {
+        Reference {
+            kind,
+            final_state,
+            events,
+            event_time: Arc::new(event_time),
+        }
+    }
+
     /// The time of event number `k` (from 0).
     pub fn event_time(&self, k: u64) -> f64 {
-        self.orbit.impact_time(k)
+        (self.event_time)(k)
     }
 
     /// The largest difference between `times` and the reference's event
@@ -32,35 +52,12 @@ impl Reference {
     }
 }
 
-impl Reference {
-    /// The mechanism's closed form (46) with impacts every `T_imp`, whatever
-    /// the formulation (both describe the same `eps(t)`).
-    /// Chains have no closed form to measure against and are refused.
-    pub fn of(scene: &Scene) -> Result<Self, SceneError> {
-        match scene {
-            Scene::Mechanism(m) => {
-                let (eps, rate) = m.initial_strain;
-                let orbit = ExactOrbit::new(m.mechanism, eps, rate);
-                let (e, r) = orbit.state_at(m.t_end);
-                Ok(Reference {
-                    kind: "closed form (46) of the strain, impacts every T_imp",
-                    final_state: vec![e, r],
-                    events: orbit.impacts_until(m.t_end),
-                    orbit,
-                })
-            }
-            Scene::Chain(_) => Err(SceneError::field(
-                "model",
-                "method comparisons measure against the mechanism's closed form; a chain scene has none \
-                 (its exact and ODE paths are checked against each other in tests/flicker/chain_exact.rs)"
-                    .into(),
-            )),
-            Scene::Continuum(_) => Err(SceneError::field(
-                "model",
-                "method comparisons measure numerical methods against a closed form; a continuum runs by \
-                 exact front tracking only (`flicker compare-models` compares it with the chain)"
-                    .into(),
-            )),
-        }
+impl fmt::Debug for Reference {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("Reference")
+            .field("kind", &self.kind)
+            .field("final_state", &self.final_state)
+            .field("events", &self.events)
+            .finish_non_exhaustive()
     }
 }

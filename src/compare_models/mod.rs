@@ -22,7 +22,7 @@ use crate::models::chain::coarse::{Coarse, WINDOW_WIDTH};
 use crate::models::chain::{Chain, TaylorChain};
 use crate::models::continuum::{Piece, StringModel, Variant};
 use crate::runner::{self, Control};
-use crate::scene::{ContinuumScene, Scene, SceneError};
+use crate::scene::{ChainScene, ContinuumScene, Scene, SceneError};
 use crate::time::Time;
 
 /// Fewest windows behind the front for a plateau to be measured.
@@ -46,38 +46,36 @@ pub fn release(scene: &Scene) -> Result<ContinuumScene, SceneError> {
             "the models are compared from the release of a uniform string at rest; leave `initial` out".into(),
         )
     };
-    let (c, uniform) = match scene {
-        Scene::Continuum(c) => (c.clone(), c.cells.len() == 1),
-        Scene::Chain(c) => {
-            let rest = c.load_before - 1.0;
-            let uniform =
-                c.strain.iter().all(|e| *e == rest) && c.velocity.iter().all(|v| *v == 0.0);
-            let string = ContinuumScene {
-                variant: Variant::Paper,
-                length: c.length,
-                wave_speed: c.wave_speed,
-                load_before: c.load_before,
-                load_after: c.load_after,
-                constraint: c.constraint,
-                t_end: c.t_end,
-                snapshots: c.snapshots.clone(),
-                samples: c.samples,
-                resolution: DEFAULT_CELLS,
-                cells: vec![Piece {
-                    strain: rest,
-                    velocity: 0.0,
-                }],
-                max_events: c.max_events,
-                description: None,
-            };
-            (string, uniform)
-        }
-        Scene::Mechanism(_) => {
-            return Err(SceneError::field(
-                "model",
-                "compares a chain with its continuum: give a chain or continuum scene".into(),
-            ));
-        }
+    // A tool made for these two kinds: it asks for them by name.
+    let (c, uniform) = if let Some(c) = scene.downcast_ref::<ContinuumScene>() {
+        (c.clone(), c.cells.len() == 1)
+    } else if let Some(c) = scene.downcast_ref::<ChainScene>() {
+        let rest = c.load_before - 1.0;
+        let uniform = c.strain.iter().all(|e| *e == rest) && c.velocity.iter().all(|v| *v == 0.0);
+        let string = ContinuumScene {
+            variant: Variant::Paper,
+            length: c.length,
+            wave_speed: c.wave_speed,
+            load_before: c.load_before,
+            load_after: c.load_after,
+            constraint: c.constraint,
+            t_end: c.t_end,
+            snapshots: c.snapshots.clone(),
+            samples: c.samples,
+            resolution: DEFAULT_CELLS,
+            cells: vec![Piece {
+                strain: rest,
+                velocity: 0.0,
+            }],
+            max_events: c.max_events,
+            description: None,
+        };
+        (string, uniform)
+    } else {
+        return Err(SceneError::field(
+            "model",
+            "compares a chain with its continuum: give a chain or continuum scene".into(),
+        ));
     };
     if !uniform || c.cells[0].velocity != 0.0 {
         return Err(refuse());

@@ -95,7 +95,7 @@ impl<'s> Sampler<'s> {
     }
 }
 
-pub(super) fn run(
+pub(crate) fn run(
     scene: &ChainScene,
     control: &Control,
     observer: &mut dyn Observer,

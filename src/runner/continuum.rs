@@ -9,7 +9,7 @@ use crate::runner::{Classical, Control, FieldOutputs, Profile, Report, TraceRow}
 use crate::scene::{ContinuumScene, SceneError};
 use crate::time::Time;
 
-pub(super) fn run(
+pub(crate) fn run(
     scene: &ContinuumScene,
     control: &Control,
     observer: &mut dyn Observer,

@@ -6,7 +6,7 @@ use crate::models::mechanism::{AngleMechanism, Charts, StrainMechanism};
 use crate::runner::{Control, Report};
 use crate::scene::{Formulation, Initial, MechanismScene, SceneError};
 
-pub(super) fn run(
+pub(crate) fn run(
     scene: &MechanismScene,
     control: &Control,
     observer: &mut dyn Observer,

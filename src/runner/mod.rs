@@ -1,17 +1,16 @@
 //! Running a validated scene: build its model, pick its method, run it, and
 //! describe the result in the scene's own terms.
 
-mod chain;
-mod continuum;
+pub(crate) mod chain;
+pub(crate) mod continuum;
 pub mod ensemble;
 mod fields;
-mod mechanism;
+pub(crate) mod mechanism;
 
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
-use crate::engine::{Method, Observer, Options, Outcome, Tolerances};
-use crate::scene::{Scene, SceneError};
+use crate::engine::{Method, Options, Outcome, Tolerances};
 
 pub use continuum::{front_tracking, homogenized};
 pub use fields::{CLASSICAL_MAX_UNITS, Classical, FieldOutputs, Profile, TraceRow};
@@ -56,18 +55,5 @@ impl Control {
             stop: self.stop.clone(),
             max_wall_seconds: self.max_wall_seconds,
         }
-    }
-}
-
-/// Run `scene` under `control`.
-pub fn run(
-    scene: &Scene,
-    control: &Control,
-    observer: &mut dyn Observer,
-) -> Result<Report, SceneError> {
-    match scene {
-        Scene::Mechanism(m) => mechanism::run(m, control, observer),
-        Scene::Chain(c) => chain::run(c, control, observer),
-        Scene::Continuum(c) => continuum::run(c, control, observer),
     }
 }

@@ -26,12 +26,15 @@
 
 use serde_json::Value;
 
-use crate::engine::{Method, Tolerances};
+use crate::compare::Reference;
+use crate::engine::{Method, Observer, Tolerances};
 use crate::models::chain::Chain;
-use crate::scene::SceneError;
+use crate::runner::{Control, Report};
 use crate::scene::extent;
 use crate::scene::fields::Fields;
+use crate::scene::mechanism::check_steps;
 use crate::scene::solver::SolverSpec;
+use crate::scene::{Scene, SceneError, SceneModel};
 
 /// Most units a scene may have.
 pub const MAX_UNITS: u64 = 1_000_000;
@@ -84,6 +87,11 @@ impl ChainScene {
     pub fn due_times(&self) -> Vec<f64> {
         extent::due_times(&self.snapshots, self.sample_times())
     }
+}
+
+/// The registry's validator of chain scenes.
+pub(crate) fn scene(f: Fields) -> Result<Scene, SceneError> {
+    validate(f).map(Scene::new)
 }
 
 pub(crate) fn validate(mut f: Fields) -> Result<ChainScene, SceneError> {
@@ -212,4 +220,81 @@ fn initial(value: &Value, units: usize, at_rest: f64) -> Result<(Vec<f64>, Vec<f
         .unwrap_or_else(|| vec![0.0; units]);
     f.finish()?;
     Ok((strain, velocity))
+}
+
+impl SceneModel for ChainScene {
+    fn model(&self) -> &'static str {
+        "chain"
+    }
+
+    fn t_end(&self) -> f64 {
+        self.t_end
+    }
+
+    /// A shortened run takes the snapshots it reaches.
+    fn set_t_end(&mut self, t_end: f64) -> Result<(), SceneError> {
+        check_steps(self.method, t_end)?;
+        self.snapshots.retain(|&t| t <= t_end);
+        self.t_end = t_end;
+        Ok(())
+    }
+
+    fn solver(&self) -> &SolverSpec {
+        &self.solver
+    }
+
+    fn set_solver(&mut self, spec: SolverSpec) -> Result<(), SceneError> {
+        (self.method, self.tolerances) = resolve_solver(&spec, self.units)?;
+        check_steps(self.method, self.t_end)?;
+        self.solver = spec;
+        Ok(())
+    }
+
+    fn methods(&self) -> Vec<&'static str> {
+        vec!["exact", "linear", "dopri5", "dop853", "verlet"]
+    }
+
+    /// The time a wave at the bar speed takes to cross the chain.
+    fn time_scale(&self) -> f64 {
+        self.length / self.wave_speed
+    }
+
+    fn describe(&self) -> Vec<String> {
+        vec![
+            format!("{} units, method {}", self.units, self.method.name()),
+            extent::describe_string(
+                self.length,
+                self.wave_speed,
+                (self.load_before, self.load_after),
+                self.constraint,
+                self.t_end,
+            ),
+            format!(
+                "{} snapshots, {} trace samples",
+                self.snapshots.len(),
+                self.samples
+            ),
+        ]
+    }
+
+    fn run(&self, control: &Control, observer: &mut dyn Observer) -> Result<Report, SceneError> {
+        crate::runner::chain::run(self, control, observer)
+    }
+
+    fn reference(&self) -> Result<Reference, SceneError> {
+        Err(SceneError::field(
+            "model",
+            "method comparisons measure against the mechanism's closed form; a chain scene has none \
+             (its exact and ODE paths are checked against each other in tests/flicker/chain_exact.rs)"
+                .into(),
+        ))
+    }
+
+    fn clone_box(&self) -> Box<dyn SceneModel> {
+        Box::new(self.clone())
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
 }

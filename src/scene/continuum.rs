@@ -25,10 +25,14 @@
 
 use serde_json::Value;
 
+use crate::compare::Reference;
+use crate::engine::{Method, Observer};
 use crate::models::continuum::{Continuum, Piece, Variant};
-use crate::scene::SceneError;
+use crate::runner::{Control, Report};
 use crate::scene::extent;
 use crate::scene::fields::{Fields, kind};
+use crate::scene::solver::SolverSpec;
+use crate::scene::{Scene, SceneError, SceneModel};
 
 /// Most cells an `initial` profile may have, and most profile points.
 pub const MAX_CELLS: u64 = 1_000_000;
@@ -86,6 +90,11 @@ impl ContinuumScene {
             .map(|i| -0.5 * self.length + (i as f64 + 0.5) * cell)
             .collect()
     }
+}
+
+/// The registry's validator of continuum scenes.
+pub(crate) fn scene(f: Fields) -> Result<Scene, SceneError> {
+    validate(f).map(Scene::new)
 }
 
 pub(crate) fn validate(mut f: Fields) -> Result<ContinuumScene, SceneError> {
@@ -235,4 +244,104 @@ fn initial(value: &Value, at_rest: Piece) -> Result<Vec<Piece>, SceneError> {
         .zip(velocity)
         .map(|(strain, velocity)| Piece { strain, velocity })
         .collect())
+}
+
+/// A continuum scene names no solver: it runs by its own method.
+const OWN_METHOD: SolverSpec = SolverSpec {
+    method: None,
+    rtol: None,
+    atol: None,
+    step: None,
+};
+
+impl SceneModel for ContinuumScene {
+    fn model(&self) -> &'static str {
+        "continuum"
+    }
+
+    fn t_end(&self) -> f64 {
+        self.t_end
+    }
+
+    fn set_t_end(&mut self, t_end: f64) -> Result<(), SceneError> {
+        self.snapshots.retain(|&t| t <= t_end);
+        self.t_end = t_end;
+        Ok(())
+    }
+
+    fn solver(&self) -> &SolverSpec {
+        &OWN_METHOD
+    }
+
+    /// Front tracking is exact and the only method offered.
+    fn set_solver(&mut self, spec: SolverSpec) -> Result<(), SceneError> {
+        let (method, _) = spec.resolve()?;
+        if !matches!(method, Method::Auto | Method::Exact) {
+            return Err(SceneError::field(
+                "solver.method",
+                format!(
+                    "a continuum runs by its own method only (exact front tracking, or finite volumes for the homogenized string), not {}",
+                    method.name()
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    fn methods(&self) -> Vec<&'static str> {
+        vec!["exact"]
+    }
+
+    /// The time a wave at the bar speed takes to cross the string.
+    fn time_scale(&self) -> f64 {
+        self.length / self.wave_speed
+    }
+
+    fn describe(&self) -> Vec<String> {
+        let method = match self.variant {
+            Variant::Paper => "exact front tracking".to_string(),
+            Variant::Homogenized => format!("finite volumes on {} cells", self.resolution),
+        };
+        vec![
+            format!(
+                "{} variant, {} initial cells, {method}",
+                self.variant.name(),
+                self.cells.len()
+            ),
+            extent::describe_string(
+                self.length,
+                self.wave_speed,
+                (self.load_before, self.load_after),
+                self.constraint,
+                self.t_end,
+            ),
+            format!(
+                "{} snapshots of {} points, {} trace samples",
+                self.snapshots.len(),
+                self.resolution,
+                self.samples
+            ),
+        ]
+    }
+
+    fn run(&self, control: &Control, observer: &mut dyn Observer) -> Result<Report, SceneError> {
+        crate::runner::continuum::run(self, control, observer)
+    }
+
+    fn reference(&self) -> Result<Reference, SceneError> {
+        Err(SceneError::field(
+            "model",
+            "method comparisons measure numerical methods against a closed form; a continuum runs by \
+             exact front tracking only (`flicker compare-models` compares it with the chain)"
+                .into(),
+        ))
+    }
+
+    fn clone_box(&self) -> Box<dyn SceneModel> {
+        Box::new(self.clone())
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
 }

@@ -120,3 +120,17 @@ pub fn numbers(
         })
         .collect()
 }
+
+/// The line `flicker check` gives of a chain's or a continuum's string.
+pub fn describe_string(
+    length: f64,
+    wave_speed: f64,
+    (before, after): (f64, f64),
+    constraint: bool,
+    t_end: f64,
+) -> String {
+    format!(
+        "length {length}, wave speed {wave_speed}, load {before} -> {after} (F / F_cr), constraint {}, t_end {t_end}",
+        if constraint { "on" } else { "off" }
+    )
+}

@@ -25,11 +25,16 @@
 
 use std::f64::consts::FRAC_PI_2;
 
+use crate::compare::Reference;
+use crate::engine::Observer;
+use crate::engine::zeno;
 use crate::engine::{Method, Tolerances};
+use crate::models::mechanism::ExactOrbit;
 use crate::models::mechanism::{Charts, Mechanism, Phase};
-use crate::scene::SceneError;
+use crate::runner::{Control, Report};
 use crate::scene::fields::{Fields, kind};
 use crate::scene::solver::SolverSpec;
+use crate::scene::{Scene, SceneError, SceneModel};
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Formulation {
@@ -59,6 +64,11 @@ pub struct MechanismScene {
     pub tolerances: Tolerances,
     pub max_events: u64,
     pub description: Option<String>,
+}
+
+/// The registry's validator of mechanism scenes.
+pub(crate) fn scene(f: Fields) -> Result<Scene, SceneError> {
+    validate(f).map(Scene::new)
 }
 
 pub(crate) fn validate(mut f: Fields) -> Result<MechanismScene, SceneError> {
@@ -225,4 +235,118 @@ fn initial(
     };
     f.finish()?;
     Ok(initial)
+}
+
+impl SceneModel for MechanismScene {
+    fn model(&self) -> &'static str {
+        "mechanism"
+    }
+
+    fn t_end(&self) -> f64 {
+        self.t_end
+    }
+
+    fn set_t_end(&mut self, t_end: f64) -> Result<(), SceneError> {
+        check_steps(self.method, t_end)?;
+        self.t_end = t_end;
+        Ok(())
+    }
+
+    fn solver(&self) -> &SolverSpec {
+        &self.solver
+    }
+
+    fn set_solver(&mut self, spec: SolverSpec) -> Result<(), SceneError> {
+        (self.method, self.tolerances) = resolve_solver(&spec, self.formulation)?;
+        check_steps(self.method, self.t_end)?;
+        self.solver = spec;
+        Ok(())
+    }
+
+    fn methods(&self) -> Vec<&'static str> {
+        match self.formulation {
+            Formulation::Strain => vec!["exact", "linear", "dopri5", "dop853", "verlet"],
+            Formulation::Angle(_) => vec!["dopri5", "dop853"],
+        }
+    }
+
+    fn time_scale(&self) -> f64 {
+        std::f64::consts::TAU / self.mechanism.omega
+    }
+
+    fn describe(&self) -> Vec<String> {
+        let (eps, rate) = self.initial_strain;
+        let h0 = self.mechanism.energy(eps, rate);
+        let formulation = match self.formulation {
+            Formulation::Strain => "strain formulation",
+            Formulation::Angle(_) => "angle formulation",
+        };
+        vec![
+            format!("{formulation}, method {}", self.method.name()),
+            format!(
+                "eta {}, omega {}, t_end {}",
+                self.mechanism.eta, self.mechanism.omega, self.t_end
+            ),
+            format!(
+                "initial strain {eps:e}, strain rate {rate:e}, energy H0 = {h0:e}: {}",
+                regime(self.mechanism, h0, self.t_end)
+            ),
+        ]
+    }
+
+    fn run(&self, control: &Control, observer: &mut dyn Observer) -> Result<Report, SceneError> {
+        crate::runner::mechanism::run(self, control, observer)
+    }
+
+    /// The closed form (46) of the strain with impacts every `T_imp`,
+    /// whatever the formulation (both describe the same `eps(t)`).
+    fn reference(&self) -> Result<Reference, SceneError> {
+        let (eps, rate) = self.initial_strain;
+        let orbit = ExactOrbit::new(self.mechanism, eps, rate);
+        let (e, r) = orbit.state_at(self.t_end);
+        Ok(Reference::new(
+            "closed form (46) of the strain, impacts every T_imp",
+            vec![e, r],
+            orbit.impacts_until(self.t_end),
+            move |k| orbit.impact_time(k),
+        ))
+    }
+
+    /// `T_imp` of an impacting orbit that impacts before `t_end`.
+    fn period(&self) -> Option<f64> {
+        let (eps, rate) = self.initial_strain;
+        let h0 = self.mechanism.energy(eps, rate);
+        let impacts = ExactOrbit::new(self.mechanism, eps, rate).impacts_until(self.t_end);
+        (h0 > 0.0 && impacts > 0).then(|| self.mechanism.impact_period(h0))
+    }
+
+    fn clone_box(&self) -> Box<dyn SceneModel> {
+        Box::new(self.clone())
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+}
+
+/// Which regime of docs/physics.md s.2 an orbit of energy `h0` is in.
+fn regime(m: Mechanism, h0: f64, t_end: f64) -> String {
+    let c = m.centre();
+    let resolution = zeno::resolution(0.0, t_end);
+    if h0 > 0.0 && m.impact_period(h0) <= resolution {
+        format!(
+            "chattering towards resting contact: an impact every {:e}, faster than the run can resolve (expect zeno)",
+            m.impact_period(h0)
+        )
+    } else if h0 > 0.0 {
+        format!("impacting, an impact every {:e}", m.impact_period(h0))
+    } else if h0 == 0.0 && c > 0.0 {
+        "the grazing separatrix: touches eps = 0 at zero speed, no impact".into()
+    } else if h0 == 0.0 && c < 0.0 {
+        "resting contact at the trivial state".into()
+    } else if h0 == 0.0 {
+        "at rest at the critical load".into()
+    } else {
+        "a loose oscillation about the buckled strain, no impact".into()
+    }
 }

@@ -115,7 +115,7 @@ fn a_homogenized_scene_runs_and_says_what_it_used() {
         "wave_speed": 1.0, "load": {"before": 1.1, "after": 0.0}, "t_end": 0.2,
         "snapshots": [0.1], "samples": 5, "resolution": 100}"#;
     let scene = scene::parse(text).unwrap();
-    let report = flicker::runner::run(&scene, &Default::default(), &mut ()).unwrap();
+    let report = scene.run(&Default::default(), &mut ()).unwrap();
     assert_eq!(report.method, "finite_volume");
     assert!(
         report.description.contains("100 cells"),

@@ -1,0 +1,208 @@
+//! What a kind of scene offers the tools, and the registry that finds it
+//! by the scene's `"model"`.
+//!
+//! Every command (`run`, `check`, `compare`, `stress`, `sweep`...) asks a
+//! [`SceneModel`] what it needs: its time span and solver, the methods it
+//! can run, what to say of it in `check`, the run itself, and where the
+//! model has them an exact reference and a period. No command matches on
+//! the kind of model, so a new kind is its validator and this one impl:
+//! registered in a [`Registry`], every tool takes it.
+
+use std::any::Any;
+use std::fmt;
+
+use serde_json::Value;
+
+use crate::compare::Reference;
+use crate::engine::Observer;
+use crate::runner::{Control, Report};
+use crate::scene::SceneError;
+use crate::scene::fields::{Fields, kind};
+use crate::scene::solver::SolverSpec;
+
+/// A validated scene of one kind of model.
+pub trait SceneModel: fmt::Debug + Send + Sync + 'static {
+    /// The scene's `"model"`, as the registry knows it.
+    fn model(&self) -> &'static str;
+
+    /// Simulated time to run to.
+    fn t_end(&self) -> f64;
+
+    /// Replace `t_end` (already checked finite and positive), checking it
+    /// against the rest of the scene.
+    fn set_t_end(&mut self, t_end: f64) -> Result<(), SceneError>;
+
+    /// The solver as the scene wrote it.
+    fn solver(&self) -> &SolverSpec;
+
+    /// Replace the solver, checking it against the model.
+    fn set_solver(&mut self, spec: SolverSpec) -> Result<(), SceneError>;
+
+    /// The methods this scene can run, in the names of `solver.method`,
+    /// cheapest exact description first.
+    fn methods(&self) -> Vec<&'static str>;
+
+    /// The natural time scale of the scene (a period of its linear flow, a
+    /// wave's crossing time): what fixed steps are fractions of.
+    fn time_scale(&self) -> f64;
+
+    /// Lines describing the scene for `flicker check` (after the line that
+    /// names the file and the model).
+    fn describe(&self) -> Vec<String>;
+
+    /// Run the scene under `control`, reporting events to `observer`.
+    fn run(&self, control: &Control, observer: &mut dyn Observer) -> Result<Report, SceneError>;
+
+    /// The exact answer numerical methods are measured against
+    /// (`flicker compare`, `flicker stress`), where the model has one.
+    fn reference(&self) -> Result<Reference, SceneError> {
+        Err(SceneError::field(
+            "model",
+            format!(
+                "a {} scene has no exact reference to measure methods against",
+                self.model()
+            ),
+        ))
+    }
+
+    /// The closed-form period of the orbit the scene starts on, where the
+    /// model knows one and the orbit has one (a sweep's `exact_period`).
+    fn period(&self) -> Option<f64> {
+        None
+    }
+
+    /// A copy behind a new box (scenes are cloned per sweep point and per
+    /// method compared).
+    fn clone_box(&self) -> Box<dyn SceneModel>;
+
+    /// The scene as `Any`, for the few tools made for one kind of model
+    /// (a chain's ensemble and advice).
+    fn as_any(&self) -> &dyn Any;
+}
+
+/// A validated scene of any registered kind.
+#[derive(Debug)]
+pub struct Scene(Box<dyn SceneModel>);
+
+impl Scene {
+    /// Wrap a validated scene.
+    pub fn new(model: impl SceneModel) -> Self {
+        Scene(Box::new(model))
+    }
+
+    /// The scene as its concrete kind, if it is of kind `T`.
+    pub fn downcast_ref<T: SceneModel>(&self) -> Option<&T> {
+        self.0.as_any().downcast_ref()
+    }
+
+    /// Replace `t_end` (from the command line), checking it.
+    pub fn set_t_end(&mut self, t_end: f64) -> Result<(), SceneError> {
+        if !(t_end.is_finite() && t_end > 0.0) {
+            return Err(SceneError::field(
+                "t_end",
+                format!("must be a finite number > 0 (got {t_end})"),
+            ));
+        }
+        self.0.set_t_end(t_end)
+    }
+
+    /// Override the solver with what the command line gave (the fields it
+    /// sets replace the scene's), checking it.
+    pub fn override_solver(&mut self, flags: &SolverSpec) -> Result<(), SceneError> {
+        let spec = self.0.solver().overridden_by(flags);
+        self.0.set_solver(spec)
+    }
+}
+
+impl Clone for Scene {
+    fn clone(&self) -> Self {
+        Scene(self.0.clone_box())
+    }
+}
+
+impl std::ops::Deref for Scene {
+    type Target = dyn SceneModel;
+
+    fn deref(&self) -> &Self::Target {
+        &*self.0
+    }
+}
+
+impl std::ops::DerefMut for Scene {
+    fn deref_mut(&mut self) -> &mut Self::Target {
+        &mut *self.0
+    }
+}
+
+/// Validates the keys of one kind of scene (all but `"model"`).
+pub type Validator = fn(Fields) -> Result<Scene, SceneError>;
+
+/// The kinds of scene a program knows, by their `"model"`.
+#[derive(Debug, Clone)]
+pub struct Registry {
+    kinds: Vec<(&'static str, Validator)>,
+}
+
+impl Registry {
+    /// The models this crate ships: the mechanism, the chain and the
+    /// continuum.
+    pub fn builtin() -> Self {
+        Registry {
+            kinds: vec![
+                ("mechanism", crate::scene::mechanism::scene),
+                ("chain", crate::scene::chain::scene),
+                ("continuum", crate::scene::continuum::scene),
+            ],
+        }
+    }
+
+    /// The same registry, knowing one more kind (or another validator for
+    /// a kind it knew).
+    pub fn with(mut self, model: &'static str, validate: Validator) -> Self {
+        self.kinds.retain(|(name, _)| *name != model);
+        self.kinds.push((model, validate));
+        self
+    }
+
+    /// Validate a scene given as a parsed JSON value.
+    pub fn from_value(&self, value: &Value) -> Result<Scene, SceneError> {
+        let mut fields = Fields::open(value, "")?;
+        let model = fields.required("model")?;
+        let Some(name) = model.as_str() else {
+            return Err(SceneError::field(
+                "model",
+                format!("must be a string, found {}", kind(model)),
+            ));
+        };
+        match self.kinds.iter().find(|(known, _)| *known == name) {
+            Some((_, validate)) => validate(fields),
+            None => {
+                let known: Vec<String> = self.kinds.iter().map(|(k, _)| format!("{k:?}")).collect();
+                Err(SceneError::field(
+                    "model",
+                    format!("unknown model {name:?} (known: {})", known.join(", ")),
+                ))
+            }
+        }
+    }
+
+    /// Validate a scene given as JSON text.
+    pub fn parse(&self, text: &str) -> Result<Scene, SceneError> {
+        let value: Value = serde_json::from_str(text).map_err(|e| SceneError {
+            file: None,
+            field: None,
+            reason: format!("is not valid JSON: {e}"),
+        })?;
+        self.from_value(&value)
+    }
+
+    /// Read and validate the scene in `path`.
+    pub fn load(&self, path: &std::path::Path) -> Result<Scene, SceneError> {
+        let text = std::fs::read_to_string(path).map_err(|e| SceneError {
+            file: Some(path.to_path_buf()),
+            field: None,
+            reason: format!("cannot be read: {e}"),
+        })?;
+        self.parse(&text).map_err(|e| e.in_path(path))
+    }
+}
