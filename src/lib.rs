@@ -11,7 +11,8 @@
 //!   [`engine::simulate`]).
 //! - [`models`]: models built on it (the bistable mechanism).
 //! - [`scene`], [`runner`], [`log`]: JSON scenes, running them, and the
-//!   event log and summary they write.
+//!   event log and summary they write; [`cli`]: the command line over
+//!   them, for the scene models of a [`scene::Registry`].
 //!
 //! A model of your own: a sawtooth, `x' = 1`, reset to zero at `x = 1`.
 //!
@@ -57,6 +58,7 @@
 //! assert!((outcome.final_state[0] - eps).abs() < 1e-12);
 //! ```
 
+pub mod cli;
 pub mod compare;
 pub mod compare_models;
 pub mod engine;

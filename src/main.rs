@@ -1,21 +1,7 @@
-//! The `flicker` command line: run scenes and inspect event logs.
-//!
-//! Exit codes, decided in one place ([`cli::exit`]): 0 completed (or a Zeno
-//! accumulation recognised and handled), 2 bad input, 3 the run cannot be
-//! trusted (a method failed), 130 interrupted.
-
-mod cli;
-
-use clap::Parser;
+//! The `flicker` command line over the scene models this crate ships (see
+//! [`flicker::cli`]; a program with models of its own calls
+//! [`flicker::cli::main`] with a registry that knows them).
 
 fn main() {
-    let args = cli::Cli::parse();
-    let code = match cli::dispatch(args) {
-        Ok(code) => code,
-        Err(error) => {
-            eprintln!("flicker: {}", error.message);
-            error.code
-        }
-    };
-    std::process::exit(code as i32);
+    std::process::exit(flicker::cli::main(flicker::scene::Registry::builtin()));
 }

@@ -12,7 +12,7 @@ use std::time::Instant;
 use crate::engine::{EventTimes, Status};
 use crate::runner::Control;
 use crate::scene::solver::SolverSpec;
-use crate::scene::{self, Scene, SceneError};
+use crate::scene::{Registry, Scene, SceneError};
 
 /// Dormand-Prince's tolerance in the suite.
 pub const TOLERANCE: f64 = 1e-9;
@@ -102,8 +102,8 @@ pub struct Row {
     pub wall_seconds: f64,
 }
 
-/// The stress scenes in `dir`, sorted by name.
-pub fn cases(dir: &Path) -> Result<Vec<(String, Scene)>, SceneError> {
+/// The stress scenes in `dir` (of models `registry` knows), sorted by name.
+pub fn cases(dir: &Path, registry: &Registry) -> Result<Vec<(String, Scene)>, SceneError> {
     let entries = std::fs::read_dir(dir).map_err(|e| SceneError {
         file: Some(dir.to_path_buf()),
         field: None,
@@ -122,7 +122,7 @@ pub fn cases(dir: &Path) -> Result<Vec<(String, Scene)>, SceneError> {
                     .unwrap_or_default()
                     .to_string_lossy()
                     .into_owned(),
-                scene::load(p)?,
+                registry.load(p)?,
             ))
         })
         .collect()

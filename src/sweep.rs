@@ -25,7 +25,7 @@ use serde_json::Value;
 use crate::engine::{EventRecord, Observer, SETTLE, Status};
 use crate::runner::Control;
 use crate::scene::fields::Fields;
-use crate::scene::{self, SceneError};
+use crate::scene::{Registry, SceneError};
 
 /// The largest grid a sweep file may describe.
 const MAX_POINTS: usize = 100_000_000;
@@ -42,6 +42,8 @@ pub struct Axis {
 pub struct Sweep {
     pub base: Value,
     pub axes: Vec<Axis>,
+    /// The scene models its points may be of.
+    pub registry: Registry,
 }
 
 /// Which points this process runs.
@@ -87,29 +89,30 @@ pub struct Row {
     pub t_reached: f64,
 }
 
-/// Read and validate a sweep file.
-pub fn load(path: &Path) -> Result<Sweep, SceneError> {
+/// Read and validate a sweep file, whose scenes are of the models
+/// `registry` knows.
+pub fn load(path: &Path, registry: &Registry) -> Result<Sweep, SceneError> {
     let text = std::fs::read_to_string(path).map_err(|e| SceneError {
         file: Some(path.to_path_buf()),
         field: None,
         reason: format!("cannot be read: {e}"),
     })?;
     let folder = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    parse_text(&text, &folder).map_err(|e| e.in_path(path))
+    parse_text(&text, &folder, registry).map_err(|e| e.in_path(path))
 }
 
 /// Validate a sweep given as JSON text; a `scene` path is read relative to
 /// `folder`.
-pub fn parse_text(text: &str, folder: &Path) -> Result<Sweep, SceneError> {
+pub fn parse_text(text: &str, folder: &Path, registry: &Registry) -> Result<Sweep, SceneError> {
     let value: Value = serde_json::from_str(text).map_err(|e| SceneError {
         file: None,
         field: None,
         reason: format!("is not valid JSON: {e}"),
     })?;
-    parse(&value, folder)
+    parse(&value, folder, registry)
 }
 
-fn parse(value: &Value, folder: &Path) -> Result<Sweep, SceneError> {
+fn parse(value: &Value, folder: &Path, registry: &Registry) -> Result<Sweep, SceneError> {
     let mut f = Fields::open(value, "")?;
     let base = match f.required("scene")? {
         Value::String(relative) => {
@@ -170,7 +173,11 @@ fn parse(value: &Value, folder: &Path) -> Result<Sweep, SceneError> {
             ));
         }
     }
-    Ok(Sweep { base, axes })
+    Ok(Sweep {
+        base,
+        axes,
+        registry: registry.clone(),
+    })
 }
 
 fn axis(value: &Value, path: &str) -> Result<Axis, SceneError> {
@@ -300,7 +307,10 @@ impl Sweep {
             energy_error: None,
             t_reached: 0.0,
         };
-        let scene = match self.scene_at(point).and_then(|v| scene::from_value(&v)) {
+        let scene = match self
+            .scene_at(point)
+            .and_then(|v| self.registry.from_value(&v))
+        {
             Ok(scene) => scene,
             Err(e) => return failed(e.to_string()),
         };

@@ -14,13 +14,13 @@
 
 use std::path::PathBuf;
 
-use flicker::compare_models::{
+use crate::compare_models::{
     Track, chain_track, continuum_track, distance, release, without_homogenized,
 };
-use flicker::engine::Status;
-use flicker::models::continuum::Variant;
-use flicker::runner::Control;
-use flicker::scene::{self, ChainScene};
+use crate::engine::Status;
+use crate::models::continuum::Variant;
+use crate::runner::Control;
+use crate::scene::{ChainScene, Registry};
 
 use crate::cli::exit::{Code, Failure};
 
@@ -41,8 +41,8 @@ pub struct AdviseArgs {
     tolerance: f64,
 }
 
-pub fn advise(args: AdviseArgs) -> Result<Code, Failure> {
-    let scene = scene::load(&args.scene).map_err(Failure::bad_input)?;
+pub fn advise(args: AdviseArgs, registry: &Registry) -> Result<Code, Failure> {
+    let scene = registry.load(&args.scene).map_err(Failure::bad_input)?;
     let Some(chain) = scene.downcast_ref::<ChainScene>() else {
         return Err(Failure::bad_input(format!(
             "{}: advise weighs a chain scene against its continua; this is not a chain scene",

@@ -3,16 +3,16 @@
 
 use std::path::Path;
 
-use flicker::scene;
-use flicker::sweep;
+use crate::scene::Registry;
+use crate::sweep;
 
 use crate::cli::exit::{Code, Failure};
 
-pub fn check(path: &Path) -> Result<Code, Failure> {
+pub fn check(registry: &Registry, path: &Path) -> Result<Code, Failure> {
     if is_sweep(path) {
-        return check_sweep(path);
+        return check_sweep(registry, path);
     }
-    let scene = scene::load(path).map_err(Failure::bad_input)?;
+    let scene = registry.load(path).map_err(Failure::bad_input)?;
     let mut lines = scene.describe().into_iter();
     say!(
         "{}: a valid {} scene ({})",
@@ -37,8 +37,8 @@ fn is_sweep(path: &Path) -> bool {
 
 /// Validate a sweep file (its base scene and every axis) and say what it
 /// would run.
-fn check_sweep(path: &Path) -> Result<Code, Failure> {
-    let spec = sweep::load(path).map_err(Failure::bad_input)?;
+fn check_sweep(registry: &Registry, path: &Path) -> Result<Code, Failure> {
+    let spec = sweep::load(path, registry).map_err(Failure::bad_input)?;
     let model = spec
         .base
         .get("model")

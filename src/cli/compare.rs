@@ -3,20 +3,21 @@
 
 use std::path::{Path, PathBuf};
 
-use flicker::compare::{Plan, Row, TOLERANCES, chart, compare as run_compare, write_csv};
-use flicker::scene::solver::METHODS;
-use flicker::scene::{self, Scene};
+use crate::compare::{Plan, Row, TOLERANCES, chart, compare as run_compare, write_csv};
+use crate::scene::solver::METHODS;
+use crate::scene::{Registry, Scene};
 
 use crate::cli::exit::{Code, Failure};
 
 pub fn compare(
+    registry: &Registry,
     scene_path: &Path,
     methods: Option<Vec<String>>,
     tolerances: Option<Vec<f64>>,
     steps: Option<Vec<f64>>,
     out: Option<PathBuf>,
 ) -> Result<Code, Failure> {
-    let scene = scene::load(scene_path).map_err(Failure::bad_input)?;
+    let scene = registry.load(scene_path).map_err(Failure::bad_input)?;
     let methods = methods.unwrap_or_else(|| applicable(&scene));
     if let Some(bad) = methods.iter().find(|m| !METHODS.contains(&m.as_str())) {
         return Err(Failure::bad_input(format!(

@@ -4,14 +4,14 @@
 use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
 
-use flicker::compare_models::{
+use crate::compare_models::{
     Model, chart, distance, files, release as release_of, run_all, without_homogenized,
 };
-use flicker::engine::Status;
-use flicker::log::summary::write_atomically;
-use flicker::models::continuum::Variant;
-use flicker::runner::Control;
-use flicker::scene;
+use crate::engine::Status;
+use crate::log::summary::write_atomically;
+use crate::models::continuum::Variant;
+use crate::runner::Control;
+use crate::scene::Registry;
 
 use crate::cli::exit::{Code, Failure};
 
@@ -29,7 +29,7 @@ pub struct CompareModelsArgs {
     )]
     units: Vec<usize>,
     /// Cells of the homogenized continuum.
-    #[arg(long, default_value_t = flicker::compare_models::DEFAULT_CELLS, value_name = "M")]
+    #[arg(long, default_value_t = crate::compare_models::DEFAULT_CELLS, value_name = "M")]
     cells: usize,
     /// Sample times over [0, t_end] for the trace and the front.
     #[arg(long, default_value_t = 121, value_name = "S")]
@@ -39,7 +39,7 @@ pub struct CompareModelsArgs {
     out: Option<PathBuf>,
 }
 
-pub fn compare_models(args: CompareModelsArgs) -> Result<Code, Failure> {
+pub fn compare_models(args: CompareModelsArgs, registry: &Registry) -> Result<Code, Failure> {
     let CompareModelsArgs {
         scene: path,
         mut units,
@@ -47,9 +47,9 @@ pub fn compare_models(args: CompareModelsArgs) -> Result<Code, Failure> {
         samples,
         out,
     } = args;
-    let scene = scene::load(&path).map_err(Failure::bad_input)?;
+    let scene = registry.load(&path).map_err(Failure::bad_input)?;
     let mut release = release_of(&scene).map_err(|e| Failure::bad_input(e.in_path(&path)))?;
-    let most = flicker::scene::continuum::MAX_FINITE_VOLUMES;
+    let most = crate::scene::continuum::MAX_FINITE_VOLUMES;
     if !(2..=most).contains(&cells) {
         return Err(Failure::bad_input(format!("--cells: from 2 to {most}")));
     }

@@ -3,9 +3,9 @@
 use std::io::{self, Write};
 use std::path::Path;
 
-pub use flicker::log::inspect::Filter;
-use flicker::log::inspect::Summary;
-use flicker::log::reader::for_each_event;
+pub use crate::log::inspect::Filter;
+use crate::log::inspect::Summary;
+use crate::log::reader::for_each_event;
 
 use crate::cli::exit::{Code, Failure};
 

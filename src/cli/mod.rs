@@ -1,4 +1,9 @@
-//! Command-line arguments and their dispatch to subcommands.
+//! The `flicker` command line: arguments and their dispatch to
+//! subcommands, over the scene models of a [`Registry`].
+//!
+//! Exit codes, decided in one place ([`exit`]): 0 completed (or a Zeno
+//! accumulation recognised and handled), 2 bad input, 3 the run cannot be
+//! trusted (a method failed), 130 interrupted.
 
 /// `println!` that ignores a closed stdout (`flicker ... | head`): what the
 /// reader chose not to read is no error, and must not panic.
@@ -33,6 +38,8 @@ pub mod sweep;
 use std::path::PathBuf;
 
 use clap::{Parser, Subcommand};
+
+use crate::scene::Registry;
 
 use crate::cli::exit::{Code, Failure};
 
@@ -151,35 +158,52 @@ enum Command {
     },
 }
 
-pub fn dispatch(cli: Cli) -> Result<Code, Failure> {
+/// Parse the process's arguments and run the command they name, for the
+/// scene models `registry` knows: what the `flicker` binary does (with
+/// [`Registry::builtin`]), and what a program with models of its own does
+/// with a registry that knows them. Returns the exit code (see
+/// [`exit::Code`]).
+pub fn main(registry: Registry) -> i32 {
+    let code = match dispatch(Cli::parse(), &registry) {
+        Ok(code) => code,
+        Err(error) => {
+            eprintln!("flicker: {}", error.message);
+            error.code
+        }
+    };
+    code as i32
+}
+
+/// Run one parsed command line.
+pub fn dispatch(cli: Cli, registry: &Registry) -> Result<Code, Failure> {
     match cli.command {
-        Command::Run(args) => run::run(args),
+        Command::Run(args) => run::run(args, registry),
         Command::Compare {
             scene,
             methods,
             tolerances,
             steps,
             out,
-        } => compare::compare(&scene, methods, tolerances, steps, out),
-        Command::CompareModels(args) => compare_models::compare_models(args),
-        Command::Advise(args) => advise::advise(args),
+        } => compare::compare(registry, &scene, methods, tolerances, steps, out),
+        Command::CompareModels(args) => compare_models::compare_models(args, registry),
+        Command::Advise(args) => advise::advise(args, registry),
         Command::Stress {
             dir,
             wall,
             markdown,
-        } => stress::stress(&dir, wall, markdown),
+        } => stress::stress(registry, &dir, wall, markdown),
         Command::Sweep {
             sweep: file,
             shard,
             threads,
             out,
-        } => sweep::sweep(&file, shard, threads, out),
+        } => sweep::sweep(registry, &file, shard, threads, out),
         Command::Merge {
             sweep: file,
             shards,
             out,
-        } => sweep::merge(&file, &shards, &out),
-        Command::Check { scene } => check::check(&scene),
+        } => sweep::merge(registry, &file, &shards, &out),
+        Command::Check { scene } => check::check(registry, &scene),
         Command::Plot {
             what: Some(what), ..
         } => plot::plot(what),

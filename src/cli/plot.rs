@@ -3,8 +3,8 @@
 
 use std::path::{Path, PathBuf};
 
-use flicker::models::mechanism::Mechanism;
-use flicker::plot::phase::{Plane, Portrait};
+use crate::models::mechanism::Mechanism;
+use crate::plot::phase::{Plane, Portrait};
 
 use crate::cli::exit::{Code, Failure};
 
@@ -34,7 +34,7 @@ pub enum PlotCommand {
 
 /// `flicker plot DIR`: the pictures of what a run wrote.
 pub fn plot_dir(dir: &Path) -> Result<Code, Failure> {
-    let written = flicker::plot::run::plot_run(dir).map_err(Failure::bad_input)?;
+    let written = crate::plot::run::plot_run(dir).map_err(Failure::bad_input)?;
     let names: Vec<String> = written.iter().map(|p| p.display().to_string()).collect();
     say!("wrote {}", names.join(", "));
     Ok(Code::Ok)

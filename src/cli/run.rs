@@ -6,14 +6,14 @@ use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
 
-use flicker::engine::{Method, Status};
-use flicker::log::JsonlWriter;
-use flicker::log::field_files;
-use flicker::log::summary::{summary, write_atomically};
-use flicker::runner::ensemble::{check as check_ensemble, run_ensemble};
-use flicker::runner::{Control, Report};
-use flicker::scene::solver::SolverSpec;
-use flicker::scene::{self, ChainScene, Scene};
+use crate::engine::{Method, Status};
+use crate::log::JsonlWriter;
+use crate::log::field_files;
+use crate::log::summary::{summary, write_atomically};
+use crate::runner::ensemble::{check as check_ensemble, run_ensemble};
+use crate::runner::{Control, Report};
+use crate::scene::solver::SolverSpec;
+use crate::scene::{ChainScene, Registry, Scene};
 
 use crate::cli::exit::{Code, Failure};
 use crate::cli::progress::WithProgress;
@@ -81,7 +81,7 @@ pub struct SolverFlags {
     step: Option<f64>,
 }
 
-pub fn run(args: RunArgs) -> Result<Code, Failure> {
+pub fn run(args: RunArgs, registry: &Registry) -> Result<Code, Failure> {
     let RunArgs {
         scene: scene_path,
         out,
@@ -101,7 +101,7 @@ pub fn run(args: RunArgs) -> Result<Code, Failure> {
         step: solver.step,
     };
     // Everything is checked before any file is touched: bad input loses nothing.
-    let mut scene = scene::load(scene_path).map_err(Failure::bad_input)?;
+    let mut scene = registry.load(scene_path).map_err(Failure::bad_input)?;
     if let Some(t) = t_end {
         scene
             .set_t_end(t)
@@ -165,7 +165,7 @@ pub fn run(args: RunArgs) -> Result<Code, Failure> {
         if report.outcome.status == Status::Failed {
             // A write that failed half way (a full disk) may have left part
             // of a line: cut the log back to its last whole line.
-            let _ = flicker::log::writer::cut_to_last_line(&log_path);
+            let _ = crate::log::writer::cut_to_last_line(&log_path);
         }
         report
     } else {
@@ -224,7 +224,7 @@ pub fn run(args: RunArgs) -> Result<Code, Failure> {
     })?;
     print_report(&report, &scene, &summary_path, log, &written);
     if plot {
-        let drawn = flicker::plot::run::plot_run(&out).map_err(Failure::untrusted)?;
+        let drawn = crate::plot::run::plot_run(&out).map_err(Failure::untrusted)?;
         let names: Vec<String> = drawn.iter().map(|p| p.display().to_string()).collect();
         say!("  drew {}", names.join(", "));
     }

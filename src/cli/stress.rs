@@ -3,17 +3,23 @@
 
 use std::path::Path;
 
-use flicker::stress::{Verdict, cases, markdown, run_case, settings};
+use crate::stress::{Verdict, cases, markdown, run_case, settings};
 
 use crate::cli::exit::{Code, Failure};
+use crate::scene::Registry;
 
-pub fn stress(dir: &Path, wall_seconds: f64, as_markdown: bool) -> Result<Code, Failure> {
+pub fn stress(
+    registry: &Registry,
+    dir: &Path,
+    wall_seconds: f64,
+    as_markdown: bool,
+) -> Result<Code, Failure> {
     if !(wall_seconds.is_finite() && wall_seconds > 0.0) {
         return Err(Failure::bad_input(
             "--wall: must be a number of seconds > 0",
         ));
     }
-    let cases = cases(dir).map_err(Failure::bad_input)?;
+    let cases = cases(dir, registry).map_err(Failure::bad_input)?;
     let mut rows = Vec::new();
     for (name, scene) in &cases {
         for setting in settings(scene) {

@@ -6,17 +6,19 @@ use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use flicker::sweep::{self, Shard};
+use crate::sweep::{self, Shard};
 
 use crate::cli::exit::{Code, Failure};
+use crate::scene::Registry;
 
 pub fn sweep(
+    registry: &Registry,
     file: &Path,
     shard: Option<String>,
     threads: Option<usize>,
     out: Option<PathBuf>,
 ) -> Result<Code, Failure> {
-    let spec = sweep::load(file).map_err(Failure::bad_input)?;
+    let spec = sweep::load(file, registry).map_err(Failure::bad_input)?;
     let shard = match shard {
         Some(text) => {
             Shard::parse(&text).map_err(|e| Failure::bad_input(format!("--shard: {e}")))?
@@ -67,8 +69,13 @@ pub fn sweep(
     Ok(Code::Ok)
 }
 
-pub fn merge(file: &Path, shards: &[PathBuf], out: &Path) -> Result<Code, Failure> {
-    let spec = sweep::load(file).map_err(Failure::bad_input)?;
+pub fn merge(
+    registry: &Registry,
+    file: &Path,
+    shards: &[PathBuf],
+    out: &Path,
+) -> Result<Code, Failure> {
+    let spec = sweep::load(file, registry).map_err(Failure::bad_input)?;
     let text = sweep::merge(&spec, shards).map_err(Failure::bad_input)?;
     std::fs::write(out, text)
         .map_err(|e| Failure::untrusted(format!("{}: cannot be written: {e}", out.display())))?;

@@ -20,6 +20,7 @@ mod mechanism_angle;
 mod mechanism_strain;
 mod oscillator;
 mod phase;
+mod registry;
 mod reproducible;
 mod scenes;
 mod schemas;

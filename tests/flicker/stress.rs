@@ -6,6 +6,7 @@
 
 use std::path::Path;
 
+use flicker::scene::Registry;
 use flicker::stress::{Row, Verdict, cases, run_case, settings};
 
 /// Per-run budget here; `flicker stress` uses 10 s for docs/stress.md.
@@ -14,7 +15,7 @@ const WALL: f64 = 2.0;
 fn rows() -> Vec<Row> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/stress");
     let mut rows = Vec::new();
-    for (name, scene) in cases(&dir).unwrap() {
+    for (name, scene) in cases(&dir, &Registry::builtin()).unwrap() {
         for setting in settings(&scene) {
             rows.push(run_case(&name, &scene, &setting, WALL).unwrap());
         }
@@ -140,7 +141,11 @@ fn no_method_is_silently_wrong_and_each_says_why_it_fails() {
 #[test]
 fn every_stress_scene_runs_each_offered_method() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/stress");
-    let names: Vec<String> = cases(&dir).unwrap().into_iter().map(|(n, _)| n).collect();
+    let names: Vec<String> = cases(&dir, &Registry::builtin())
+        .unwrap()
+        .into_iter()
+        .map(|(n, _)| n)
+        .collect();
     assert_eq!(
         names,
         [

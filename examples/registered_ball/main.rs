@@ -1,0 +1,196 @@
+//! A kind of scene from outside the crate, registered and run by every tool
+//! of the command line: a ball bouncing on the floor.
+//!
+//! This file is the whole of it: the model (free flight, exact landing
+//! times, restitution `e`, settling on the floor at its Zeno point), the
+//! scene's keys, what it offers the tools ([`SceneModel`]), and a `main`
+//! that is `flicker` with one more model. Beside it, `ball.json` (a scene)
+//! and `ball_sweep.json` (a sweep over restitution and height).
+//!
+//! ```text
+//! cargo run --release --example registered_ball -- check examples/registered_ball/ball.json
+//! cargo run --release --example registered_ball -- run examples/registered_ball/ball.json
+//! cargo run --release --example registered_ball -- sweep examples/registered_ball/ball_sweep.json
+//! ```
+
+use flicker::engine::{
+    Direction, Flow, Guard, HybridModel, Jump, Method, Mode, Observer, Options, Tolerances,
+    simulate,
+};
+use flicker::runner::{Control, Report};
+use flicker::scene::fields::Fields;
+use flicker::scene::solver::SolverSpec;
+use flicker::scene::{Registry, Scene, SceneError, SceneModel};
+
+const FLYING: Mode = 0;
+const RESTING: Mode = 1;
+const BOUNCE: [Guard; 1] = [Guard::affine("bounce", Direction::Falling)];
+
+/// State `[height, velocity]`; exact free flight between bounces.
+struct Ball {
+    gravity: f64,
+    restitution: f64,
+}
+
+impl HybridModel for Ball {
+    fn dimension(&self) -> usize {
+        2
+    }
+    fn state_names(&self, _: Mode) -> &[&'static str] {
+        &["height", "velocity"]
+    }
+    fn mode_name(&self, mode: Mode) -> &'static str {
+        if mode == RESTING { "resting" } else { "flying" }
+    }
+    fn guards(&self, mode: Mode) -> &[Guard] {
+        if mode == RESTING { &[] } else { &BOUNCE }
+    }
+    fn guard(&self, _: Mode, _: usize, x: &[f64]) -> f64 {
+        x[0]
+    }
+    fn flow(&self, mode: Mode) -> Flow {
+        if mode == RESTING {
+            Flow::Frozen
+        } else {
+            Flow::Exact
+        }
+    }
+    fn advance(&self, _: Mode, x0: &[f64], tau: f64, x: &mut [f64]) {
+        x[0] = x0[0] + x0[1] * tau - 0.5 * self.gravity * tau * tau;
+        x[1] = x0[1] - self.gravity * tau;
+    }
+    /// The later root of `h + v tau - g tau^2 / 2`, without cancellation.
+    fn next_crossing(&self, _: Mode, _: usize, x0: &[f64]) -> Option<f64> {
+        let (h, v, g) = (x0[0], x0[1], self.gravity);
+        let root = (v * v + 2.0 * g * h).sqrt();
+        Some(if v > 0.0 {
+            (v + root) / g
+        } else {
+            2.0 * h / (root - v)
+        })
+    }
+    fn reset(&self, mode: Mode, _: usize, x: &mut [f64]) -> Jump {
+        x[0] = 0.0;
+        x[1] *= -self.restitution;
+        Jump::to(mode)
+    }
+    fn energy(&self, _: Mode, x: &[f64]) -> Option<f64> {
+        Some(0.5 * x[1] * x[1] + self.gravity * x[0])
+    }
+    fn settle(&self, _: Mode, x: &mut [f64]) -> Option<Mode> {
+        x.copy_from_slice(&[0.0, 0.0]);
+        Some(RESTING)
+    }
+}
+
+/// A ball scene: `{"model": "ball", "gravity": 9.81, "restitution": 0.8,
+/// "height": 1.0, "t_end": 10.0}` (`gravity` optional, the ball dropped
+/// from rest).
+#[derive(Debug, Clone)]
+pub struct BallScene {
+    gravity: f64,
+    restitution: f64,
+    height: f64,
+    t_end: f64,
+    solver: SolverSpec,
+}
+
+fn validate(mut f: Fields) -> Result<Scene, SceneError> {
+    let gravity = f.optional_number("gravity")?.unwrap_or(9.81);
+    let gravity = f.check("gravity", gravity, "> 0", |g| g > 0.0)?;
+    let restitution = f.number_where("restitution", "in [0, 1)", |e| (0.0..1.0).contains(&e))?;
+    let height = f.number_where("height", "> 0", |h| h > 0.0)?;
+    let t_end = f.number_where("t_end", "> 0", |t| t > 0.0)?;
+    let mut scene = BallScene {
+        gravity,
+        restitution,
+        height,
+        t_end,
+        solver: SolverSpec::default(),
+    };
+    if let Some(solver) = f.optional("solver") {
+        scene.set_solver(SolverSpec::from_json(solver)?)?;
+    }
+    f.finish()?;
+    Ok(Scene::new(scene))
+}
+
+impl SceneModel for BallScene {
+    fn model(&self) -> &'static str {
+        "ball"
+    }
+    fn t_end(&self) -> f64 {
+        self.t_end
+    }
+    fn set_t_end(&mut self, t_end: f64) -> Result<(), SceneError> {
+        self.t_end = t_end;
+        Ok(())
+    }
+    fn solver(&self) -> &SolverSpec {
+        &self.solver
+    }
+    fn set_solver(&mut self, spec: SolverSpec) -> Result<(), SceneError> {
+        match spec.resolve()?.0 {
+            Method::Auto | Method::Exact => Ok(self.solver = spec),
+            other => Err(SceneError::field(
+                "solver.method",
+                format!("a ball flies exactly: not {}", other.name()),
+            )),
+        }
+    }
+    fn methods(&self) -> Vec<&'static str> {
+        vec!["exact"]
+    }
+    /// The first fall's duration.
+    fn time_scale(&self) -> f64 {
+        (2.0 * self.height / self.gravity).sqrt()
+    }
+    fn describe(&self) -> Vec<String> {
+        let first = self.time_scale();
+        let zeno = first * (1.0 + self.restitution) / (1.0 - self.restitution);
+        vec![
+            format!("restitution {}, exact flight", self.restitution),
+            format!(
+                "dropped from {} under gravity {}, t_end {}",
+                self.height, self.gravity, self.t_end
+            ),
+            format!("first bounce at t = {first:e}, bounces pile up at t = {zeno:e}"),
+        ]
+    }
+    fn run(&self, control: &Control, observer: &mut dyn Observer) -> Result<Report, SceneError> {
+        let ball = Ball {
+            gravity: self.gravity,
+            restitution: self.restitution,
+        };
+        let options: Options =
+            control.options(self.t_end, 1_000_000, Method::Auto, Tolerances::default());
+        let outcome = simulate(&ball, FLYING, &[self.height, 0.0], &options, observer);
+        let final_state = vec![
+            ("height", outcome.final_state[0]),
+            ("velocity", outcome.final_state[1]),
+        ];
+        Ok(Report {
+            outcome,
+            method: "exact",
+            description: "free flight in closed form, exact landing times".into(),
+            final_state,
+            fields: None,
+        })
+    }
+    fn clone_box(&self) -> Box<dyn SceneModel> {
+        Box::new(self.clone())
+    }
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+}
+
+/// The scene models `flicker` ships, and the ball.
+pub fn registry() -> Registry {
+    Registry::builtin().with("ball", validate)
+}
+
+#[cfg_attr(test, allow(dead_code))]
+fn main() {
+    std::process::exit(flicker::cli::main(registry()));
+}
