@@ -20,6 +20,7 @@ use std::ops::Range;
 use std::sync::atomic::Ordering;
 use std::time::Instant;
 
+use crate::engine::labels::Labels;
 use crate::engine::model::Guard;
 use crate::engine::observer::{EventRecord, Observer, SETTLE};
 use crate::engine::queue::EventQueue;
@@ -83,13 +84,8 @@ pub struct Fired {
     /// The guards whose predictions the reset changed; the fired guard is
     /// re-predicted whether it is in the range or not.
     pub affects: Range<usize>,
-    /// The part of the model the event happened at (a chain's unit), for
-    /// the log.
-    pub unit: Option<u64>,
-    /// The closing speed just before an impact, for the log.
-    pub rel_velocity: Option<f64>,
-    /// Where along the model (a continuum's position) it happened, for the log.
-    pub x: Option<f64>,
+    /// What the model labels the event with, for the log.
+    pub labels: Labels,
 }
 
 /// Run `model` from `t = 0` to `options.t_end`, calling `on_sample` with the
@@ -298,9 +294,7 @@ impl LocalRun<'_> {
                 before: &[],
                 names_after: &[],
                 after: &[],
-                unit: fired.unit,
-                rel_velocity: fired.rel_velocity,
-                x: fired.x,
+                labels: fired.labels,
             };
             observer
                 .on_event(&event)
@@ -343,9 +337,7 @@ impl LocalRun<'_> {
                 before: &[],
                 names_after: &[],
                 after: &[],
-                unit: settled.unit,
-                rel_velocity: None,
-                x: settled.x,
+                labels: settled.labels,
             };
             observer
                 .on_event(&event)

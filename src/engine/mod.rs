@@ -8,6 +8,7 @@ pub mod dopri5;
 pub mod error_set;
 pub mod fused;
 pub mod integrator;
+pub mod labels;
 pub mod linear;
 pub mod local;
 pub mod locate;
@@ -22,6 +23,7 @@ pub mod zeno;
 
 pub use adaptive::Tolerances;
 pub use integrator::Method;
+pub use labels::{Label, Labels};
 pub use local::{Fired, LocalModel, simulate_local};
 pub use model::{Affects, Direction, Flow, Guard, HybridModel, Jump, Mode};
 pub use observer::{EventRecord, EventTimes, Observer, RecordedEvent, Recorder, SETTLE};

@@ -10,6 +10,8 @@
 
 use nalgebra::{DMatrix, DVector};
 
+use crate::engine::labels::Labels;
+
 /// Index of a discrete mode. Models name their modes with [`HybridModel::mode_name`].
 pub type Mode = usize;
 
@@ -219,12 +221,12 @@ pub trait HybridModel {
         None
     }
 
-    /// Where the event of `guard` at state `before` happened, for the log:
-    /// the part of a many-part model (a chain's unit) and the closing speed
-    /// of an impact, where the model has them.
-    fn site(&self, mode: Mode, guard: usize, before: &[f64]) -> (Option<u64>, Option<f64>) {
+    /// What to label the event of `guard` at state `before` with in the
+    /// log (a chain's unit and the closing speed of an impact, say); none
+    /// by default.
+    fn labels(&self, mode: Mode, guard: usize, before: &[f64]) -> Labels {
         let _ = (mode, guard, before);
-        (None, None)
+        Labels::NONE
     }
 
     /// A sentence explaining why a numerical flow may fail at `x`, added to

@@ -4,6 +4,8 @@
 //! [`Observer`]. `()` ignores them, [`Recorder`] keeps them in memory, and the
 //! JSON Lines writer in [`crate::log`] streams them to disk.
 
+use crate::engine::labels::Labels;
+
 /// One event, borrowed from the engine for the duration of the call.
 #[derive(Debug, Clone, Copy)]
 pub struct EventRecord<'a> {
@@ -19,14 +21,9 @@ pub struct EventRecord<'a> {
     pub before: &'a [f64],
     pub names_after: &'a [&'static str],
     pub after: &'a [f64],
-    /// The part of a many-part model the event happened at (a chain's
-    /// unit), if the model says.
-    pub unit: Option<u64>,
-    /// The closing speed just before an impact, if the model says.
-    pub rel_velocity: Option<f64>,
-    /// Where along a model with extent (a continuum) the event happened,
-    /// if the model says.
-    pub x: Option<f64>,
+    /// What the model labels the event with (a chain's unit and closing
+    /// speed, a place along a continuum), passed on as it is.
+    pub labels: Labels,
 }
 
 /// Receives events as they happen. An error stops the run (status `failed`).
@@ -82,9 +79,7 @@ pub struct RecordedEvent {
     pub energy_after: Option<f64>,
     pub before: Vec<f64>,
     pub after: Vec<f64>,
-    pub unit: Option<u64>,
-    pub rel_velocity: Option<f64>,
-    pub x: Option<f64>,
+    pub labels: Labels,
 }
 
 /// Keeps every event in memory.
@@ -102,9 +97,7 @@ impl Observer for Recorder {
             energy_after: e.energy_after,
             before: e.before.to_vec(),
             after: e.after.to_vec(),
-            unit: e.unit,
-            rel_velocity: e.rel_velocity,
-            x: e.x,
+            labels: e.labels,
         });
         Ok(())
     }

@@ -25,6 +25,7 @@ use crate::engine::adaptive::{StepFailure, Tolerances};
 use crate::engine::dop853::Crossing;
 use crate::engine::error_set::ErrorSet;
 use crate::engine::integrator::{Integrator, Method, Motion, motion};
+use crate::engine::labels::Labels;
 use crate::engine::locate::scan_step;
 use crate::engine::model::{Affects, Direction, HybridModel, Mode};
 use crate::engine::observer::{EventRecord, Observer, SETTLE};
@@ -400,8 +401,8 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
             Ok(())
         } else {
             self.count(mode, slot);
-            let site = model.site(mode, slot, &before);
-            self.record(guard.name, t, jump.mode, &before, site, observer)
+            let labels = model.labels(mode, slot, &before);
+            self.record(guard.name, t, jump.mode, &before, labels, observer)
         };
         self.before = before;
         recorded?;
@@ -518,7 +519,7 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
         t: Time,
         mode_after: Mode,
         before: &[f64],
-        (unit, rel_velocity): (Option<u64>, Option<f64>),
+        labels: Labels,
         observer: &mut O,
     ) -> Result<(), End> {
         let (model, mode) = (self.model, self.mode);
@@ -539,9 +540,7 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
             before,
             names_after: model.state_names(mode_after),
             after: &self.after,
-            unit,
-            rel_velocity,
-            x: None,
+            labels,
         };
         observer
             .on_event(&event)
@@ -580,7 +579,7 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
             .fold(0.0, f64::max);
         self.errors.widen(jump);
         self.settles += 1;
-        let recorded = self.record(SETTLE, t, rest, &before, (None, None), observer);
+        let recorded = self.record(SETTLE, t, rest, &before, Labels::NONE, observer);
         self.state = before;
         recorded?;
         std::mem::swap(&mut self.state, &mut self.after);

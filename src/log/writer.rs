@@ -6,7 +6,7 @@
 
 use std::io::{self, Write};
 
-use crate::engine::{EventRecord, Observer};
+use crate::engine::{EventRecord, Label, Observer};
 
 /// Bytes collected before they are written out.
 const CHUNK: usize = 1 << 16;
@@ -99,18 +99,16 @@ impl<W: Write> Observer for JsonlWriter<W> {
         self.state(e.names_before, e.before);
         self.buffer.extend_from_slice(b",\"after\":");
         self.state(e.names_after, e.after);
-        if let Some(unit) = e.unit {
-            self.buffer.extend_from_slice(b",\"unit\":");
-            self.buffer
-                .extend_from_slice(self.integers.format(unit).as_bytes());
-        }
-        if let Some(v) = e.rel_velocity {
-            self.buffer.extend_from_slice(b",\"rel_velocity\":");
-            self.number(v);
-        }
-        if let Some(x) = e.x {
-            self.buffer.extend_from_slice(b",\"x\":");
-            self.number(x);
+        for (key, value) in e.labels.iter() {
+            self.buffer.push(b',');
+            self.string(key);
+            self.buffer.push(b':');
+            match value {
+                Label::Count(n) => self
+                    .buffer
+                    .extend_from_slice(self.integers.format(n).as_bytes()),
+                Label::Number(x) => self.number(x),
+            }
         }
         self.buffer.extend_from_slice(b"}\n");
         if self.buffer.len() >= CHUNK {
@@ -156,6 +154,7 @@ pub fn cut_to_last_line(path: &std::path::Path) -> io::Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::engine::Labels;
 
     #[test]
     fn a_half_written_line_is_cut_off() {
@@ -189,9 +188,10 @@ mod tests {
             before: &[0.0, -1e-300],
             names_after: &["strain", "strain_rate"],
             after: &[0.0, f64::NAN],
-            unit: Some(7),
-            rel_velocity: Some(0.5),
-            x: Some(-0.25),
+            labels: Labels::NONE
+                .with("unit", Label::Count(7))
+                .with("rel_velocity", Label::Number(0.5))
+                .with("x", Label::Number(-0.25)),
         };
         w.on_event(&event).unwrap();
         w.flush().unwrap();
@@ -208,5 +208,12 @@ mod tests {
         assert_eq!(v["unit"], 7);
         assert_eq!(v["x"], -0.25);
         assert_eq!(v["rel_velocity"], 0.5);
+        // In the order the model gave them, after the state.
+        let (unit, speed, x) = (
+            text.find("\"unit\"").unwrap(),
+            text.find("\"rel_velocity\"").unwrap(),
+            text.find("\"x\"").unwrap(),
+        );
+        assert!(text.find("\"after\"").unwrap() < unit && unit < speed && speed < x);
     }
 }

@@ -189,8 +189,8 @@ fn the_paper_release_is_a_front_at_the_wave_speed_then_one_impact_at_the_wall() 
     let guards: Vec<&str> = log.events.iter().map(|e| e.guard).collect();
     assert_eq!(guards, ["wall", "impact"]);
     let impact = &log.events[1];
-    assert_eq!((impact.t, impact.x), (2.0, Some(-1.0)));
-    assert!((impact.rel_velocity.unwrap() - 0.1).abs() < 1e-15);
+    assert_eq!((impact.t, impact.labels.number("x")), (2.0, Some(-1.0)));
+    assert!((impact.labels.number("rel_velocity").unwrap() - 0.1).abs() < 1e-15);
     // Energy 0.21 - F_cr y_end(0) = 0.01, kept through the impact.
     assert!((outcome.energy_initial.unwrap() - 0.01).abs() < 1e-15);
     assert!(outcome.max_energy_error.unwrap() < 1e-12);

@@ -6,8 +6,8 @@
 use std::cell::Cell;
 
 use flicker::engine::{
-    Affects, Direction, Fired, Flow, Guard, HybridModel, Jump, LocalModel, Mode, Options, Recorder,
-    Status, simulate, simulate_local,
+    Affects, Direction, Fired, Flow, Guard, HybridModel, Jump, Labels, LocalModel, Mode, Options,
+    Recorder, Status, simulate, simulate_local,
 };
 use flicker::time::Time;
 
@@ -135,9 +135,7 @@ impl LocalModel for SilencedAlarm {
         self.silenced = true;
         Ok(Fired {
             affects: guard..2,
-            unit: None,
-            rel_velocity: None,
-            x: None,
+            labels: Labels::NONE,
         })
     }
 }

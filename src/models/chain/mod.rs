@@ -19,7 +19,7 @@
 //! [`modal()`] is the exact solution of the unconstrained chain; [`coarse`]
 //! holds the coarse-grained fields a chain is compared by.
 
-use crate::engine::{Direction, Guard};
+use crate::engine::{Direction, Guard, Label, Labels};
 
 pub mod coarse;
 pub mod collide;
@@ -121,4 +121,12 @@ impl Chain {
     pub fn momentum(&self, x: &[f64]) -> f64 {
         self.mass * x[self.units..].iter().sum::<f64>()
     }
+}
+
+/// What the log says of a chain's event: the unit (1 = next to the wall)
+/// and, for an impact, the closing speed `y'_{n-1} - y'_n` just before it.
+pub fn impact_labels(unit: usize, rel_velocity: Option<f64>) -> Labels {
+    Labels::NONE
+        .with("unit", Label::Count(unit as u64))
+        .with_some("rel_velocity", rel_velocity.map(Label::Number))
 }

@@ -6,9 +6,9 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::Chain;
 use super::collide::cascade;
-use crate::engine::{Flow, Guard, HybridModel, Jump, Mode};
+use super::{Chain, impact_labels};
+use crate::engine::{Flow, Guard, HybridModel, Jump, Labels, Mode};
 
 impl HybridModel for Chain {
     fn dimension(&self) -> usize {
@@ -90,10 +90,10 @@ impl HybridModel for Chain {
         Jump::to(mode)
     }
 
-    fn site(&self, _: Mode, guard: usize, x: &[f64]) -> (Option<u64>, Option<f64>) {
+    fn labels(&self, _: Mode, guard: usize, x: &[f64]) -> Labels {
         let n = self.units;
         let left = if guard > 0 { x[n + guard - 1] } else { 0.0 };
-        (Some(guard as u64 + 1), Some(left - x[n + guard]))
+        impact_labels(guard + 1, Some(left - x[n + guard]))
     }
 
     fn energy(&self, _: Mode, x: &[f64]) -> Option<f64> {

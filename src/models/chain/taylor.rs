@@ -52,12 +52,12 @@
 //! captured nor released over and over.
 
 use crate::engine::taylor::{integral, search_fall};
-use crate::engine::{Direction, Fired, Guard, LocalModel};
+use crate::engine::{Direction, Fired, Guard, Labels, LocalModel};
 use crate::time::Time;
 
-use super::Chain;
 use super::collide::{alone, cascade};
 use super::series::{MAX_COLUMN, Series, blocks};
+use super::{Chain, impact_labels};
 
 /// Window length in scaled time `omega t`: longer windows mean fewer full
 /// re-expansions but longer series and a wider reach per impact.
@@ -407,9 +407,7 @@ impl TaylorChain {
             self.store_window(r_lo, r_hi, w_lo, sigma);
             return Fired {
                 affects: self.guards_of(r_lo, r_hi),
-                unit: Some(unit as u64),
-                rel_velocity: Some(rel_velocity),
-                x: None,
+                labels: impact_labels(unit, Some(rel_velocity)),
             };
         }
     }
@@ -427,9 +425,7 @@ impl TaylorChain {
         self.store_window(r_lo, r_hi, w_lo, sigma);
         Fired {
             affects: self.guards_of(r_lo, r_hi),
-            unit: Some(a as u64),
-            rel_velocity: None,
-            x: None,
+            labels: impact_labels(a, None),
         }
     }
 
@@ -606,9 +602,7 @@ impl TaylorChain {
         self.store_window(r_lo, r_hi, w_lo, sigma);
         Some(Fired {
             affects: self.guards_of(r_lo, r_hi),
-            unit: Some(unit as u64),
-            rel_velocity: None,
-            x: None,
+            labels: impact_labels(unit, None),
         })
     }
 
@@ -679,9 +673,7 @@ impl LocalModel for TaylorChain {
             self.next_window();
             return Ok(Fired {
                 affects: 0..self.guards.len(),
-                unit: None,
-                rel_velocity: None,
-                x: None,
+                labels: Labels::NONE,
             });
         }
         if guard == self.chain.units {

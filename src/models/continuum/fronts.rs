@@ -27,7 +27,7 @@
 
 use std::ops::Range;
 
-use crate::engine::{Direction, Fired, Guard, LocalModel};
+use crate::engine::{Direction, Fired, Guard, Label, Labels, LocalModel};
 use crate::models::chain::coarse::{Coarse, WINDOW_WIDTH};
 use crate::models::continuum::{Continuum, Piece, StringModel};
 use crate::time::Time;
@@ -371,9 +371,9 @@ impl FrontTracking {
     fn fired(&self, affects: Range<usize>, x: f64, rel_velocity: Option<f64>) -> Fired {
         Fired {
             affects,
-            unit: None,
-            rel_velocity,
-            x: Some(x),
+            labels: Labels::NONE
+                .with_some("rel_velocity", rel_velocity.map(Label::Number))
+                .with("x", Label::Number(x)),
         }
     }
 }

@@ -38,7 +38,7 @@
 
 use std::ops::Range;
 
-use crate::engine::{Direction, Fired, Guard, LocalModel};
+use crate::engine::{Direction, Fired, Guard, Labels, LocalModel};
 use crate::models::chain::coarse::{Coarse, WINDOW_WIDTH};
 use crate::models::continuum::{Continuum, Piece, StringModel, hugoniot, rattle};
 use crate::time::Time;
@@ -400,9 +400,7 @@ impl LocalModel for Homogenized {
         self.step(next)?;
         Ok(Fired {
             affects: Range { start: 0, end: 1 },
-            unit: None,
-            rel_velocity: None,
-            x: None,
+            labels: Labels::NONE,
         })
     }
 
