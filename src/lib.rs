@@ -64,6 +64,7 @@ pub mod compare_models;
 pub mod engine;
 pub mod log;
 pub mod models;
+pub mod numerics;
 pub mod plot;
 pub mod runner;
 pub mod scene;

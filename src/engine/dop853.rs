@@ -18,6 +18,7 @@
 #![allow(clippy::needless_range_loop)]
 
 use crate::engine::adaptive::{EmbeddedPair, StepControl, Tolerances, TrialError};
+use crate::engine::integrator::Crossing;
 use crate::engine::model::{HybridModel, Mode};
 
 /// The order of the error estimate in the step size.
@@ -246,16 +247,6 @@ impl DenseStep {
     pub fn end(&self, x: &mut [f64]) {
         x.copy_from_slice(&self.y1);
     }
-}
-
-/// A crossing found on the dense output, `tau` into the step, for
-/// [`Dop853::sharpen`]: how far it may move, the guard, and which of the
-/// guard's values count as having crossed.
-pub struct Crossing<'a> {
-    pub tau: f64,
-    pub reach: f64,
-    pub guard: &'a dyn Fn(&[f64]) -> f64,
-    pub crossed: &'a dyn Fn(f64) -> bool,
 }
 
 /// The integrator's working storage and step-size memory.

@@ -6,7 +6,7 @@
 //! frozen state, or steps of the chosen integrator.
 
 use crate::engine::adaptive::{EmbeddedPair, StepFailure, Tolerances};
-use crate::engine::dop853::{Crossing, Dop853};
+use crate::engine::dop853::Dop853;
 use crate::engine::dopri5::Dopri5;
 use crate::engine::linear::Linear;
 use crate::engine::locate::Interpolant;
@@ -82,6 +82,16 @@ pub fn motion<M: HybridModel + ?Sized>(
         )),
         _ => Ok(Motion::Stepped),
     }
+}
+
+/// A crossing found on a step's dense output, `tau` into the step, for
+/// [`Integrator::sharpen`]: how far it may move, the guard, and which of
+/// the guard's values count as having crossed.
+pub struct Crossing<'a> {
+    pub tau: f64,
+    pub reach: f64,
+    pub guard: &'a dyn Fn(&[f64]) -> f64,
+    pub crossed: &'a dyn Fn(f64) -> bool,
 }
 
 /// One numerical method's working state. One lives per run, so the size of

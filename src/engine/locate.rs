@@ -36,6 +36,7 @@
 //! [`Guard::affine`]: crate::engine::Guard::affine
 
 use crate::engine::model::{Direction, Guard};
+use crate::numerics::polynomial::eval_plain;
 
 /// What one step says about one guard.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -189,12 +190,12 @@ fn scan_piece<const N: usize>(
             .fold(f64::MIN_POSITIVE, |m, v| m.max(v.abs()));
         let misfit = (0..degree)
             .map(|k| (k as f64 + 0.5) * step)
-            .map(|u| (g(a + u * w) - horner(poly, u)).abs())
+            .map(|u| (g(a + u * w) - eval_plain(poly, u)).abs())
             .fold(0.0, f64::max);
         let nearest = turning
             .iter()
             .chain(&[0.0, 1.0])
-            .map(|u| horner(poly, *u).abs())
+            .map(|u| eval_plain(poly, *u).abs())
             .fold(f64::INFINITY, f64::min);
         let crosses = samples.windows(2).any(|p| p[0].signum() != p[1].signum());
         if misfit > FIT_TOLERANCE * scale && (crosses || nearest <= 8.0 * misfit) {
@@ -254,7 +255,7 @@ fn scan_piece<const N: usize>(
         &cuts[..=turning.len()],
         from.1,
         g,
-        &|s| horner(poly, (s - a) / w),
+        &|s| eval_plain(poly, (s - a) / w),
     );
     let local = crossing.map(|s| (s - a) / w);
     let margin = margin(direction, poly, local, turning.as_slice());
@@ -281,8 +282,8 @@ fn margin(direction: Direction, poly: &[f64], crossing: Option<f64>, turning: &[
             let d1 = derivative(poly);
             let d2 = derivative(&d1[..poly.len() - 1]);
             let (slope, curvature) = (
-                horner(&d1[..poly.len() - 1], s),
-                horner(&d2[..poly.len().saturating_sub(2)], s),
+                eval_plain(&d1[..poly.len() - 1], s),
+                eval_plain(&d2[..poly.len().saturating_sub(2)], s),
             );
             if curvature * inward < 0.0 {
                 slope * slope / (2.0 * curvature.abs())
@@ -292,7 +293,7 @@ fn margin(direction: Direction, poly: &[f64], crossing: Option<f64>, turning: &[
         }
         None => turning
             .iter()
-            .map(|&s| horner(poly, s) * -inward)
+            .map(|&s| eval_plain(poly, s) * -inward)
             .filter(|height| *height > 0.0)
             .fold(f64::INFINITY, f64::min),
     }
@@ -433,7 +434,7 @@ fn leaves_zero(direction: Direction, poly: &[f64], samples: &[f64]) -> Leaves {
     let floor = VISIBLE * samples.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
     let mut s = f64::EPSILON;
     while s <= 1.0 {
-        let moved = horner(poly, s) - poly[0];
+        let moved = eval_plain(poly, s) - poly[0];
         if moved.abs() > floor {
             return if moved * sign > 0.0 {
                 Leaves::Inward
@@ -478,10 +479,6 @@ fn derivative(poly: &[f64]) -> [f64; MAX_DEGREE] {
         d[k - 1] = k as f64 * poly[k];
     }
     d
-}
-
-fn horner(poly: &[f64], s: f64) -> f64 {
-    poly.iter().rev().fold(0.0, |acc, c| acc * s + c)
 }
 
 /// At most seven sorted values in `(0, 1)`: the roots or turning points of
@@ -532,11 +529,11 @@ fn roots_in_unit_interval(poly: &[f64]) -> Points {
     };
     let (mut left, mut f_left) = (0.0, p[0]);
     for &right in turning.iter().chain(std::iter::once(&1.0)) {
-        let f_right = horner(p, right);
+        let f_right = eval_plain(p, right);
         if f_left * f_right < 0.0 {
             // Illinois rather than bisection: a septic's roots take a few
             // iterations each, not fifty.
-            let at = |s: f64| horner(p, s);
+            let at = |s: f64| eval_plain(p, s);
             roots.push(refine(left, f_left, right, f_right, &mut { at }, &at));
         } else if f_right == 0.0 && right < 1.0 {
             roots.push(right);

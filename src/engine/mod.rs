@@ -6,7 +6,6 @@ pub mod adaptive;
 pub mod dop853;
 pub mod dopri5;
 pub mod error_set;
-pub mod fused;
 pub mod integrator;
 pub mod labels;
 pub mod linear;
@@ -17,7 +16,6 @@ pub mod observer;
 pub mod queue;
 pub mod simulation;
 pub mod tangent;
-pub mod taylor;
 pub mod verlet;
 pub mod zeno;
 

@@ -22,9 +22,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use crate::engine::adaptive::{StepFailure, Tolerances};
-use crate::engine::dop853::Crossing;
 use crate::engine::error_set::ErrorSet;
-use crate::engine::integrator::{Integrator, Method, Motion, motion};
+use crate::engine::integrator::{Crossing, Integrator, Method, Motion, motion};
 use crate::engine::labels::Labels;
 use crate::engine::locate::scan_step;
 use crate::engine::model::{Affects, Direction, HybridModel, Mode};

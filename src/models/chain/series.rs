@@ -22,7 +22,7 @@
 
 use wide::f64x4;
 
-use crate::engine::fused::mul_add;
+use crate::numerics::fused::mul_add;
 
 /// Longest series a column is gathered into (orders up to 15).
 pub const MAX_COLUMN: usize = 16;

@@ -51,8 +51,8 @@
 //! round-off of zero count as zero both ways, so a unit on the edge is neither
 //! captured nor released over and over.
 
-use crate::engine::taylor::{integral, search_fall};
 use crate::engine::{Direction, Fired, Guard, Labels, LocalModel};
+use crate::numerics::taylor::{integral, search_fall};
 use crate::time::Time;
 
 use super::collide::{alone, cascade};

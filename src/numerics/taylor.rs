@@ -12,7 +12,8 @@
 //! root (then refined), or halved. Pieces are visited left to right, so the
 //! first root found is the earliest; none can be missed.
 
-use crate::engine::fused::mul_add;
+use crate::numerics::fused::mul_add;
+use crate::numerics::polynomial::eval;
 
 /// `(p(s), p'(s), p''(s))` of `p = sum c[k] s^k`.
 pub fn eval2(c: &[f64], s: f64) -> (f64, f64, f64) {
@@ -44,11 +45,6 @@ fn eval2_with_size(c: &[f64], s: f64) -> (f64, f64, f64, f64) {
         size = mul_add(size, a, ck.abs());
     }
     (p, d1, d2, size)
-}
-
-/// `p(s)` of `p = sum c[k] s^k`.
-pub fn eval(c: &[f64], s: f64) -> f64 {
-    c.iter().rev().fold(0.0, |p, &ck| mul_add(p, s, ck))
 }
 
 /// The integral of `p` from 0 to `s`.
