@@ -38,7 +38,7 @@ impl Default for Labels {
 
 impl Labels {
     /// The most labels an event carries.
-    pub const CAPACITY: usize = 4;
+    pub const CAPACITY: usize = 3;
 
     /// No labels.
     pub const NONE: Labels = Labels {

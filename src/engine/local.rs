@@ -294,7 +294,7 @@ impl LocalRun<'_> {
                 before: &[],
                 names_after: &[],
                 after: &[],
-                labels: fired.labels,
+                labels: &fired.labels,
             };
             observer
                 .on_event(&event)
@@ -337,7 +337,7 @@ impl LocalRun<'_> {
                 before: &[],
                 names_after: &[],
                 after: &[],
-                labels: settled.labels,
+                labels: &settled.labels,
             };
             observer
                 .on_event(&event)

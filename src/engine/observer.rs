@@ -23,7 +23,7 @@ pub struct EventRecord<'a> {
     pub after: &'a [f64],
     /// What the model labels the event with (a chain's unit and closing
     /// speed, a place along a continuum), passed on as it is.
-    pub labels: Labels,
+    pub labels: &'a Labels,
 }
 
 /// Receives events as they happen. An error stops the run (status `failed`).
@@ -97,7 +97,7 @@ impl Observer for Recorder {
             energy_after: e.energy_after,
             before: e.before.to_vec(),
             after: e.after.to_vec(),
-            labels: e.labels,
+            labels: *e.labels,
         });
         Ok(())
     }

@@ -401,7 +401,7 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
         } else {
             self.count(mode, slot);
             let labels = model.labels(mode, slot, &before);
-            self.record(guard.name, t, jump.mode, &before, labels, observer)
+            self.record(guard.name, t, jump.mode, &before, &labels, observer)
         };
         self.before = before;
         recorded?;
@@ -518,7 +518,7 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
         t: Time,
         mode_after: Mode,
         before: &[f64],
-        labels: Labels,
+        labels: &Labels,
         observer: &mut O,
     ) -> Result<(), End> {
         let (model, mode) = (self.model, self.mode);
@@ -578,7 +578,7 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
             .fold(0.0, f64::max);
         self.errors.widen(jump);
         self.settles += 1;
-        let recorded = self.record(SETTLE, t, rest, &before, Labels::NONE, observer);
+        let recorded = self.record(SETTLE, t, rest, &before, &Labels::NONE, observer);
         self.state = before;
         recorded?;
         std::mem::swap(&mut self.state, &mut self.after);

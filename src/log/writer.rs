@@ -188,7 +188,7 @@ mod tests {
             before: &[0.0, -1e-300],
             names_after: &["strain", "strain_rate"],
             after: &[0.0, f64::NAN],
-            labels: Labels::NONE
+            labels: &Labels::NONE
                 .with("unit", Label::Count(7))
                 .with("rel_velocity", Label::Number(0.5))
                 .with("x", Label::Number(-0.25)),
