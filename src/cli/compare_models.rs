@@ -39,6 +39,10 @@ pub struct CompareModelsArgs {
     out: Option<PathBuf>,
 }
 
+/// Run `flicker compare-models`: run the release scene as the chain at each
+/// of the sizes asked for and as each continuum, print each model's
+/// distance from the largest chain, and write the CSVs, the JSON summary
+/// and the pictures.
 pub fn compare_models(args: CompareModelsArgs, registry: &Registry) -> Result<Code, Failure> {
     let CompareModelsArgs {
         scene: path,

@@ -81,6 +81,10 @@ pub struct SolverFlags {
     step: Option<f64>,
 }
 
+/// Run `flicker run`: validate the scene and the flags, run it with the
+/// event log streamed to disk, write the summary (and a chain's fields and
+/// ensemble), and print what happened. The exit code follows the run's
+/// status.
 pub fn run(args: RunArgs, registry: &Registry) -> Result<Code, Failure> {
     let RunArgs {
         scene: scene_path,
