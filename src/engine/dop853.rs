@@ -220,6 +220,7 @@ const D: [[(usize, f64); 12]; 4] = [
 /// with `s = tau / h`.
 #[derive(Debug, Clone, Default)]
 pub struct DenseStep {
+    /// The step's size.
     pub h: f64,
     y0: Vec<f64>,
     r: [Vec<f64>; 7],
@@ -252,9 +253,13 @@ impl DenseStep {
 /// [`Dop853::sharpen`]: how far it may move, the guard, and which of the
 /// guard's values count as having crossed.
 pub struct Crossing<'a> {
+    /// Time of the crossing into the step, as the dense output puts it.
     pub tau: f64,
+    /// The largest correction to `tau` that is accepted.
     pub reach: f64,
+    /// The guard, as a function of the state.
     pub guard: &'a dyn Fn(&[f64]) -> f64,
+    /// Whether a value of the guard counts as having crossed.
     pub crossed: &'a dyn Fn(f64) -> bool,
 }
 
@@ -269,6 +274,7 @@ pub struct Dop853 {
 }
 
 impl Dop853 {
+    /// An integrator for states of `dimension` components, at tolerances `tol`.
     pub fn new(dimension: usize, tol: Tolerances) -> Self {
         let v = || vec![0.0; dimension];
         Dop853 {

@@ -28,7 +28,10 @@ pub enum Method {
     /// Dormand and Prince's 8th-order pair DOP853 with these tolerances.
     Dop853(Tolerances),
     /// Stormer-Verlet with this fixed step.
-    Verlet { step: f64 },
+    Verlet {
+        /// The fixed step.
+        step: f64,
+    },
 }
 
 impl Method {
@@ -48,8 +51,11 @@ impl Method {
 /// How one mode moves under a method.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Motion {
+    /// The model's exact flow map and crossing times.
     Exact,
+    /// The state does not move.
     Frozen,
+    /// Steps of the run's integrator, events located on its dense output.
     Stepped,
 }
 
@@ -89,9 +95,13 @@ pub fn motion<M: HybridModel + ?Sized>(
 #[derive(Debug, Clone)]
 #[allow(clippy::large_enum_variant)]
 pub enum Integrator {
+    /// Dormand-Prince 5(4).
     Dopri5(Dopri5),
+    /// Dormand and Prince's DOP853.
     Dop853(Dop853),
+    /// Stormer-Verlet.
     Verlet(Verlet),
+    /// The exact propagator of linear flows.
     Linear(Linear),
 }
 
