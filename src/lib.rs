@@ -58,7 +58,7 @@
 //! assert!((outcome.final_state[0] - eps).abs() < 1e-12);
 //! ```
 
-#![warn(missing_docs)]
+#![deny(missing_docs)]
 
 pub mod cli;
 pub mod compare;

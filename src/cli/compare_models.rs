@@ -34,6 +34,9 @@ pub struct CompareModelsArgs {
     /// Sample times over [0, t_end] for the trace and the front.
     #[arg(long, default_value_t = 121, value_name = "S")]
     samples: usize,
+    // This doc comment is clap's help text, printed as written: the
+    // `<scene name>` in it is a placeholder, not an HTML tag.
+    #[allow(rustdoc::invalid_html_tags)]
     /// Output directory (default: out/<scene name>-models).
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,

@@ -23,6 +23,9 @@ use crate::cli::progress::WithProgress;
 pub struct RunArgs {
     /// The scene file (JSON).
     scene: PathBuf,
+    // This doc comment is clap's help text, printed as written: the
+    // `<scene name>` in it is a placeholder, not an HTML tag.
+    #[allow(rustdoc::invalid_html_tags)]
     /// Output directory (default: out/<scene name>).
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
