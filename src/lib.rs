@@ -58,6 +58,8 @@
 //! assert!((outcome.final_state[0] - eps).abs() < 1e-12);
 //! ```
 
+#![deny(missing_docs)]
+
 pub mod cli;
 pub mod compare;
 pub mod compare_models;

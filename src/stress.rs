@@ -26,29 +26,44 @@ pub enum Verdict {
     /// state and every event time within the bounds the run stated.
     Passed,
     /// The run said it could not be trusted, and why.
-    Failed { reason: String },
+    Failed {
+        /// The run's own reason.
+        reason: String,
+    },
     /// The exact answer's events, but a final state or an event time
     /// further off than the run's own bound: the bound was wrong.
-    Drifted { why: String },
+    Drifted {
+        /// Which error exceeded which bound, by how much.
+        why: String,
+    },
     /// A different answer given without complaint.
-    Wrong { why: String },
+    Wrong {
+        /// How the answer differs: its event count against the exact one.
+        why: String,
+    },
 }
 
 /// One run measured against the exact answer: what [`classify`] judges.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Measured {
+    /// How the run ended.
     pub status: Status,
+    /// Why the run is not plainly completed, if it is not.
     pub reason: Option<String>,
-    /// Events logged (impacts), and the exact answer's count.
+    /// Events logged (impacts).
     pub events: u64,
+    /// The exact answer's count of events (`u64::MAX`: without end).
     pub reference_events: u64,
     /// Largest difference of a final state component from the exact one.
     pub final_error: f64,
     /// Largest difference of an event time from the exact one, over the
     /// events both have.
     pub time_error: Option<f64>,
-    /// The bounds the run stated (`error_bound`, `event_time_bound`).
+    /// The bound the run stated on its final state's error
+    /// ([`Outcome::error_bound`](crate::engine::Outcome::error_bound)).
     pub error_bound: f64,
+    /// The bound it stated on its event times' errors, where it tracks
+    /// them ([`Outcome::event_time_bound`](crate::engine::Outcome::event_time_bound)).
     pub event_time_bound: Option<f64>,
 }
 
@@ -94,11 +109,17 @@ pub fn classify(m: &Measured) -> Verdict {
 /// One run of the table.
 #[derive(Debug, Clone)]
 pub struct Row {
+    /// The case: the stress scene's file name without `.json`.
     pub case: String,
+    /// The method run, by the name `--method` takes.
     pub method: String,
+    /// How the run is judged.
     pub verdict: Verdict,
+    /// What the verdict was judged from.
     pub measured: Measured,
+    /// Largest relative energy error the run saw, for a model with an energy.
     pub energy_error: Option<f64>,
+    /// Wall time of the run, in seconds.
     pub wall_seconds: f64,
 }
 

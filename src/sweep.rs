@@ -33,14 +33,18 @@ const MAX_POINTS: usize = 100_000_000;
 /// One axis of the grid.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Axis {
+    /// The scene key the axis sets, as a dotted path (`initial.energy`).
     pub key: String,
+    /// The values it takes, in order.
     pub values: Vec<f64>,
 }
 
 /// A validated sweep.
 #[derive(Debug, Clone)]
 pub struct Sweep {
+    /// The scene every point starts from, as JSON.
     pub base: Value,
+    /// The grid's axes, the last varying fastest.
     pub axes: Vec<Axis>,
     /// The scene models its points may be of.
     pub registry: Registry,
@@ -49,11 +53,14 @@ pub struct Sweep {
 /// Which points this process runs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Shard {
+    /// Which shard this is, `0 <= index < count`.
     pub index: usize,
+    /// How many shards the points are dealt among.
     pub count: usize,
 }
 
 impl Shard {
+    /// Every point: the shard `0/1`.
     pub const WHOLE: Shard = Shard { index: 0, count: 1 };
 
     /// Parse `I/N` with `0 <= I < N`.
@@ -74,18 +81,27 @@ impl Shard {
 /// One point's result.
 #[derive(Debug, Clone)]
 pub struct Row {
+    /// The point's number, from 0 in grid order.
     pub point: usize,
     /// The grid values, in axis order.
     pub values: Vec<f64>,
+    /// How the run ended: `completed`, another status with its reason
+    /// (`zeno: ...`, `failed: ...`), or `invalid: ...` for a point whose
+    /// scene is refused.
     pub status: String,
+    /// Events the run took.
     pub events: u64,
+    /// Time of the first event (settling aside), if any.
     pub first_impact: Option<f64>,
     /// Mean interval between consecutive impacts.
     pub impact_period: Option<f64>,
     /// The closed form's impact period, for the mechanism.
     pub exact_period: Option<f64>,
+    /// `|impact_period - exact_period| / exact_period`, where both are known.
     pub period_error: Option<f64>,
+    /// Largest relative energy error the run saw, for a model with an energy.
     pub energy_error: Option<f64>,
+    /// Simulated time the run reached.
     pub t_reached: f64,
 }
 

@@ -41,6 +41,9 @@ pub struct AdviseArgs {
     tolerance: f64,
 }
 
+/// Run `flicker advise`: probe the chain scene and each continuum, print
+/// how far each continuum is from the chain and what it costs, and advise
+/// which to run. Returns [`Code::Untrusted`] if a run stopped early.
 pub fn advise(args: AdviseArgs, registry: &Registry) -> Result<Code, Failure> {
     let scene = registry.load(&args.scene).map_err(Failure::bad_input)?;
     let Some(chain) = scene.downcast_ref::<ChainScene>() else {

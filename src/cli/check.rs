@@ -8,6 +8,8 @@ use crate::sweep;
 
 use crate::cli::exit::{Code, Failure};
 
+/// Run `flicker check`: load the scene (or the sweep) at `path`, print what
+/// it describes, and return [`Code::Ok`]; an invalid one is bad input.
 pub fn check(registry: &Registry, path: &Path) -> Result<Code, Failure> {
     if is_sweep(path) {
         return check_sweep(registry, path);

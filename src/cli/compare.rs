@@ -9,6 +9,10 @@ use crate::scene::{Registry, Scene};
 
 use crate::cli::exit::{Code, Failure};
 
+/// Run `flicker compare`: run the scene with each of `methods` (default:
+/// every method its model offers) over `tolerances` or `steps`, print one
+/// line per run, and write `compare.csv`, `compare.svg` and `compare.png`
+/// into `out` (default: `out/<scene name>-compare`).
 pub fn compare(
     registry: &Registry,
     scene_path: &Path,

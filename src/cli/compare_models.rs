@@ -34,11 +34,18 @@ pub struct CompareModelsArgs {
     /// Sample times over [0, t_end] for the trace and the front.
     #[arg(long, default_value_t = 121, value_name = "S")]
     samples: usize,
+    // This doc comment is clap's help text, printed as written: the
+    // `<scene name>` in it is a placeholder, not an HTML tag.
+    #[allow(rustdoc::invalid_html_tags)]
     /// Output directory (default: out/<scene name>-models).
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
 }
 
+/// Run `flicker compare-models`: run the release scene as the chain at each
+/// of the sizes asked for and as each continuum, print each model's
+/// distance from the largest chain, and write the CSVs, the JSON summary
+/// and the pictures.
 pub fn compare_models(args: CompareModelsArgs, registry: &Registry) -> Result<Code, Failure> {
     let CompareModelsArgs {
         scene: path,

@@ -20,6 +20,8 @@ pub enum Format {
     Csv,
 }
 
+/// Run `flicker events`: read the log at `log` and print the events
+/// `filter` keeps in `format`. A closed stdout is not an error.
 pub fn events(log: &Path, filter: Filter, format: Format) -> Result<Code, Failure> {
     for (flag, value) in [("--from", filter.from), ("--to", filter.to)] {
         if value.is_some_and(|t| !t.is_finite()) {

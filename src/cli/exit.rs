@@ -16,11 +16,14 @@ pub enum Code {
 /// An error with its exit code and a one-line message.
 #[derive(Debug)]
 pub struct Failure {
+    /// The exit code the process ends with.
     pub code: Code,
+    /// What went wrong, in one line (printed after `flicker: `).
     pub message: String,
 }
 
 impl Failure {
+    /// A failure for input that cannot be used ([`Code::BadInput`]).
     pub fn bad_input(message: impl ToString) -> Self {
         Failure {
             code: Code::BadInput,
@@ -28,6 +31,8 @@ impl Failure {
         }
     }
 
+    /// A failure for a run that cannot be trusted, or output that could not
+    /// be written ([`Code::Untrusted`]).
     pub fn untrusted(message: impl ToString) -> Self {
         Failure {
             code: Code::Untrusted,

@@ -43,6 +43,7 @@ use crate::scene::Registry;
 
 use crate::cli::exit::{Code, Failure};
 
+/// The command line as clap parses it: one subcommand and its arguments.
 #[derive(Debug, Parser)]
 #[command(
     name = "flicker",

@@ -40,6 +40,9 @@ pub fn plot_dir(dir: &Path) -> Result<Code, Failure> {
     Ok(Code::Ok)
 }
 
+/// Run `flicker plot phase`: check the parameters, draw the phase
+/// portrait into its file, and print how well the level sets and the
+/// simulated trajectories agree.
 pub fn plot(command: PlotCommand) -> Result<Code, Failure> {
     let PlotCommand::Phase {
         eta,

@@ -13,6 +13,7 @@ const STEPS: u64 = 1000;
 
 /// Passes events on to `inner` and shows progress.
 pub struct WithProgress<O> {
+    /// The observer the events are passed on to.
     pub inner: O,
     bar: Option<ProgressBar>,
     t_end: f64,
@@ -20,6 +21,8 @@ pub struct WithProgress<O> {
 }
 
 impl<O> WithProgress<O> {
+    /// Wrap `inner`, with a bar over `[0, t_end]` drawn only if stderr is a
+    /// terminal and not `quiet`.
     pub fn new(inner: O, t_end: f64, quiet: bool) -> Self {
         let bar = (!quiet && std::io::stderr().is_terminal()).then(|| {
             let bar = ProgressBar::new(STEPS);

@@ -23,6 +23,9 @@ use crate::cli::progress::WithProgress;
 pub struct RunArgs {
     /// The scene file (JSON).
     scene: PathBuf,
+    // This doc comment is clap's help text, printed as written: the
+    // `<scene name>` in it is a placeholder, not an HTML tag.
+    #[allow(rustdoc::invalid_html_tags)]
     /// Output directory (default: out/<scene name>).
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
@@ -81,6 +84,10 @@ pub struct SolverFlags {
     step: Option<f64>,
 }
 
+/// Run `flicker run`: validate the scene and the flags, run it with the
+/// event log streamed to disk, write the summary (and a chain's fields and
+/// ensemble), and print what happened. The exit code follows the run's
+/// status.
 pub fn run(args: RunArgs, registry: &Registry) -> Result<Code, Failure> {
     let RunArgs {
         scene: scene_path,

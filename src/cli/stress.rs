@@ -8,6 +8,10 @@ use crate::stress::{Verdict, cases, markdown, run_case, settings};
 use crate::cli::exit::{Code, Failure};
 use crate::scene::Registry;
 
+/// Run `flicker stress`: run every stress scene in `dir` with every method
+/// it offers, each within `wall_seconds`, printing one line per run (and
+/// the Markdown table if `as_markdown`). A run that was silently wrong is
+/// an untrusted failure.
 pub fn stress(
     registry: &Registry,
     dir: &Path,

@@ -11,6 +11,10 @@ use crate::sweep::{self, Shard};
 use crate::cli::exit::{Code, Failure};
 use crate::scene::Registry;
 
+/// Run `flicker sweep`: run the points of the sweep in `file` (all, or one
+/// `shard` given as `I/N`) on `threads` threads (default: one per core)
+/// and write one CSV row per point to `out` (default:
+/// `out/<sweep name>.csv`, or `.shard-I-of-N.csv`).
 pub fn sweep(
     registry: &Registry,
     file: &Path,
@@ -69,6 +73,8 @@ pub fn sweep(
     Ok(Code::Ok)
 }
 
+/// Run `flicker merge`: join the shard CSVs of the sweep in `file` into
+/// `out`, the CSV a single run writes.
 pub fn merge(
     registry: &Registry,
     file: &Path,

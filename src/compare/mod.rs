@@ -27,17 +27,36 @@ pub const STEP_FRACTIONS: [f64; 6] = [1e-1, 3e-2, 1e-2, 3e-3, 1e-3, 3e-4];
 /// One run of one method at one setting.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Row {
+    /// The method run, by the name `--method` takes.
     pub method: String,
+    /// Its tolerance (`rtol = atol`), for the adaptive methods.
     pub tolerance: Option<f64>,
+    /// Its fixed step, for Stormer-Verlet.
     pub step: Option<f64>,
+    /// Wall time of one run, in seconds: the median of the repeats.
     pub wall_seconds: f64,
+    /// Evaluations of the flow ([`Outcome::flow_evaluations`]).
+    ///
+    /// [`Outcome::flow_evaluations`]: crate::engine::Outcome::flow_evaluations
     pub flow_evals: u64,
+    /// Events the run took.
     pub events: u64,
+    /// Largest difference of a final state component from the reference's.
     pub final_error: f64,
+    /// Largest difference of an event time from the reference's, over the
+    /// events both have; `None` if either has none.
     pub max_event_time_error: Option<f64>,
+    /// Largest relative energy error the run saw, for a model with an energy.
     pub energy_error: Option<f64>,
-    /// The bounds the run stated on its final state and event times.
+    /// The bound the run stated on its final state's error
+    /// ([`Outcome::error_bound`]).
+    ///
+    /// [`Outcome::error_bound`]: crate::engine::Outcome::error_bound
     pub error_bound: f64,
+    /// The bound it stated on its event times' errors, where it tracks them
+    /// ([`Outcome::event_time_bound`]).
+    ///
+    /// [`Outcome::event_time_bound`]: crate::engine::Outcome::event_time_bound
     pub event_time_bound: Option<f64>,
     /// `completed`, `zeno`, `failed: <reason>` or `events differ: ...`.
     pub status: String,
@@ -46,7 +65,9 @@ pub struct Row {
 /// Which settings to try for each method.
 #[derive(Debug, Clone)]
 pub struct Plan {
+    /// The methods to run, by name.
     pub methods: Vec<String>,
+    /// Tolerances (`rtol = atol`) to run the adaptive methods at.
     pub tolerances: Vec<f64>,
     /// Fixed steps; `None` picks fractions of the scene's period.
     pub steps: Option<Vec<f64>>,

@@ -11,6 +11,7 @@ use std::sync::Arc;
 pub struct Reference {
     /// How the reference was obtained, for the output.
     pub kind: &'static str,
+    /// The exact state at the end, component by component as the run's.
     pub final_state: Vec<f64>,
     /// Events up to the end (saturating for chattering orbits).
     pub events: u64,

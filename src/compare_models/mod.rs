@@ -119,14 +119,21 @@ fn centres(release: &ContinuumScene) -> Vec<f64> {
 pub struct Track {
     /// `chain N=..` or `continuum (variant)`.
     pub label: String,
+    /// Which model ran.
     pub model: Model,
+    /// How the run ended.
     pub status: Status,
+    /// Why the run is not plainly completed, if it is not.
     pub reason: Option<String>,
+    /// Events the run took.
     pub events: u64,
+    /// Wall time of the run, in seconds.
     pub wall_seconds: f64,
+    /// Largest relative energy error the run saw, if the model has an energy.
     pub max_energy_error: Option<f64>,
-    /// At the release's sample times, then at its snapshots.
+    /// The model at the release's sample times.
     pub samples: Vec<Sample>,
+    /// The model at the release's snapshot times.
     pub snapshots: Vec<Sample>,
 }
 
@@ -143,10 +150,16 @@ impl Track {
 /// A model at one time.
 #[derive(Debug, Clone)]
 pub struct Sample {
+    /// The sample's time.
     pub t: f64,
+    /// The loaded end's displacement.
     pub right_end: f64,
+    /// The energy, with the scene's end load (NaN if the model gives none).
     pub energy: f64,
+    /// Where the front is (the leftmost window centre behind it), once there
+    /// is one.
     pub front: Option<f64>,
+    /// The coarse fields at the comparison's [`CENTRES`] window centres.
     pub coarse: Coarse,
 }
 
@@ -324,13 +337,17 @@ pub struct Distance {
     /// Relative difference of the plateau's strain and velocity: the mean
     /// over the windows behind the reference's front (a window clear of
     /// the front and of the end; at least [`PLATEAU_WINDOWS`] of them) and
-    /// over the sample times while the front is on its way.
+    /// over the sample times while the front is on its way. This is the
+    /// strain's; `None` where no plateau was measured.
     pub plateau_strain: Option<f64>,
+    /// The same for the plateau's velocity.
     pub plateau_velocity: Option<f64>,
-    /// Largest difference of the coarse strain, velocity and hidden energy
-    /// over the window centres and snapshot times.
+    /// Largest difference of the coarse strain over the window centres and
+    /// snapshot times.
     pub window_strain: f64,
+    /// The same for the coarse velocity.
     pub window_velocity: f64,
+    /// The same for the hidden energy.
     pub hidden_energy: f64,
     /// Largest `|energy - reference|` relative to the reference's initial
     /// energy.
@@ -442,7 +459,9 @@ pub fn front_speed(track: &Track) -> Option<f64> {
 /// One model of a comparison.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Model {
+    /// The chain of this many units.
     Chain(usize),
+    /// The continuum of this variant.
     Continuum(Variant),
 }
 

@@ -9,7 +9,9 @@ use crate::engine::model::{HybridModel, Mode};
 /// Relative and absolute error tolerances of an adaptive step.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Tolerances {
+    /// Relative tolerance: the error allowed per unit of a component's size.
     pub rtol: f64,
+    /// Absolute tolerance: the error allowed a component of size zero.
     pub atol: f64,
 }
 
@@ -36,7 +38,10 @@ impl Tolerances {
 pub enum StepFailure {
     /// The error control asked for a step below `h_min`: the solution is
     /// (nearly) singular here.
-    Collapsed { h: f64 },
+    Collapsed {
+        /// The step size asked for.
+        h: f64,
+    },
     /// The right-hand side returned a non-finite value.
     NonFinite,
     /// The method cannot integrate this mode (said why).
@@ -50,6 +55,7 @@ pub trait EmbeddedPair {
     /// start) and a scratch state.
     fn parts(&mut self) -> (&mut StepControl, &mut [Vec<f64>], &mut [f64]);
 
+    /// The step control, to read.
     fn control(&self) -> &StepControl;
 
     /// One trial step of size `h` from `y0`, and its error.
@@ -109,6 +115,7 @@ pub trait EmbeddedPair {
 /// The step-size memory and rules of an adaptive pair.
 #[derive(Debug, Clone)]
 pub struct StepControl {
+    /// The tolerances trials are judged by.
     pub tol: Tolerances,
     /// Order of the pair's error estimate in the step size.
     order: i32,
@@ -130,11 +137,17 @@ pub struct StepControl {
 /// non-finite when the trial blew up) and its largest component, absolute.
 #[derive(Debug, Clone, Copy)]
 pub struct TrialError {
+    /// The scaled error norm: the trial is accepted if it is at most 1.
     pub norm: f64,
+    /// The error's largest component, absolute.
     pub largest: f64,
 }
 
 impl StepControl {
+    /// Step control for a pair whose error estimate is of order `order` in
+    /// the step size: after an accepted trial a step grows by at most the
+    /// factor `growth`, after a rejected one it shrinks by no factor smaller
+    /// than `shrinkage`.
     pub fn new(tol: Tolerances, order: i32, growth: f64, shrinkage: f64) -> Self {
         StepControl {
             tol,

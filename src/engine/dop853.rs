@@ -221,6 +221,7 @@ const D: [[(usize, f64); 12]; 4] = [
 /// with `s = tau / h`.
 #[derive(Debug, Clone, Default)]
 pub struct DenseStep {
+    /// The step's size.
     pub h: f64,
     y0: Vec<f64>,
     r: [Vec<f64>; 7],
@@ -260,6 +261,7 @@ pub struct Dop853 {
 }
 
 impl Dop853 {
+    /// An integrator for states of `dimension` components, at tolerances `tol`.
     pub fn new(dimension: usize, tol: Tolerances) -> Self {
         let v = || vec![0.0; dimension];
         Dop853 {

@@ -53,6 +53,7 @@ const D7: f64 = 69997945.0 / 29380423.0;
 /// The dense output of one accepted step, as a function of `tau in [0, h]`.
 #[derive(Debug, Clone, Default)]
 pub struct DenseStep {
+    /// The step's size.
     pub h: f64,
     r: [Vec<f64>; 5],
     /// The step's end state as the integrator computed it (the polynomial
@@ -88,6 +89,7 @@ pub struct Dopri5 {
 }
 
 impl Dopri5 {
+    /// An integrator for states of `dimension` components, at tolerances `tol`.
     pub fn new(dimension: usize, tol: Tolerances) -> Self {
         let v = || vec![0.0; dimension];
         Dopri5 {

@@ -28,7 +28,10 @@ pub enum Method {
     /// Dormand and Prince's 8th-order pair DOP853 with these tolerances.
     Dop853(Tolerances),
     /// Stormer-Verlet with this fixed step.
-    Verlet { step: f64 },
+    Verlet {
+        /// The fixed step.
+        step: f64,
+    },
 }
 
 impl Method {
@@ -48,8 +51,11 @@ impl Method {
 /// How one mode moves under a method.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Motion {
+    /// The model's exact flow map and crossing times.
     Exact,
+    /// The state does not move.
     Frozen,
+    /// Steps of the run's integrator, events located on its dense output.
     Stepped,
 }
 
@@ -88,9 +94,13 @@ pub fn motion<M: HybridModel + ?Sized>(
 /// [`Integrator::sharpen`]: how far it may move, the guard, and which of
 /// the guard's values count as having crossed.
 pub struct Crossing<'a> {
+    /// Time of the crossing into the step, as the dense output puts it.
     pub tau: f64,
+    /// The largest correction to `tau` that is accepted.
     pub reach: f64,
+    /// The guard, as a function of the state.
     pub guard: &'a dyn Fn(&[f64]) -> f64,
+    /// Whether a value of the guard counts as having crossed.
     pub crossed: &'a dyn Fn(f64) -> bool,
 }
 
@@ -99,9 +109,13 @@ pub struct Crossing<'a> {
 #[derive(Debug, Clone)]
 #[allow(clippy::large_enum_variant)]
 pub enum Integrator {
+    /// Dormand-Prince 5(4).
     Dopri5(Dopri5),
+    /// Dormand and Prince's DOP853.
     Dop853(Dop853),
+    /// Stormer-Verlet.
     Verlet(Verlet),
+    /// The exact propagator of linear flows.
     Linear(Linear),
 }
 

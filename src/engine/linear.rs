@@ -15,6 +15,8 @@ use nalgebra::{DMatrix, DVector};
 use crate::engine::adaptive::StepFailure;
 use crate::engine::model::{HybridModel, Mode};
 
+/// The exact propagator's working state: the augmented matrix of the
+/// current mode, and the current step.
 #[derive(Debug, Clone)]
 pub struct Linear {
     /// The mode whose `M` is cached.
@@ -40,6 +42,7 @@ pub struct Linear {
 const GRID: usize = 8;
 
 impl Linear {
+    /// A propagator for states of `dimension` components.
     pub fn new(dimension: usize) -> Self {
         Linear {
             mode: None,
@@ -54,12 +57,17 @@ impl Linear {
         }
     }
 
+    /// Nothing to forget: a step does not depend on the one before.
     pub fn restart(&mut self) {}
 
+    /// The length of the last step taken.
     pub fn h(&self) -> f64 {
         self.h
     }
 
+    /// One step from `y0` in `mode`, as long as `h_max` and the bound
+    /// `|M| h <= 1/2` allow; fails if the mode's flow is not linear or the
+    /// state stops being finite.
     pub fn step<M: HybridModel + ?Sized>(
         &mut self,
         model: &M,
@@ -140,6 +148,7 @@ impl Linear {
         self.evaluations.set(self.evaluations.get() + 1);
     }
 
+    /// Propagator evaluations so far: the matrix exponentials taken.
     pub fn evaluations(&self) -> u64 {
         self.evaluations.get()
     }
@@ -149,6 +158,7 @@ impl Linear {
         8.0 * f64::EPSILON * self.y1.iter().fold(1.0, |m: f64, x| m.max(x.abs()))
     }
 
+    /// The state at the end of the step.
     pub fn end(&self, x: &mut [f64]) {
         x.copy_from_slice(&self.y1);
     }

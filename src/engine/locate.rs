@@ -110,7 +110,10 @@ pub enum Interpolant {
     /// A polynomial of at most this degree (at most seven) in the step
     /// time: the polynomial through `degree + 1` samples of an affine guard
     /// is the guard itself.
-    Polynomial { degree: usize },
+    Polynomial {
+        /// The bound on the degree, at most seven.
+        degree: usize,
+    },
     /// Anything else (the exact linear propagator): pieces are halved until
     /// a quartic fits.
     Other,

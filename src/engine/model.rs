@@ -43,6 +43,7 @@ impl Direction {
 pub struct Guard {
     /// Name used in the event log and the summary (`impact`, `bounce`...).
     pub name: &'static str,
+    /// Which way the guard must cross zero to fire.
     pub direction: Direction,
     /// The guard is an affine function of the state. Along a polynomial
     /// interpolant it is then a polynomial of the same degree, whose roots
@@ -109,13 +110,20 @@ pub enum Affects {
     All,
     /// Only guards `first..first + count` are re-predicted; the others keep
     /// their queued times (only meaningful for [`Flow::Exact`] modes).
-    Range { first: usize, count: usize },
+    Range {
+        /// The first guard re-predicted.
+        first: usize,
+        /// How many guards, from `first` on.
+        count: usize,
+    },
 }
 
 /// What a reset did: the mode after it, and which predictions it spoiled.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Jump {
+    /// The mode after the reset.
     pub mode: Mode,
+    /// Which guards' predictions the reset spoiled.
     pub affects: Affects,
 }
 

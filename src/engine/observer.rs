@@ -11,15 +11,25 @@ use crate::engine::labels::Labels;
 pub struct EventRecord<'a> {
     /// 1-based position in the log.
     pub seq: u64,
+    /// Time of the event.
     pub t: f64,
+    /// Name of the guard that fired ([`SETTLE`] for a Zeno settling).
     pub guard: &'static str,
+    /// Name of the mode before the reset.
     pub mode_before: &'static str,
+    /// Name of the mode after the reset.
     pub mode_after: &'static str,
+    /// The model's energy just before the reset, if it has one.
     pub energy_before: Option<f64>,
+    /// The model's energy just after the reset, if it has one.
     pub energy_after: Option<f64>,
+    /// Names of the components of `before`.
     pub names_before: &'a [&'static str],
+    /// The state just before the reset (empty for an event-local model).
     pub before: &'a [f64],
+    /// Names of the components of `after`.
     pub names_after: &'a [&'static str],
+    /// The state just after the reset (empty for an event-local model).
     pub after: &'a [f64],
     /// What the model labels the event with (a chain's unit and closing
     /// speed, a place along a continuum), passed on as it is.
@@ -28,6 +38,7 @@ pub struct EventRecord<'a> {
 
 /// Receives events as they happen. An error stops the run (status `failed`).
 pub trait Observer {
+    /// Receive one event. An error stops the run.
     fn on_event(&mut self, event: &EventRecord) -> std::io::Result<()>;
 
     /// Called now and then (every few thousand turns of the loop) with the
@@ -73,18 +84,26 @@ impl Observer for EventTimes {
 /// An event copied out of the engine.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RecordedEvent {
+    /// Time of the event.
     pub t: f64,
+    /// Name of the guard that fired.
     pub guard: &'static str,
+    /// The model's energy just before the reset, if it has one.
     pub energy_before: Option<f64>,
+    /// The model's energy just after the reset, if it has one.
     pub energy_after: Option<f64>,
+    /// The state just before the reset.
     pub before: Vec<f64>,
+    /// The state just after the reset.
     pub after: Vec<f64>,
+    /// What the model labelled the event with.
     pub labels: Labels,
 }
 
 /// Keeps every event in memory.
 #[derive(Debug, Clone, Default)]
 pub struct Recorder {
+    /// The events, in the order they happened.
     pub events: Vec<RecordedEvent>,
 }
 

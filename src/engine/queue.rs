@@ -19,6 +19,8 @@ use crate::time::Time;
 
 type Priority = Reverse<u128>;
 
+/// Predicted events, one slot per guard, popped earliest first (ties in
+/// slot order), each with its exact time.
 #[derive(Default)]
 pub struct EventQueue {
     /// Slots are small integers: a fast non-cryptographic hash will do.
@@ -71,6 +73,7 @@ impl EventQueue {
         Some((slot, self.exact[slot]))
     }
 
+    /// Forget every prediction.
     pub fn clear(&mut self) {
         self.queue.clear();
         self.queued.fill(false);

@@ -82,6 +82,8 @@ pub enum Status {
 }
 
 impl Status {
+    /// The status as the summary writes it: `completed`, `zeno`, `failed` or
+    /// `interrupted`.
     pub fn as_str(self) -> &'static str {
         match self {
             Status::Completed => "completed",
@@ -95,22 +97,34 @@ impl Status {
 /// What a run did.
 #[derive(Debug, Clone)]
 pub struct Outcome {
+    /// How the run ended.
     pub status: Status,
     /// Why the run is not plainly `completed`.
     pub reason: Option<String>,
+    /// The simulated time the run was asked to reach.
     pub t_end: f64,
+    /// The simulated time it reached: `t_end` unless it stopped early.
     pub t_reached: f64,
     /// Non-internal events (impacts and other resets).
     pub events: u64,
+    /// Events per guard name; Zeno settlings under [`SETTLE`].
     pub events_by_guard: BTreeMap<&'static str, u64>,
+    /// Whether a Zeno accumulation was recognised, whether the run then
+    /// settled and went on or stopped there.
     pub zeno: bool,
+    /// The model's energy at the start, if it has one.
     pub energy_initial: Option<f64>,
+    /// The model's energy at the end, if it has one.
     pub energy_final: Option<f64>,
     /// Largest `|E - E(0)| / scale` seen at any event and at the end.
     pub max_energy_error: Option<f64>,
+    /// The mode the run ended in.
     pub final_mode: Mode,
+    /// That mode's name.
     pub final_mode_name: &'static str,
+    /// Names of the components of `final_state`.
     pub final_state_names: Vec<&'static str>,
+    /// The state at `t_reached`.
     pub final_state: Vec<f64>,
     /// Evaluations of the flow: right-hand sides and propagators of
     /// numerical methods, flow maps and crossing times of exact ones.
@@ -127,6 +141,7 @@ pub struct Outcome {
     /// allowance of [`ROUNDOFF_ULPS`] ulps of the time reached; `None`
     /// where the errors are not tracked.
     pub event_time_bound: Option<f64>,
+    /// Wall time the run took, in seconds.
     pub wall_seconds: f64,
 }
 

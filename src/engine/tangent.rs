@@ -37,6 +37,7 @@ fn step_for(x: f64) -> f64 {
 }
 
 impl Tangents {
+    /// Scratch for a model of `n` state components.
     pub fn new(n: usize) -> Self {
         Tangents {
             n,

@@ -13,6 +13,8 @@
 use crate::engine::adaptive::StepFailure;
 use crate::engine::model::{HybridModel, Mode};
 
+/// Stormer-Verlet's working state: the fixed step and the current step's
+/// ends.
 #[derive(Debug, Clone)]
 pub struct Verlet {
     /// The fixed step; the last step before the end of the run is shorter.
@@ -25,6 +27,7 @@ pub struct Verlet {
     f0: Vec<f64>,
     f1: Vec<f64>,
     fsal: bool,
+    /// Right-hand-side evaluations so far.
     pub evaluations: u64,
 }
 
@@ -44,14 +47,20 @@ impl Verlet {
         }
     }
 
+    /// Forget the previous step: the next one starts from a state that was
+    /// not this method's last output (after a reset).
     pub fn restart(&mut self) {
         self.fsal = false;
     }
 
+    /// The length of the last step taken.
     pub fn h(&self) -> f64 {
         self.h
     }
 
+    /// One step from `y0` in `mode`: the fixed step, or `h_max` if that is
+    /// shorter; fails if the fixed step is below `h_min` or the state stops
+    /// being finite.
     pub fn step<M: HybridModel + ?Sized>(
         &mut self,
         model: &M,
@@ -120,6 +129,7 @@ impl Verlet {
         self.h * self.h * change / 3.0
     }
 
+    /// The state at the end of the step, exactly as the method computed it.
     pub fn end(&self, x: &mut [f64]) {
         x.copy_from_slice(&self.y1);
     }

@@ -43,6 +43,7 @@ pub struct ZenoWatch {
 }
 
 impl ZenoWatch {
+    /// A watch for a run that ends at `t_end`, with nothing seen yet.
     pub fn new(t_end: f64) -> Self {
         ZenoWatch {
             t_end,

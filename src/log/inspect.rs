@@ -11,12 +11,16 @@ use crate::log::reader::LoggedEvent;
 /// Which events to keep.
 #[derive(Debug, Clone, Default)]
 pub struct Filter {
+    /// Keep only events of the guard of this name.
     pub guard: Option<String>,
+    /// Keep only events at `t >= from`.
     pub from: Option<f64>,
+    /// Keep only events at `t <= to`.
     pub to: Option<f64>,
 }
 
 impl Filter {
+    /// Whether `e` passes every condition that is set.
     pub fn keeps(&self, e: &LoggedEvent) -> bool {
         self.guard.as_ref().is_none_or(|g| *g == e.guard)
             && self.from.is_none_or(|t| e.t >= t)
@@ -27,9 +31,13 @@ impl Filter {
 /// Smallest, mean and largest of a stream of values.
 #[derive(Debug, Clone, Default, Serialize)]
 pub struct Spread {
+    /// How many values.
     pub count: u64,
+    /// The smallest, once there is a value.
     pub min: Option<f64>,
+    /// The mean, once there is a value.
     pub mean: Option<f64>,
+    /// The largest, once there is a value.
     pub max: Option<f64>,
     #[serde(skip)]
     sum: f64,
@@ -48,8 +56,11 @@ impl Spread {
 /// What one guard did.
 #[derive(Debug, Clone, Default, Serialize)]
 pub struct GuardSummary {
+    /// Events of this guard.
     pub count: u64,
+    /// Time of its first event.
     pub first_t: Option<f64>,
+    /// Time of its last event.
     pub last_t: Option<f64>,
     /// Between consecutive events of this guard.
     pub intervals: Spread,
@@ -58,30 +69,41 @@ pub struct GuardSummary {
 /// The event with the largest `|energy_after - energy_before|`.
 #[derive(Debug, Clone, Serialize)]
 pub struct EnergyJump {
+    /// `|energy_after - energy_before|`.
     pub jump: f64,
+    /// The event's `seq`.
     pub seq: u64,
+    /// The event's time.
     pub t: f64,
+    /// The guard that fired.
     pub guard: String,
 }
 
 /// A summary of the events a filter kept.
 #[derive(Debug, Clone, Default, Serialize)]
 pub struct Summary {
+    /// Events kept.
     pub events: u64,
+    /// Time of the first kept event.
     pub first_t: Option<f64>,
+    /// Time of the last kept event.
     pub last_t: Option<f64>,
+    /// What each guard did, by guard name.
     pub by_guard: BTreeMap<String, GuardSummary>,
     /// Between consecutive kept events, whatever their guard.
     pub intervals: Spread,
     /// The same intervals counted per decade: `"1e-3"` holds those in
     /// `[1e-3, 1e-2)`; `"0"` holds simultaneous events.
     pub interval_histogram: BTreeMap<String, u64>,
+    /// The largest energy jump across a reset, among events that log their
+    /// energy on both sides.
     pub largest_energy_jump: Option<EnergyJump>,
     /// Events whose time is earlier than the one before (should be none).
     pub out_of_order: u64,
 }
 
 impl Summary {
+    /// Count `e` in, as the next kept event.
     pub fn add(&mut self, e: &LoggedEvent) {
         if let Some(last) = self.last_t {
             if e.t < last {

@@ -10,10 +10,15 @@ use serde::Deserialize;
 /// The fields of a log line that inspection uses; others are ignored.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 pub struct LoggedEvent {
+    /// 1-based position of the event in the run.
     pub seq: u64,
+    /// Time of the event.
     pub t: f64,
+    /// The guard that fired.
     pub guard: String,
+    /// The model's energy just before the reset, if it has one.
     pub energy_before: Option<f64>,
+    /// The model's energy just after the reset, if it has one.
     pub energy_after: Option<f64>,
     /// A chain's unit.
     #[serde(default)]
@@ -26,8 +31,11 @@ pub struct LoggedEvent {
 /// A log that could not be read: which file, which line, why.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LogError {
+    /// The log file.
     pub path: PathBuf,
+    /// The 1-based line at fault, if the fault is in a line.
     pub line: Option<u64>,
+    /// What is wrong.
     pub reason: String,
 }
 

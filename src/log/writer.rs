@@ -11,6 +11,9 @@ use crate::engine::{EventRecord, Label, Observer};
 /// Bytes collected before they are written out.
 const CHUNK: usize = 1 << 16;
 
+/// An [`Observer`] that writes each event as one line of `events.jsonl`
+/// to `out`, in chunks of whole lines. Call [`JsonlWriter::flush`] at the
+/// end for the last of them.
 pub struct JsonlWriter<W: Write> {
     out: W,
     buffer: Vec<u8>,
@@ -19,6 +22,7 @@ pub struct JsonlWriter<W: Write> {
 }
 
 impl<W: Write> JsonlWriter<W> {
+    /// A writer to `out`, with nothing written yet.
     pub fn new(out: W) -> Self {
         JsonlWriter {
             out,

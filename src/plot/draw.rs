@@ -40,20 +40,28 @@ pub const PALETTE: [RGBColor; 6] = [
     RGBColor(23, 190, 207),
 ];
 
-/// One curve, with the label drawn at its start (if any).
+/// One curve, with its label (if any).
 #[derive(Debug, Clone)]
 pub struct Curve {
+    /// The label, drawn at the curve's upper-right end.
     pub label: Option<String>,
+    /// The points `(x, y)`, in the order they are joined; points that are
+    /// not finite are left out.
     pub points: Vec<(f64, f64)>,
+    /// How the curve is drawn.
     pub style: Style,
 }
 
 /// A whole figure.
 #[derive(Debug, Clone)]
 pub struct Figure {
+    /// The title above the plot.
     pub title: String,
+    /// The horizontal axis's label.
     pub x_label: String,
+    /// The vertical axis's label.
     pub y_label: String,
+    /// The curves, drawn in this order.
     pub curves: Vec<Curve>,
     /// Points with `|y|` above this are left out (rates that diverge).
     pub y_limit: Option<f64>,

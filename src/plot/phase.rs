@@ -25,11 +25,16 @@ use crate::plot::draw::{Curve, Figure, Style};
 /// Which phase plane.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Plane {
+    /// `(eps, eps')`, level sets of `H0` (32), with the constraint and the
+    /// flips at impacts.
     Strain,
+    /// `(theta, p0)` with `p0` from (29), level sets of (26).
     Canonical,
+    /// `(theta, theta')`, where `theta'` diverges at `theta = 0`.
     Theta,
     /// The linearised plane, with `f1` (`eta = 1 + e^2 f1`).
     Linear {
+        /// The linearised load parameter.
         f1: f64,
     },
 }
@@ -38,6 +43,7 @@ pub enum Plane {
 /// started on.
 #[derive(Debug, Clone)]
 pub struct Portrait {
+    /// The figure: level sets and trajectories, ready to draw.
     pub figure: Figure,
     /// `(level, points)` of each drawn level-set curve (a set split at
     /// `theta = 0` gives two), the same points as in the figure, with the

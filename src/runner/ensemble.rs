@@ -30,25 +30,36 @@ const MAX_VALUES: usize = 100_000_000;
 /// What the ensemble found.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Ensemble {
+    /// Number of perturbed copies run.
     pub copies: usize,
+    /// Largest perturbation of a unit's initial strain, relative to the
+    /// scene's largest initial strain.
     pub perturb: f64,
+    /// Seed of the perturbations.
     pub seed: u64,
     /// First sample time at which unit strains of two copies differ by
     /// more than [`HORIZON`], if any before `t_end`.
     pub horizon: Option<f64>,
     /// Spacing of the sample times: the horizon's resolution.
     pub resolution: f64,
+    /// The spread at each sample time.
     pub spread: Vec<Spread>,
 }
 
 /// The largest difference between copies at one sample time.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Spread {
+    /// The sample time.
     pub t: f64,
+    /// Largest difference of a unit's strain.
     pub unit_strain: f64,
+    /// Largest difference of a window's coarse strain.
     pub window_strain: f64,
+    /// Largest difference of a window's coarse velocity.
     pub window_velocity: f64,
+    /// Largest difference of a window's hidden energy.
     pub hidden_energy: f64,
+    /// Largest difference of the loaded end's displacement.
     pub right_end: f64,
     /// `None` while some copy has no front (docs/physics.md s.6) yet.
     pub front: Option<f64>,

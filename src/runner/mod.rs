@@ -18,6 +18,7 @@ pub use fields::{CLASSICAL_MAX_UNITS, Classical, FieldOutputs, Profile, TraceRow
 /// A finished run and what the summary needs to say about it.
 #[derive(Debug, Clone)]
 pub struct Report {
+    /// What the engine reported: how the run ended, its events, its errors.
     pub outcome: Outcome,
     /// The method used, in the names `flicker compare` uses (`exact`, `dopri5`).
     pub method: &'static str,

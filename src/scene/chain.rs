@@ -43,25 +43,45 @@ pub const MAX_UNITS: u64 = 1_000_000;
 /// scans N guards (the linear propagator a dense 2N x 2N exponential).
 pub const MAX_ODE_UNITS: usize = 2000;
 
+/// A validated chain scene: `units` equal units on a string, released
+/// from one end load to another at `t = 0` (docs/physics.md s.4, scene
+/// units).
 #[derive(Debug, Clone, PartialEq)]
 pub struct ChainScene {
+    /// N, the number of units (1 to [`MAX_UNITS`]).
     pub units: usize,
+    /// Length `L > 0` of the string.
     pub length: f64,
+    /// Wave speed `c > 0`: `F_cr = c^2`, node mass `L / N`, unit stiffness
+    /// `F_cr N / L`.
     pub wave_speed: f64,
+    /// End load over `F_cr` before the release: the units start at strain
+    /// `load_before - 1` unless `initial` says otherwise.
     pub load_before: f64,
+    /// End load over `F_cr` after the release at `t = 0`; energies use it.
     pub load_after: f64,
+    /// Whether the units are unilateral (`eps >= 0`, impacts); `false` is the
+    /// classical linear chain.
     pub constraint: bool,
+    /// Simulated time to run to, `> 0`.
     pub t_end: f64,
     /// Sorted times for `profiles.json`.
     pub snapshots: Vec<f64>,
+    /// How many rows `trace.csv` has, at `linspace(0, t_end, samples)`.
     pub samples: usize,
-    /// Initial unit strains and node velocities, N each.
+    /// Initial unit strains, N of them (`>= 0` under the constraint).
     pub strain: Vec<f64>,
+    /// Initial velocities of nodes 1 to N (node 0, the wall, does not move).
     pub velocity: Vec<f64>,
+    /// The solver as written (the command line may override parts of it).
     pub solver: SolverSpec,
+    /// The method `solver` resolves to ([`Method::Auto`]: the exact flow).
     pub method: Method,
+    /// The tolerances `solver` resolves to.
     pub tolerances: Tolerances,
+    /// Event budget: the run fails after this many events (default 10^9).
     pub max_events: u64,
+    /// Free text about the scene, if given.
     pub description: Option<String>,
 }
 

@@ -41,23 +41,38 @@ pub const MAX_CELLS: u64 = 1_000_000;
 /// one event, so this keeps an event to milliseconds).
 pub const MAX_FINITE_VOLUMES: usize = 20_000;
 
+/// A validated continuum scene: the chain scene's string without its
+/// units, run as the continuum `variant` (docs/physics.md s.5, scene
+/// units).
 #[derive(Debug, Clone, PartialEq)]
 pub struct ContinuumScene {
+    /// Which continuum: the paper's (front tracking) or the homogenized
+    /// string (finite volumes).
     pub variant: Variant,
+    /// Length `L > 0` of the string.
     pub length: f64,
+    /// Wave speed `c > 0`: `F_cr = c^2`.
     pub wave_speed: f64,
+    /// End load over `F_cr` before the release: the string starts at strain
+    /// `load_before - 1` unless `initial` says otherwise.
     pub load_before: f64,
+    /// End load over `F_cr` after the release at `t = 0`.
     pub load_after: f64,
+    /// Whether `eps >= 0` is enforced; `false` is the classical string.
     pub constraint: bool,
+    /// Simulated time to run to, `> 0`.
     pub t_end: f64,
     /// Sorted times for `profiles.json`.
     pub snapshots: Vec<f64>,
+    /// How many rows `trace.csv` has, at `linspace(0, t_end, samples)`.
     pub samples: usize,
     /// Points along the string in `profiles.json`.
     pub resolution: usize,
     /// The initial state, one piece per equal cell.
     pub cells: Vec<Piece>,
+    /// Event budget: the run fails after this many events (default 10^9).
     pub max_events: u64,
+    /// Free text about the scene, if given.
     pub description: Option<String>,
 }
 

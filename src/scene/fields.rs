@@ -42,11 +42,13 @@ impl<'a> Fields<'a> {
         self.map.contains_key(key)
     }
 
+    /// The value of `key`, if present; either way `key` counts as known.
     pub fn optional(&mut self, key: &'static str) -> Option<&'a Value> {
         self.seen.push(key);
         self.map.get(key)
     }
 
+    /// The value of `key`, or an error saying it is missing.
     pub fn required(&mut self, key: &'static str) -> Result<&'a Value, SceneError> {
         self.optional(key)
             .ok_or_else(|| SceneError::field(&self.path(key), "is missing".into()))
@@ -58,6 +60,7 @@ impl<'a> Fields<'a> {
         self.as_number(key, value)
     }
 
+    /// A finite number, if `key` is present.
     pub fn optional_number(&mut self, key: &'static str) -> Result<Option<f64>, SceneError> {
         self.optional(key)
             .map(|v| self.as_number(key, v))
@@ -75,6 +78,8 @@ impl<'a> Fields<'a> {
         self.check(key, x, rule, ok)
     }
 
+    /// `x`, the value of `key`, if it satisfies `ok`; otherwise an error
+    /// saying it must be `rule`.
     pub fn check(
         &self,
         key: &str,
@@ -92,11 +97,13 @@ impl<'a> Fields<'a> {
         }
     }
 
+    /// A string.
     pub fn string(&mut self, key: &'static str) -> Result<&'a str, SceneError> {
         let value = self.required(key)?;
         self.as_string(key, value)
     }
 
+    /// A string, if `key` is present.
     pub fn optional_string(&mut self, key: &'static str) -> Result<Option<&'a str>, SceneError> {
         self.optional(key)
             .map(|v| self.as_string(key, v))

@@ -36,33 +36,68 @@ use crate::scene::fields::{Fields, kind};
 use crate::scene::solver::SolverSpec;
 use crate::scene::{Scene, SceneError, SceneModel};
 
+/// Which equations describe the mechanism.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Formulation {
+    /// The strain formulation: a hybrid automaton whose flight has a
+    /// closed form ([`StrainMechanism`](crate::models::mechanism::StrainMechanism)).
     Strain,
+    /// The angle formulation: the smooth equation (8), integrated
+    /// numerically, changing chart near `theta = 0` or not
+    /// ([`AngleMechanism`](crate::models::mechanism::AngleMechanism)).
     Angle(Charts),
 }
 
 /// The initial state as the scene gave it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Initial {
-    Strain { strain: f64, rate: f64 },
-    Energy { energy: f64, phase: Phase },
-    Angle { angle: f64, rate: f64 },
+    /// A strain and its rate.
+    Strain {
+        /// The strain `eps >= 0`.
+        strain: f64,
+        /// The strain rate `eps'`.
+        rate: f64,
+    },
+    /// An energy and where on its orbit to start.
+    Energy {
+        /// The energy `H0`.
+        energy: f64,
+        /// Where on the orbit of that energy to start.
+        phase: Phase,
+    },
+    /// An angle and its rate (the angle formulation only).
+    Angle {
+        /// The angle `theta`, `|theta| < pi/2`.
+        angle: f64,
+        /// The angle rate `theta'`.
+        rate: f64,
+    },
 }
 
+/// A validated mechanism scene: one bistable mechanism, its formulation,
+/// its initial state and how to run it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MechanismScene {
+    /// Strain or angle formulation.
     pub formulation: Formulation,
+    /// The mechanism's load ratio `eta` and frequency `omega`.
     pub mechanism: Mechanism,
+    /// The initial state as the scene gave it.
     pub initial: Initial,
     /// The initial `(eps, eps')`, resolved from `initial`.
     pub initial_strain: (f64, f64),
+    /// Simulated time to run to, `> 0`.
     pub t_end: f64,
     /// The solver as written (the command line may override parts of it).
     pub solver: SolverSpec,
+    /// The method `solver` resolves to ([`Method::Auto`]: the formulation's
+    /// cheapest exact description).
     pub method: Method,
+    /// The tolerances `solver` resolves to (`1e-12` unless given).
     pub tolerances: Tolerances,
+    /// Event budget: the run fails after this many events (default 10^9).
     pub max_events: u64,
+    /// Free text about the scene, if given.
     pub description: Option<String>,
 }
 

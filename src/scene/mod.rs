@@ -29,13 +29,16 @@ pub use crate::scene::model::{Registry, Scene, SceneModel, Validator};
 /// Why a scene was refused: where, and what is wrong.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SceneError {
+    /// The scene file, once known ([`SceneError::in_path`]).
     pub file: Option<PathBuf>,
     /// Dotted path of the offending key, or `None` for the file as a whole.
     pub field: Option<String>,
+    /// What is wrong, in one sentence.
     pub reason: String,
 }
 
 impl SceneError {
+    /// An error in the key at the dotted path `path`, said of no file yet.
     pub fn field(path: &str, reason: String) -> Self {
         SceneError {
             file: None,

@@ -25,9 +25,14 @@ pub const METHODS: [&str; 5] = ["exact", "linear", "dopri5", "dop853", "verlet"]
 /// The solver as written, before it is checked against the model.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct SolverSpec {
+    /// `method`: one of [`METHODS`]; `None` for the model's cheapest exact
+    /// description.
     pub method: Option<String>,
+    /// `rtol`: relative tolerance, for `dopri5` and `dop853`.
     pub rtol: Option<f64>,
+    /// `atol`: absolute tolerance, for `dopri5` and `dop853`.
     pub atol: Option<f64>,
+    /// `step`: the fixed step, for `verlet`.
     pub step: Option<f64>,
 }
 

@@ -22,9 +22,14 @@ pub const FRONT_DROP: f64 = 0.008;
 /// The coarse fields at the nodes `x` (the wall's included).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Coarse {
+    /// Window centres, in the scene's length units (the wall at `-length / 2`).
     pub x: Vec<f64>,
+    /// Window strain at each centre: the mean unit strain over the window.
     pub strain: Vec<f64>,
+    /// Window velocity at each centre: the mass-weighted mean node velocity.
     pub velocity: Vec<f64>,
+    /// Hidden energy per unit length at each centre: the window's energy
+    /// minus the energy of its mean fields.
     pub hidden_energy: Vec<f64>,
 }
 

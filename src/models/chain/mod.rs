@@ -34,6 +34,7 @@ pub use taylor::TaylorChain;
 /// The chain's parameters, in the scene units of docs/physics.md s.4 or any.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Chain {
+    /// N, the number of units (and of moving nodes).
     pub units: usize,
     /// Node mass `m`.
     pub mass: f64,
@@ -49,6 +50,8 @@ pub struct Chain {
 }
 
 impl Chain {
+    /// A chain of `units` units with these parameters (see the fields); with
+    /// the constraint, each unit has an `impact` guard.
     pub fn new(
         units: usize,
         mass: f64,

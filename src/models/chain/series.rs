@@ -103,7 +103,10 @@ pub struct Series {
     width: usize,
     /// Allocated row length: room for whole blocks from any column.
     stride: usize,
+    /// Gap series `Delta`, coefficient-major: coefficient `k` of column `c`
+    /// is at [`Series::at`]`(k, c)`.
     pub gap: Vec<f64>,
+    /// Scaled velocity series `u`, laid out as `gap`.
     pub vel: Vec<f64>,
 }
 
@@ -130,6 +133,7 @@ impl Series {
         self.vel.resize(len, 0.0);
     }
 
+    /// Columns, the two boundary columns included.
     pub fn width(&self) -> usize {
         self.width
     }

@@ -73,6 +73,7 @@ const CERTIFIED: f64 = 1.0 / (1u64 << 60) as f64;
 /// The chain with its exact event-local flow.
 #[derive(Debug, Clone)]
 pub struct TaylorChain {
+    /// The chain's parameters.
     pub chain: Chain,
     /// Series order `K`.
     order: usize,

@@ -152,6 +152,7 @@ impl FrontTracking {
         Ok(model)
     }
 
+    /// The string's parameters.
     pub fn string(&self) -> &Continuum {
         &self.string
     }

@@ -22,7 +22,9 @@ use super::rattle;
 /// A state behind a shock and the shock's speed (negative: towards the wall).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Shock {
+    /// The state behind, `[e, v, E]`.
     pub behind: [f64; 3],
+    /// The shock's speed, over `c_b`.
     pub speed: f64,
 }
 

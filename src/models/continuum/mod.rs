@@ -63,6 +63,7 @@ pub enum Variant {
 }
 
 impl Variant {
+    /// The variant's name in scenes and output: `paper` or `homogenized`.
     pub fn name(self) -> &'static str {
         match self {
             Variant::Paper => "paper",
@@ -87,11 +88,14 @@ pub struct Continuum {
 /// A constant state of the string.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Piece {
+    /// Strain `eps = y_x`.
     pub strain: f64,
+    /// Velocity `y_t`.
     pub velocity: f64,
 }
 
 impl Continuum {
+    /// The critical load `F_cr = c^2` (with `rho = 1`).
     pub fn critical_load(&self) -> f64 {
         self.wave_speed * self.wave_speed
     }

@@ -203,7 +203,9 @@ pub fn stress(e: f64, g: f64) -> Result<f64, String> {
 /// its sound speed over `c_b`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Law {
+    /// The centre `c` of the oscillation: the cell carries `F_cr (1 + c)`.
     pub centre: f64,
+    /// The sound speed, over `c_b`.
     pub speed: f64,
 }
 

@@ -19,12 +19,18 @@
 use crate::engine::{Direction, Flow, Guard, HybridModel, Jump, Mode};
 use crate::models::mechanism::closed_form::Mechanism;
 
-/// Mode indices: the angle chart on either side of `theta = 0`, the strain
-/// chart on either side, and the angle equation without charts.
+/// The angle chart, `theta > 0`: state `[theta, theta']`.
 pub const ANGLE_POSITIVE: Mode = 0;
+/// The angle chart, `theta < 0`: state `[theta, theta']`.
 pub const ANGLE_NEGATIVE: Mode = 1;
+/// The strain chart near `theta = 0` on the side `theta > 0`: state
+/// `[eps, eps']`.
 pub const STRAIN_POSITIVE: Mode = 2;
+/// The strain chart near `theta = 0` on the side `theta < 0`: state
+/// `[eps, eps']`.
 pub const STRAIN_NEGATIVE: Mode = 3;
+/// The angle equation everywhere, without charts ([`Charts::Plain`]):
+/// state `[theta, theta']`.
 pub const PLAIN: Mode = 4;
 /// Resting contact at `theta = 0` below the critical load, after chattering.
 pub const RESTING: Mode = 5;
@@ -55,7 +61,9 @@ pub enum Charts {
 /// State `[theta, theta']` in angle modes, `[eps, eps']` in strain modes.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AngleMechanism {
+    /// The mechanism's load ratio and frequency.
     pub mechanism: Mechanism,
+    /// Whether to change chart near `theta = 0`.
     pub charts: Charts,
 }
 

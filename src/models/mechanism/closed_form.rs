@@ -133,6 +133,7 @@ pub struct ExactOrbit {
 }
 
 impl ExactOrbit {
+    /// The orbit from strain `eps` and strain rate `rate` at `t = 0`.
     pub fn new(mechanism: Mechanism, eps: f64, rate: f64) -> Self {
         let h0 = mechanism.energy(eps, rate);
         // At H0 = 0 below critical load the unit rests shut: no impacts.

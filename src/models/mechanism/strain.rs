@@ -15,8 +15,9 @@ use nalgebra::{DMatrix, DVector};
 use crate::engine::{Direction, Flow, Guard, HybridModel, Jump, Mode};
 use crate::models::mechanism::closed_form::Mechanism;
 
-/// Mode indices.
+/// Free flight: the linear oscillator, closing on the impact guard `eps = 0`.
 pub const FLIGHT: Mode = 0;
+/// Resting contact at `eps = 0` below the critical load, after chattering.
 pub const RESTING: Mode = 1;
 
 const STATE: [&str; 2] = ["strain", "strain_rate"];
@@ -25,6 +26,7 @@ const FLIGHT_GUARDS: [Guard; 1] = [Guard::affine("impact", Direction::Falling)];
 /// State `[eps, eps']`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StrainMechanism {
+    /// The mechanism's load ratio and frequency.
     pub mechanism: Mechanism,
 }
 
