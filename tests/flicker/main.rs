@@ -14,6 +14,7 @@ mod engine_generic;
 mod error_bound;
 mod event_location;
 mod fuzz_regressions;
+mod golden;
 mod homogenized;
 mod invariants;
 mod mechanism_angle;
