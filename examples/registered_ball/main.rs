@@ -11,6 +11,7 @@
 //! cargo run --release --example registered_ball -- check examples/registered_ball/ball.json
 //! cargo run --release --example registered_ball -- run examples/registered_ball/ball.json
 //! cargo run --release --example registered_ball -- sweep examples/registered_ball/ball_sweep.json
+//! cargo run --release --example registered_ball -- schema
 //! ```
 
 use flicker::engine::{
@@ -20,7 +21,7 @@ use flicker::engine::{
 use flicker::runner::{Control, Report};
 use flicker::scene::fields::Fields;
 use flicker::scene::solver::SolverSpec;
-use flicker::scene::{Registry, Scene, SceneError, SceneModel};
+use flicker::scene::{Kind, Registry, Scene, SceneError, SceneModel};
 
 const FLYING: Mode = 0;
 const RESTING: Mode = 1;
@@ -185,9 +186,29 @@ impl SceneModel for BallScene {
     }
 }
 
+/// The JSON Schema of a ball scene (`flicker schema` includes it).
+const SCHEMA: &str = r##"{
+ "type": "object",
+ "required": ["model", "restitution", "height", "t_end"],
+ "additionalProperties": false,
+ "description": "A ball dropped from rest, bouncing with restitution e.",
+ "properties": {
+  "model": {"const": "ball"},
+  "gravity": {"$ref": "#/$defs/positive"},
+  "restitution": {"type": "number", "minimum": 0, "exclusiveMaximum": 1},
+  "height": {"$ref": "#/$defs/positive"},
+  "t_end": {"$ref": "#/$defs/positive"},
+  "solver": {"type": "object"}
+ }
+}"##;
+
 /// The scene models `flicker` ships, and the ball.
 pub fn registry() -> Registry {
-    Registry::builtin().with("ball", validate)
+    Registry::builtin().with(Kind {
+        model: "ball",
+        validate,
+        schema: SCHEMA,
+    })
 }
 
 #[cfg_attr(test, allow(dead_code))]

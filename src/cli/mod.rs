@@ -137,6 +137,9 @@ enum Command {
         /// The scene file (JSON).
         scene: PathBuf,
     },
+    /// Print the JSON Schema of scene files, for every model this program
+    /// knows (schemas/scene.schema.json is its output for the built-in ones).
+    Schema,
     /// Filter or summarise an event log.
     Events {
         /// The log (events.jsonl).
@@ -205,6 +208,12 @@ pub fn dispatch(cli: Cli, registry: &Registry) -> Result<Code, Failure> {
             out,
         } => sweep::merge(registry, &file, &shards, &out),
         Command::Check { scene } => check::check(registry, &scene),
+        Command::Schema => {
+            let schema = registry.schema().map_err(Failure::bad_input)?;
+            let text = serde_json::to_string_pretty(&schema).map_err(Failure::bad_input)?;
+            say!("{text}");
+            Ok(Code::Ok)
+        }
         Command::Plot {
             what: Some(what), ..
         } => plot::plot(what),

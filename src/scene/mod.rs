@@ -24,7 +24,7 @@ use serde_json::Value;
 pub use crate::scene::chain::ChainScene;
 pub use crate::scene::continuum::ContinuumScene;
 pub use crate::scene::mechanism::{Formulation, Initial, MechanismScene};
-pub use crate::scene::model::{Registry, Scene, SceneModel, Validator};
+pub use crate::scene::model::{Kind, Registry, Scene, SceneModel, Validator};
 
 /// Why a scene was refused: where, and what is wrong.
 #[derive(Debug, Clone, PartialEq)]

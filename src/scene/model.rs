@@ -5,8 +5,10 @@
 //! [`SceneModel`] what it needs: its time span and solver, the methods it
 //! can run, what to say of it in `check`, the run itself, and where the
 //! model has them an exact reference and a period. No command matches on
-//! the kind of model, so a new kind is its validator and this one impl:
-//! registered in a [`Registry`], every tool takes it.
+//! the kind of model, so a new kind is its validator, this one impl and
+//! its JSON Schema: registered in a [`Registry`], every tool takes it, and
+//! the scene schema (`flicker schema`, `schemas/scene.schema.json`) is the
+//! registry's.
 
 use std::any::Any;
 use std::fmt;
@@ -137,31 +139,90 @@ impl std::ops::DerefMut for Scene {
 /// Validates the keys of one kind of scene (all but `"model"`).
 pub type Validator = fn(Fields) -> Result<Scene, SceneError>;
 
+/// One kind of scene: its `"model"`, its validator, and its JSON Schema
+/// (the definition of one scene object, as JSON text; it may refer to the
+/// shared `#/$defs/positive`).
+#[derive(Debug, Clone, Copy)]
+pub struct Kind {
+    /// The scene's `"model"`.
+    pub model: &'static str,
+    /// Validates the scene's other keys.
+    pub validate: Validator,
+    /// The JSON Schema of the scene, as text.
+    pub schema: &'static str,
+}
+
 /// The kinds of scene a program knows, by their `"model"`.
 #[derive(Debug, Clone)]
 pub struct Registry {
-    kinds: Vec<(&'static str, Validator)>,
+    kinds: Vec<Kind>,
 }
+
+/// The schema of the scene file, less the kinds' own definitions.
+const SCENE_SCHEMA_TITLE: &str = "flicker scene";
+const SCENE_SCHEMA_DESCRIPTION: &str = "A scene file for `flicker run`. The schema states the shape; `flicker check SCENE.json` also checks what a schema cannot (an energy no state has, an initial angle given to the strain formulation, ...).";
 
 impl Registry {
     /// The models this crate ships: the mechanism, the chain and the
     /// continuum.
     pub fn builtin() -> Self {
+        let kind = |model, validate, schema| Kind {
+            model,
+            validate,
+            schema,
+        };
         Registry {
             kinds: vec![
-                ("mechanism", crate::scene::mechanism::scene),
-                ("chain", crate::scene::chain::scene),
-                ("continuum", crate::scene::continuum::scene),
+                kind(
+                    "mechanism",
+                    crate::scene::mechanism::scene,
+                    include_str!("../models/mechanism/scene.schema.json"),
+                ),
+                kind(
+                    "chain",
+                    crate::scene::chain::scene,
+                    include_str!("../models/chain/scene.schema.json"),
+                ),
+                kind(
+                    "continuum",
+                    crate::scene::continuum::scene,
+                    include_str!("../models/continuum/scene.schema.json"),
+                ),
             ],
         }
     }
 
-    /// The same registry, knowing one more kind (or another validator for
+    /// The same registry, knowing one more kind (or another definition of
     /// a kind it knew).
-    pub fn with(mut self, model: &'static str, validate: Validator) -> Self {
-        self.kinds.retain(|(name, _)| *name != model);
-        self.kinds.push((model, validate));
+    pub fn with(mut self, kind: Kind) -> Self {
+        self.kinds.retain(|known| known.model != kind.model);
+        self.kinds.push(kind);
         self
+    }
+
+    /// The JSON Schema of a scene file of any kind this registry knows:
+    /// one of the kinds' definitions. Fails, naming the kind, if a
+    /// definition is not JSON.
+    pub fn schema(&self) -> Result<Value, String> {
+        let mut defs = serde_json::Map::new();
+        defs.insert(
+            "positive".into(),
+            serde_json::json!({"type": "number", "exclusiveMinimum": 0}),
+        );
+        let mut one_of = Vec::new();
+        for kind in &self.kinds {
+            let schema: Value = serde_json::from_str(kind.schema)
+                .map_err(|e| format!("the schema of model {:?} is not JSON: {e}", kind.model))?;
+            defs.insert(kind.model.into(), schema);
+            one_of.push(serde_json::json!({"$ref": format!("#/$defs/{}", kind.model)}));
+        }
+        Ok(serde_json::json!({
+            "$schema": "https://json-schema.org/draft/2020-12/schema",
+            "title": SCENE_SCHEMA_TITLE,
+            "description": SCENE_SCHEMA_DESCRIPTION,
+            "oneOf": one_of,
+            "$defs": defs,
+        }))
     }
 
     /// Validate a scene given as a parsed JSON value.
@@ -174,10 +235,14 @@ impl Registry {
                 format!("must be a string, found {}", kind(model)),
             ));
         };
-        match self.kinds.iter().find(|(known, _)| *known == name) {
-            Some((_, validate)) => validate(fields),
+        match self.kinds.iter().find(|kind| kind.model == name) {
+            Some(kind) => (kind.validate)(fields),
             None => {
-                let known: Vec<String> = self.kinds.iter().map(|(k, _)| format!("{k:?}")).collect();
+                let known: Vec<String> = self
+                    .kinds
+                    .iter()
+                    .map(|kind| format!("{:?}", kind.model))
+                    .collect();
                 Err(SceneError::field(
                     "model",
                     format!("unknown model {name:?} (known: {})", known.join(", ")),

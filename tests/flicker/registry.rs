@@ -127,3 +127,37 @@ fn the_built_in_registry_refuses_the_unregistered_model_naming_the_known_ones() 
     );
     assert!(registry.load(std::path::Path::new(&mechanism)).is_ok());
 }
+
+#[test]
+fn the_registered_models_schema_joins_the_scene_schema() {
+    let schema = registered_ball::registry().schema().unwrap();
+    let validator = jsonschema::validator_for(&schema).unwrap();
+    let ball: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(example("ball.json")).unwrap()).unwrap();
+    assert!(validator.is_valid(&ball));
+    // A restitution of one never settles: the schema refuses it, as does
+    // the validator (exit 2).
+    let mut bouncy = ball.clone();
+    bouncy["restitution"] = 1.0.into();
+    assert!(!validator.is_valid(&bouncy));
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("bouncy.json");
+    std::fs::write(&path, bouncy.to_string()).unwrap();
+    assert_eq!(
+        flicker(
+            &registered_ball::registry(),
+            &["check", path.to_str().unwrap()]
+        ),
+        Code::BadInput
+    );
+    // The built-in models' scenes still pass it.
+    let mechanism: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(format!(
+            "{}/models/mechanism_impacting.json",
+            env!("CARGO_MANIFEST_DIR")
+        ))
+        .unwrap(),
+    )
+    .unwrap();
+    assert!(validator.is_valid(&mechanism));
+}

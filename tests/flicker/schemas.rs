@@ -115,3 +115,27 @@ fn every_logged_event_passes_the_event_schema() {
         }
     }
 }
+
+#[test]
+fn the_shipped_scene_schema_is_the_registrys() {
+    // Each model's definition lives beside the model (src/models/*/
+    // scene.schema.json); the shipped file is what `flicker schema` prints.
+    let shipped: Value = serde_json::from_str(
+        &std::fs::read_to_string(
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("schemas/scene.schema.json"),
+        )
+        .unwrap(),
+    )
+    .unwrap();
+    assert_eq!(
+        shipped,
+        flicker::scene::Registry::builtin().schema().unwrap()
+    );
+    let printed = Command::new(env!("CARGO_BIN_EXE_flicker"))
+        .arg("schema")
+        .output()
+        .unwrap();
+    assert_eq!(printed.status.code(), Some(0));
+    let printed: Value = serde_json::from_slice(&printed.stdout).unwrap();
+    assert_eq!(printed, shipped);
+}
