@@ -73,7 +73,7 @@ pub fn motion<M: HybridModel + ?Sized>(
         (Flow::Ode, Method::Exact) => Err(format!(
             "mode `{name}` has no exact flow; choose a numerical method"
         )),
-        (_, Method::Linear) if model.linear(mode).is_none() => Err(format!(
+        (_, Method::Linear) if !model.is_linear(mode) => Err(format!(
             "mode `{name}` is not a linear flow x' = A x + b, so the linear propagator cannot run it"
         )),
         (_, Method::Dopri5(_) | Method::Dop853(_) | Method::Verlet { .. })
@@ -102,6 +102,37 @@ pub struct Crossing<'a> {
     pub guard: &'a dyn Fn(&[f64]) -> f64,
     /// Whether a value of the guard counts as having crossed.
     pub crossed: &'a dyn Fn(f64) -> bool,
+}
+
+/// Whether `method` can run every one of `modes` of `model`, by [`motion`]'s
+/// rules; the first refusal's reason otherwise.
+pub fn runs<M: HybridModel + ?Sized>(
+    model: &M,
+    modes: &[Mode],
+    method: Method,
+) -> Result<(), String> {
+    modes
+        .iter()
+        .try_for_each(|&mode| motion(model, mode, method).map(|_| ()))
+}
+
+/// The names of the methods a user can choose that run every one of
+/// `modes` of `model` ([`runs`]), in the order exact, linear, dopri5,
+/// dop853, verlet: the one place that says which methods a model takes.
+pub fn methods_for<M: HybridModel + ?Sized>(model: &M, modes: &[Mode]) -> Vec<&'static str> {
+    // Tolerances and steps never decide whether a method applies.
+    let tol = Tolerances::default();
+    [
+        Method::Exact,
+        Method::Linear,
+        Method::Dopri5(tol),
+        Method::Dop853(tol),
+        Method::Verlet { step: 1.0 },
+    ]
+    .into_iter()
+    .filter(|&method| runs(model, modes, method).is_ok())
+    .map(|method| method.name())
+    .collect()
 }
 
 /// One numerical method's working state. One lives per run, so the size of

@@ -189,6 +189,13 @@ pub trait HybridModel {
         None
     }
 
+    /// Whether the flow in `mode` is linear (what [`linear`](HybridModel::linear)
+    /// says), without building its matrices: a model whose `A` is large
+    /// answers cheaply.
+    fn is_linear(&self, mode: Mode) -> bool {
+        self.linear(mode).is_some()
+    }
+
     /// The exact flow map of a [`Flow::Exact`] mode: `x` is the state
     /// `tau >= 0` after `x0`.
     fn advance(&self, mode: Mode, x0: &[f64], tau: f64, x: &mut [f64]) {

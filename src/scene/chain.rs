@@ -27,6 +27,7 @@
 use serde_json::Value;
 
 use crate::compare::Reference;
+use crate::engine::integrator::methods_for;
 use crate::engine::{Method, Observer, Tolerances};
 use crate::models::chain::Chain;
 use crate::runner::{Control, Report};
@@ -270,8 +271,15 @@ impl SceneModel for ChainScene {
         Ok(())
     }
 
+    /// The exact Taylor flow, and what the engine's rules let run the
+    /// chain as an ODE up to [`MAX_ODE_UNITS`].
     fn methods(&self) -> Vec<&'static str> {
-        vec!["exact", "linear", "dopri5", "dop853", "verlet"]
+        let mut methods = vec!["exact"];
+        if self.units <= MAX_ODE_UNITS {
+            let ode = methods_for(&self.chain(self.constraint), &[0]);
+            methods.extend(ode.into_iter().filter(|m| *m != "exact"));
+        }
+        methods
     }
 
     /// The time a wave at the bar speed takes to cross the chain.

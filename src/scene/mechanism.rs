@@ -27,9 +27,12 @@ use std::f64::consts::FRAC_PI_2;
 
 use crate::compare::Reference;
 use crate::engine::Observer;
+use crate::engine::integrator::{methods_for, runs};
 use crate::engine::zeno;
+use crate::engine::{HybridModel, Mode};
 use crate::engine::{Method, Tolerances};
-use crate::models::mechanism::ExactOrbit;
+use crate::models::mechanism::strain::{self, FLIGHT};
+use crate::models::mechanism::{AngleMechanism, ExactOrbit, StrainMechanism, angle};
 use crate::models::mechanism::{Charts, Mechanism, Phase};
 use crate::runner::{Control, Report};
 use crate::scene::fields::{Fields, kind};
@@ -131,7 +134,7 @@ pub(crate) fn validate(mut f: Fields) -> Result<MechanismScene, SceneError> {
         .map(SolverSpec::from_json)
         .transpose()?
         .unwrap_or_default();
-    let (method, tolerances) = resolve_solver(&solver, formulation)?;
+    let (method, tolerances) = resolve_solver(&solver, formulation, mechanism)?;
     check_steps(method, t_end)?;
     let (initial, initial_strain) = initial(f.required("initial")?, mechanism, angle)?;
     if !(initial_strain.0.is_finite() && initial_strain.1.is_finite()) {
@@ -192,24 +195,51 @@ pub fn check_steps(method: Method, t_end: f64) -> Result<(), SceneError> {
     }
 }
 
-/// The method and tolerances of `spec`, checked against the formulation.
+/// The method and tolerances of `spec`, checked by the engine's rules
+/// against the formulation's model.
 pub fn resolve_solver(
     spec: &SolverSpec,
     formulation: Formulation,
+    mechanism: Mechanism,
 ) -> Result<(Method, Tolerances), SceneError> {
     let (method, tolerances) = spec.resolve()?;
-    let refused = match (formulation, method) {
-        (Formulation::Angle(_), Method::Exact | Method::Linear) => Some(
-            "the angle formulation (8) has no closed form and is not linear; use \"dopri5\" or \"dop853\"",
+    if method == Method::Auto {
+        return Ok((method, tolerances));
+    }
+    with_model(formulation, mechanism, |model, modes| {
+        runs(model, modes, method).map_err(|why| {
+            SceneError::field(
+                "solver.method",
+                format!(
+                    "{why} (this formulation runs {})",
+                    methods_for(model, modes).join(", ")
+                ),
+            )
+        })
+    })?;
+    Ok((method, tolerances))
+}
+
+/// `f` of the formulation's model and the modes a run of it may enter:
+/// what the engine's rules judge methods against.
+fn with_model<R>(
+    formulation: Formulation,
+    mechanism: Mechanism,
+    f: impl FnOnce(&dyn HybridModel, &[Mode]) -> R,
+) -> R {
+    match formulation {
+        Formulation::Strain => f(&StrainMechanism { mechanism }, &[FLIGHT, strain::RESTING]),
+        Formulation::Angle(charts) => f(
+            &AngleMechanism { mechanism, charts },
+            &[
+                angle::ANGLE_POSITIVE,
+                angle::ANGLE_NEGATIVE,
+                angle::STRAIN_POSITIVE,
+                angle::STRAIN_NEGATIVE,
+                angle::PLAIN,
+                angle::RESTING,
+            ],
         ),
-        (Formulation::Angle(_), Method::Verlet { .. }) => Some(
-            "the angle formulation's acceleration depends on the angle rate, which Stormer-Verlet cannot take; use \"dopri5\" or \"dop853\"",
-        ),
-        _ => None,
-    };
-    match refused {
-        Some(why) => Err(SceneError::field("solver.method", why.into())),
-        None => Ok((method, tolerances)),
     }
 }
 
@@ -292,17 +322,16 @@ impl SceneModel for MechanismScene {
     }
 
     fn set_solver(&mut self, spec: SolverSpec) -> Result<(), SceneError> {
-        (self.method, self.tolerances) = resolve_solver(&spec, self.formulation)?;
+        (self.method, self.tolerances) = resolve_solver(&spec, self.formulation, self.mechanism)?;
         check_steps(self.method, self.t_end)?;
         self.solver = spec;
         Ok(())
     }
 
     fn methods(&self) -> Vec<&'static str> {
-        match self.formulation {
-            Formulation::Strain => vec!["exact", "linear", "dopri5", "dop853", "verlet"],
-            Formulation::Angle(_) => vec!["dopri5", "dop853"],
-        }
+        with_model(self.formulation, self.mechanism, |model, modes| {
+            methods_for(model, modes)
+        })
     }
 
     fn time_scale(&self) -> f64 {

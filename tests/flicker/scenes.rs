@@ -153,3 +153,30 @@ fn the_issue_example_scene_parses_as_written() {
     );
     assert_eq!(m.initial_strain, (0.05, 0.0));
 }
+
+#[test]
+fn each_scene_offers_the_methods_its_model_can_take() {
+    let methods = |name: &str| {
+        let scene = scene::load(Path::new(&format!(
+            "{}/models/{name}",
+            env!("CARGO_MANIFEST_DIR")
+        )))
+        .unwrap();
+        scene.methods()
+    };
+    // The strain formulation: a closed form, a linear flow x' = A x + b,
+    // and q'' = a(q), so every method.
+    let all = ["exact", "linear", "dopri5", "dop853", "verlet"];
+    assert_eq!(methods("mechanism_impacting.json"), all);
+    // The angle formulation: a nonlinear ODE whose acceleration depends on
+    // the rate, so the embedded pairs only.
+    assert_eq!(methods("mechanism_angle.json"), ["dopri5", "dop853"]);
+    // A chain: its exact Taylor flow, and as a linear ODE every method.
+    assert_eq!(methods("chain_cradle.json"), all);
+    // The continuum runs by front tracking only.
+    assert_eq!(methods("continuum_release_paper.json"), ["exact"]);
+    // A chain too long for the ODE path keeps its exact flow alone.
+    let long = r#"{"model": "chain", "units": 5000, "length": 2.0, "wave_speed": 1.0,
+        "load": {"before": 1.1, "after": 0.0}, "t_end": 0.1}"#;
+    assert_eq!(scene::parse(long).unwrap().methods(), ["exact"]);
+}

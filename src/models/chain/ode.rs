@@ -50,6 +50,12 @@ impl HybridModel for Chain {
         true
     }
 
+    /// Linear springs between the shocks: known without the `2N x 2N`
+    /// matrix.
+    fn is_linear(&self, _: Mode) -> bool {
+        true
+    }
+
     fn linear(&self, _: Mode) -> Option<(DMatrix<f64>, DVector<f64>)> {
         let n = self.units;
         let mut a = DMatrix::zeros(2 * n, 2 * n);
