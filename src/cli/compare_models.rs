@@ -56,7 +56,7 @@ pub fn compare_models(args: CompareModelsArgs, registry: &Registry) -> Result<Co
     } = args;
     let scene = registry.load(&path).map_err(Failure::bad_input)?;
     let mut release = release_of(&scene).map_err(|e| Failure::bad_input(e.in_path(&path)))?;
-    let most = crate::scene::continuum::MAX_FINITE_VOLUMES;
+    let most = crate::models::continuum::scene::MAX_FINITE_VOLUMES;
     if !(2..=most).contains(&cells) {
         return Err(Failure::bad_input(format!("--cells: from 2 to {most}")));
     }

@@ -1,18 +1,15 @@
 //! Running a validated scene: build its model, pick its method, run it, and
 //! describe the result in the scene's own terms.
 
-pub(crate) mod chain;
-pub(crate) mod continuum;
 pub mod ensemble;
 mod fields;
-pub(crate) mod mechanism;
 
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
 use crate::engine::{Method, Options, Outcome, Tolerances};
 
-pub use continuum::{front_tracking, homogenized};
+pub use crate::models::continuum::run::{front_tracking, homogenized};
 pub use fields::{CLASSICAL_MAX_UNITS, Classical, FieldOutputs, Profile, TraceRow};
 
 /// A finished run and what the summary needs to say about it.

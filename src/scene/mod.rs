@@ -4,15 +4,14 @@
 //! keys; every error names the file, the key's path and the reason, e.g.
 //! `models/x.json: field initial.strain: must be >= 0 (got -0.1)`. Unknown
 //! keys are errors, so a typo never silently falls back to a default.
-//! The keys of each model are documented in its module ([`mechanism`],
-//! [`chain`], [`continuum`]); what every kind of scene offers the tools,
-//! and the registry of kinds, in [`model`].
+//! Each model's scene lives in the model's own folder, its keys documented
+//! there ([`crate::models::mechanism::scene`],
+//! [`crate::models::chain::scene`], [`crate::models::continuum::scene`]);
+//! what every kind of scene offers the tools, and the registry of kinds,
+//! in [`model`]; keys several kinds share in [`extent`] and [`solver`].
 
-pub mod chain;
-pub mod continuum;
 pub mod extent;
 pub mod fields;
-pub mod mechanism;
 pub mod model;
 pub mod solver;
 
@@ -21,9 +20,9 @@ use std::path::{Path, PathBuf};
 
 use serde_json::Value;
 
-pub use crate::scene::chain::ChainScene;
-pub use crate::scene::continuum::ContinuumScene;
-pub use crate::scene::mechanism::{Formulation, Initial, MechanismScene};
+pub use crate::models::chain::scene::ChainScene;
+pub use crate::models::continuum::scene::ContinuumScene;
+pub use crate::models::mechanism::scene::{Formulation, Initial, MechanismScene};
 pub use crate::scene::model::{Kind, Registry, Scene, SceneModel, Validator};
 
 /// Why a scene was refused: where, and what is wrong.

@@ -175,17 +175,17 @@ impl Registry {
             kinds: vec![
                 kind(
                     "mechanism",
-                    crate::scene::mechanism::scene,
+                    crate::models::mechanism::scene::scene,
                     include_str!("../models/mechanism/scene.schema.json"),
                 ),
                 kind(
                     "chain",
-                    crate::scene::chain::scene,
+                    crate::models::chain::scene::scene,
                     include_str!("../models/chain/scene.schema.json"),
                 ),
                 kind(
                     "continuum",
-                    crate::scene::continuum::scene,
+                    crate::models::continuum::scene::scene,
                     include_str!("../models/continuum/scene.schema.json"),
                 ),
             ],

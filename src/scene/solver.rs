@@ -178,3 +178,20 @@ mod tests {
         assert!(verlet.overridden_by(&flags).resolve().is_ok());
     }
 }
+
+/// Fixed steps a run may take: beyond this it would run for minutes.
+const MAX_FIXED_STEPS: f64 = 1e9;
+
+/// Refuse a fixed step that would need more than 10^9 steps to reach `t_end`.
+pub fn check_steps(method: Method, t_end: f64) -> Result<(), SceneError> {
+    match method {
+        Method::Verlet { step } if t_end / step > MAX_FIXED_STEPS => Err(SceneError::field(
+            "solver.step",
+            format!(
+                "{step:e} needs {:.1e} steps to reach t_end = {t_end}, more than 1e9; take a larger step",
+                t_end / step
+            ),
+        )),
+        _ => Ok(()),
+    }
+}

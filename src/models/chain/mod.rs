@@ -25,6 +25,8 @@ pub mod coarse;
 pub mod collide;
 pub mod modal;
 pub mod ode;
+pub(crate) mod run;
+pub mod scene;
 pub mod series;
 pub mod taylor;
 

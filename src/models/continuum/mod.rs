@@ -22,6 +22,8 @@ pub mod fronts;
 pub mod homogenized;
 pub mod hugoniot;
 pub mod rattle;
+pub(crate) mod run;
+pub mod scene;
 
 pub use fronts::FrontTracking;
 pub use homogenized::Homogenized;

@@ -4,6 +4,8 @@
 
 pub mod angle;
 pub mod closed_form;
+pub(crate) mod run;
+pub mod scene;
 pub mod strain;
 
 pub use angle::{AngleMechanism, Charts};

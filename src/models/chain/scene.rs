@@ -1,4 +1,5 @@
-//! The keys of a chain scene (docs/physics.md s.4, scene units).
+//! A chain scene (docs/physics.md s.4, scene units): its keys, and what it
+//! offers the tools ([`SceneModel`]).
 //!
 //! ```json
 //! {"model": "chain", "units": 200, "length": 2.0, "wave_speed": 1.0,
@@ -33,8 +34,7 @@ use crate::models::chain::Chain;
 use crate::runner::{Control, Report};
 use crate::scene::extent;
 use crate::scene::fields::Fields;
-use crate::scene::mechanism::check_steps;
-use crate::scene::solver::SolverSpec;
+use crate::scene::solver::{SolverSpec, check_steps};
 use crate::scene::{Scene, SceneError, SceneModel};
 
 /// Most units a scene may have.
@@ -187,7 +187,7 @@ pub(crate) fn validate(mut f: Fields) -> Result<ChainScene, SceneError> {
         .transpose()?
         .unwrap_or_default();
     let (method, tolerances) = resolve_solver(&solver, units)?;
-    crate::scene::mechanism::check_steps(method, t_end)?;
+    check_steps(method, t_end)?;
     let max_events = f.optional_count("max_events")?.unwrap_or(1_000_000_000);
     let description = f.optional_string("description")?.map(str::to_string);
     f.finish()?;
@@ -306,7 +306,7 @@ impl SceneModel for ChainScene {
     }
 
     fn run(&self, control: &Control, observer: &mut dyn Observer) -> Result<Report, SceneError> {
-        crate::runner::chain::run(self, control, observer)
+        super::run::run(self, control, observer)
     }
 
     fn reference(&self) -> Result<Reference, SceneError> {

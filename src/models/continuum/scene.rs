@@ -1,5 +1,6 @@
-//! The keys of a continuum scene: the chain scene's string without its
-//! units (docs/physics.md s.5, scene units).
+//! A continuum scene, the chain scene's string without its units
+//! (docs/physics.md s.5, scene units): its keys, and what it offers the
+//! tools ([`SceneModel`]).
 //!
 //! ```json
 //! {"model": "continuum", "variant": "paper", "length": 2.0, "wave_speed": 1.0,
@@ -13,7 +14,7 @@
 //!   kept as internal energy, by finite volumes,
 //!   [`crate::models::continuum::homogenized`]).
 //! - `length`, `wave_speed`, `load`, `constraint`, `t_end`, `snapshots`,
-//!   `samples`: as in a chain scene ([`crate::scene::chain`]).
+//!   `samples`: as in a chain scene ([`crate::models::chain::scene`]).
 //! - `resolution`: how many equal cells the string is cut into (default
 //!   400): the homogenized string's finite volumes, and the points at whose
 //!   centres `profiles.json` samples either variant (front tracking itself
@@ -340,7 +341,7 @@ impl SceneModel for ContinuumScene {
     }
 
     fn run(&self, control: &Control, observer: &mut dyn Observer) -> Result<Report, SceneError> {
-        crate::runner::continuum::run(self, control, observer)
+        super::run::run(self, control, observer)
     }
 
     fn reference(&self) -> Result<Reference, SceneError> {

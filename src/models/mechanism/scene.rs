@@ -1,4 +1,6 @@
-//! The keys of a mechanism scene.
+//! A mechanism scene: its keys, and what it offers the tools
+//! ([`SceneModel`]: its methods by the engine's rules, its regime for
+//! `check`, the closed form as the exact reference, the impact period).
 //!
 //! ```json
 //! {"model": "mechanism", "formulation": "strain", "eta": 1.2, "omega": 1.0,
@@ -36,18 +38,18 @@ use crate::models::mechanism::{AngleMechanism, ExactOrbit, StrainMechanism, angl
 use crate::models::mechanism::{Charts, Mechanism, Phase};
 use crate::runner::{Control, Report};
 use crate::scene::fields::{Fields, kind};
-use crate::scene::solver::SolverSpec;
+use crate::scene::solver::{SolverSpec, check_steps};
 use crate::scene::{Scene, SceneError, SceneModel};
 
 /// Which equations describe the mechanism.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Formulation {
     /// The strain formulation: a hybrid automaton whose flight has a
-    /// closed form ([`StrainMechanism`](crate::models::mechanism::StrainMechanism)).
+    /// closed form ([`StrainMechanism`]).
     Strain,
     /// The angle formulation: the smooth equation (8), integrated
     /// numerically, changing chart near `theta = 0` or not
-    /// ([`AngleMechanism`](crate::models::mechanism::AngleMechanism)).
+    /// ([`AngleMechanism`]).
     Angle(Charts),
 }
 
@@ -175,23 +177,6 @@ fn charts(f: &mut Fields) -> Result<Charts, SceneError> {
             "chart",
             format!("must be \"switch\" or \"none\" (got {other:?})"),
         )),
-    }
-}
-
-/// Fixed steps a run may take: beyond this it would run for minutes.
-const MAX_FIXED_STEPS: f64 = 1e9;
-
-/// Refuse a fixed step that would need more than 10^9 steps to reach `t_end`.
-pub fn check_steps(method: Method, t_end: f64) -> Result<(), SceneError> {
-    match method {
-        Method::Verlet { step } if t_end / step > MAX_FIXED_STEPS => Err(SceneError::field(
-            "solver.step",
-            format!(
-                "{step:e} needs {:.1e} steps to reach t_end = {t_end}, more than 1e9; take a larger step",
-                t_end / step
-            ),
-        )),
-        _ => Ok(()),
     }
 }
 
@@ -359,7 +344,7 @@ impl SceneModel for MechanismScene {
     }
 
     fn run(&self, control: &Control, observer: &mut dyn Observer) -> Result<Report, SceneError> {
-        crate::runner::mechanism::run(self, control, observer)
+        super::run::run(self, control, observer)
     }
 
     /// The closed form (46) of the strain with impacts every `T_imp`,
