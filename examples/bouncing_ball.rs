@@ -14,14 +14,17 @@ use flicker::engine::{
     Direction, Flow, Guard, HybridModel, Jump, Mode, Options, Recorder, simulate,
 };
 
-const FLYING: Mode = 0;
+/// The ball in the air.
+pub const FLYING: Mode = 0;
 const RESTING: Mode = 1;
 const BOUNCE: [Guard; 1] = [Guard::affine("bounce", Direction::Falling)];
 
 /// State `[height, velocity]`.
-struct BouncingBall {
-    gravity: f64,
-    restitution: f64,
+pub struct BouncingBall {
+    /// Acceleration of gravity.
+    pub gravity: f64,
+    /// Fraction of its speed the ball keeps at a bounce, in `[0, 1)`.
+    pub restitution: f64,
 }
 
 impl HybridModel for BouncingBall {

@@ -1,11 +1,12 @@
 //! A kind of scene from outside the crate, registered and run by every tool
 //! of the command line: a ball bouncing on the floor.
 //!
-//! This file is the whole of it: the model (free flight, exact landing
-//! times, restitution `e`, settling on the floor at its Zeno point), the
-//! scene's keys, what it offers the tools ([`SceneModel`]), and a `main`
-//! that is `flicker` with one more model. Beside it, `ball.json` (a scene)
-//! and `ball_sweep.json` (a sweep over restitution and height).
+//! This file is the whole of it: the scene's keys, what it offers the tools
+//! ([`SceneModel`]), and a `main` that is `flicker` with one more model;
+//! the model (free flight, exact landing times, restitution `e`, settling
+//! on the floor at its Zeno point) is `examples/bouncing_ball.rs`'s. Beside
+//! it, `ball.json` (a scene) and `ball_sweep.json` (a sweep over
+//! restitution and height).
 //!
 //! ```text
 //! cargo run --release --example registered_ball -- check examples/registered_ball/ball.json
@@ -14,75 +15,19 @@
 //! cargo run --release --example registered_ball -- schema
 //! ```
 
-use flicker::engine::{
-    Direction, Flow, Guard, HybridModel, Jump, Method, Mode, Observer, Options, Tolerances,
-    simulate,
-};
+use flicker::engine::{Method, Observer, Options, Tolerances, simulate};
 use flicker::runner::{Control, Report};
 use flicker::scene::fields::Fields;
 use flicker::scene::solver::SolverSpec;
 use flicker::scene::{Kind, Registry, Scene, SceneError, SceneModel};
 
-const FLYING: Mode = 0;
-const RESTING: Mode = 1;
-const BOUNCE: [Guard; 1] = [Guard::affine("bounce", Direction::Falling)];
+// The ball itself is examples/bouncing_ball.rs's model; this file adds
+// only what makes it a kind of scene.
+#[path = "../bouncing_ball.rs"]
+#[allow(dead_code)]
+mod bouncing_ball;
 
-/// State `[height, velocity]`; exact free flight between bounces.
-struct Ball {
-    gravity: f64,
-    restitution: f64,
-}
-
-impl HybridModel for Ball {
-    fn dimension(&self) -> usize {
-        2
-    }
-    fn state_names(&self, _: Mode) -> &[&'static str] {
-        &["height", "velocity"]
-    }
-    fn mode_name(&self, mode: Mode) -> &'static str {
-        if mode == RESTING { "resting" } else { "flying" }
-    }
-    fn guards(&self, mode: Mode) -> &[Guard] {
-        if mode == RESTING { &[] } else { &BOUNCE }
-    }
-    fn guard(&self, _: Mode, _: usize, x: &[f64]) -> f64 {
-        x[0]
-    }
-    fn flow(&self, mode: Mode) -> Flow {
-        if mode == RESTING {
-            Flow::Frozen
-        } else {
-            Flow::Exact
-        }
-    }
-    fn advance(&self, _: Mode, x0: &[f64], tau: f64, x: &mut [f64]) {
-        x[0] = x0[0] + x0[1] * tau - 0.5 * self.gravity * tau * tau;
-        x[1] = x0[1] - self.gravity * tau;
-    }
-    /// The later root of `h + v tau - g tau^2 / 2`, without cancellation.
-    fn next_crossing(&self, _: Mode, _: usize, x0: &[f64]) -> Option<f64> {
-        let (h, v, g) = (x0[0], x0[1], self.gravity);
-        let root = (v * v + 2.0 * g * h).sqrt();
-        Some(if v > 0.0 {
-            (v + root) / g
-        } else {
-            2.0 * h / (root - v)
-        })
-    }
-    fn reset(&self, mode: Mode, _: usize, x: &mut [f64]) -> Jump {
-        x[0] = 0.0;
-        x[1] *= -self.restitution;
-        Jump::to(mode)
-    }
-    fn energy(&self, _: Mode, x: &[f64]) -> Option<f64> {
-        Some(0.5 * x[1] * x[1] + self.gravity * x[0])
-    }
-    fn settle(&self, _: Mode, x: &mut [f64]) -> Option<Mode> {
-        x.copy_from_slice(&[0.0, 0.0]);
-        Some(RESTING)
-    }
-}
+use bouncing_ball::{BouncingBall, FLYING};
 
 /// A ball scene: `{"model": "ball", "gravity": 9.81, "restitution": 0.8,
 /// "height": 1.0, "t_end": 10.0}` (`gravity` optional, the ball dropped
@@ -159,7 +104,7 @@ impl SceneModel for BallScene {
         ]
     }
     fn run(&self, control: &Control, observer: &mut dyn Observer) -> Result<Report, SceneError> {
-        let ball = Ball {
+        let ball = BouncingBall {
             gravity: self.gravity,
             restitution: self.restitution,
         };
