@@ -3,6 +3,7 @@
 //! and the loop ([`simulation`]).
 
 pub mod adaptive;
+pub mod bound;
 pub mod dop853;
 pub mod dopri5;
 pub mod error_set;

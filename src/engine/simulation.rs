@@ -22,15 +22,14 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use crate::engine::adaptive::{StepFailure, Tolerances};
-use crate::engine::error_set::ErrorSet;
+use crate::engine::bound::Bound;
 use crate::engine::integrator::{Crossing, Integrator, Method, Motion, motion};
 use crate::engine::labels::Labels;
 use crate::engine::locate::scan_step;
 use crate::engine::model::{Affects, Direction, HybridModel, Mode};
 use crate::engine::observer::{EventRecord, Observer, SETTLE};
 use crate::engine::queue::EventQueue;
-use crate::engine::tangent::Tangents;
-use crate::engine::zeno::{self, ZenoWatch};
+use crate::engine::zeno::ZenoWatch;
 use crate::time::Time;
 
 /// How to run a model.
@@ -131,14 +130,14 @@ pub struct Outcome {
     pub flow_evaluations: u64,
     /// The largest error any state component may carry at the end: the
     /// numerical steps' local errors carried through the flow and across
-    /// every event (see [`ErrorSet`]), plus a round-off allowance of
-    /// [`ROUNDOFF_ULPS`] ulps of the state's size per event. Above
+    /// every event (see [`bound`](crate::engine::bound)), plus a round-off allowance of
+    /// [`ROUNDOFF_ULPS`](crate::engine::bound::ROUNDOFF_ULPS) ulps of the state's size per event. Above
     /// [`TRACKED`](crate::engine::error_set::TRACKED) state components,
     /// the plain sum of the local errors instead.
     pub error_bound: f64,
     /// The largest error any event time may carry: each event's share of
     /// the state error divided by its closing speed, plus a round-off
-    /// allowance of [`ROUNDOFF_ULPS`] ulps of the time reached; `None`
+    /// allowance of [`ROUNDOFF_ULPS`](crate::engine::bound::ROUNDOFF_ULPS) ulps of the time reached; `None`
     /// where the errors are not tracked.
     pub event_time_bound: Option<f64>,
     /// Wall time the run took, in seconds.
@@ -210,22 +209,8 @@ struct Run<'m, M: HybridModel + ?Sized> {
     motions: Vec<Option<Motion>>,
     /// Flow maps and crossing times asked of exact flows.
     exact_evaluations: u64,
-    /// The state errors the numerical steps may have left so far.
-    errors: ErrorSet,
-    tangents: Tangents,
-    /// Scratch: a tangent or saltation matrix, and a guard's gradient.
-    matrix: Vec<f64>,
-    gradient: Vec<f64>,
-    /// Gradients of a mode's affine guards (see [`Run::gradients`]).
-    affine_gradients: (Option<Mode>, Vec<f64>),
-    /// The largest event-time error so far, the last event's, and when the
-    /// last logged event fired.
-    event_time_bound: f64,
-    last_time_bound: f64,
-    last_event: Option<Time>,
-    /// The largest state component seen (initial state and events): the
-    /// round-off allowance's scale.
-    state_scale: f64,
+    /// The errors so far, and the bounds the run will state.
+    bound: Bound,
     /// When the integrator's current step ends, for stepped modes.
     step_end: Option<Time>,
     /// Whether the integrator's last step starts at the current origin.
@@ -267,15 +252,7 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
             motion: Motion::Frozen,
             motions: Vec::new(),
             exact_evaluations: 0,
-            errors: ErrorSet::new(n),
-            tangents: Tangents::new(n),
-            matrix: vec![0.0; n * n],
-            gradient: vec![0.0; n],
-            affine_gradients: (None, Vec::new()),
-            event_time_bound: 0.0,
-            last_time_bound: 0.0,
-            last_event: None,
-            state_scale: largest(x0),
+            bound: Bound::new(n, x0),
             stepped: false,
             step_end: None,
             fresh: Some(None),
@@ -409,8 +386,8 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
                 before,
                 self.after
             )))
-        } else if let Err(end) = self.carry_errors(slot, t, &before, jump.mode) {
-            Err(end)
+        } else if let Err(why) = self.carry_errors(slot, t, &before, jump.mode) {
+            Err(End::failed(why))
         } else if guard.internal {
             Ok(())
         } else {
@@ -591,7 +568,7 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
             .zip(&self.after)
             .map(|(a, b)| (a - b).abs())
             .fold(0.0, f64::max);
-        self.errors.widen(jump);
+        self.bound.widen(jump);
         self.settles += 1;
         let recorded = self.record(SETTLE, t, rest, &before, &Labels::NONE, observer);
         self.state = before;
@@ -651,9 +628,8 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
                     let uncertainty = if guard.internal {
                         0.0
                     } else {
-                        self.gradient_of(g);
-                        self.errors.along(&self.gradient)
-                            + self.gradient.iter().map(|d| d.abs()).sum::<f64>() * local
+                        self.bound
+                            .guard_uncertainty(model, mode, g, &self.state, local)
                     };
                     let (step, x) = (&self.integrator, &mut self.before[..n]);
                     let scan = scan_step(guard, check_start, interpolant, uncertainty, |s| {
@@ -691,34 +667,12 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
         Ok(decided)
     }
 
-    /// The gradient of guard `g` of the current mode at the current state,
-    /// into `self.gradient`: computed once per mode for affine guards, at
-    /// every segment for the others.
-    fn gradient_of(&mut self, g: usize) {
-        let (model, mode, n) = (self.model, self.mode, self.state.len());
-        if !model.guards(mode)[g].affine {
-            self.tangents
-                .gradient(model, mode, g, &self.state, &mut self.gradient);
-            return;
-        }
-        if self.affine_gradients.0 != Some(mode) {
-            let guards = model.guards(mode).len();
-            let mut all = vec![0.0; guards * n];
-            for (g, row) in all.chunks_mut(n).enumerate() {
-                self.tangents.gradient(model, mode, g, &self.state, row);
-            }
-            self.affine_gradients = (Some(mode), all);
-        }
-        self.gradient
-            .copy_from_slice(&self.affine_gradients.1[g * n..(g + 1) * n]);
-    }
-
     /// Carry the state errors over the `tau` of the current segment that
     /// has passed: along the flow's tangent, with a numerical step's local
     /// error added. Nothing to do while the run has made no error.
     #[inline(always)]
     fn close_segment(&mut self, tau: f64) {
-        if self.motion != Motion::Stepped && self.errors.is_empty() {
+        if self.motion != Motion::Stepped && self.bound.idle() {
             return;
         }
         self.close_stretch(tau);
@@ -734,29 +688,18 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
                 // error (none for an event at the step's start).
                 let h = self.integrator.h();
                 let local = self.integrator.local_error() * (tau / h).min(1.0);
-                if self.errors.tracked() {
-                    let step = &self.integrator;
-                    self.tangents
-                        .ode(model, mode, tau, |s, x| step.eval(s, x), &mut self.matrix);
-                }
-                self.errors.map(&self.matrix, local);
+                let step = &self.integrator;
+                self.bound
+                    .after_step(model, mode, tau, local, |s, x| step.eval(s, x));
             }
-            Motion::Exact if self.errors.tracked() && !self.errors.is_empty() => {
-                self.tangents
-                    .exact(model, mode, &self.state, tau, &mut self.matrix);
-                self.errors.map(&self.matrix, 0.0);
-            }
+            Motion::Exact => self.bound.after_exact(model, mode, &self.state, tau),
             _ => {}
         }
     }
 
-    /// Carry the state errors across the event of guard `slot` at `t`
-    /// (state `before`, `self.after` after the reset, in `mode_after`) by
-    /// its saltation matrix, and bound the event's time. A run whose error
-    /// leaves an event's time uncertain by half the interval since the
-    /// previous event can no longer tell the events' order or count, and
-    /// stops; so does one that meets an event at zero closing speed (a
-    /// graze) with an error it cannot carry across.
+    /// Carry the errors across the event of guard `slot` at `t` (state
+    /// `before`, `self.after` after the reset, in `mode_after`): see
+    /// [`Bound::across`]; why the run cannot go on, if it cannot.
     #[inline(always)]
     fn carry_errors(
         &mut self,
@@ -764,99 +707,21 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
         t: Time,
         before: &[f64],
         mode_after: Mode,
-    ) -> Result<(), End> {
-        // The round-off allowance's scale: a plain loop, as this runs at
-        // every event of an exact run too.
-        for x in before {
-            let size = x.abs();
-            if size > self.state_scale {
-                self.state_scale = size;
-            }
-        }
-        if self.errors.is_empty() || !self.errors.tracked() {
+    ) -> Result<(), String> {
+        self.bound.note_state(before);
+        if self.bound.idle() {
             return Ok(());
         }
-        self.carry_across(slot, t, before, mode_after)
-    }
-
-    /// [`Run::carry_errors`] once there are errors to carry.
-    #[inline(never)]
-    fn carry_across(
-        &mut self,
-        slot: usize,
-        t: Time,
-        before: &[f64],
-        mode_after: Mode,
-    ) -> Result<(), End> {
-        let (model, mode) = (self.model, self.mode);
-        let guard = model.guards(mode)[slot];
-        self.tangents
-            .gradient(model, mode, slot, before, &mut self.gradient);
-        let along = self.errors.along(&self.gradient);
-        let (closing, jump) = self.tangents.saltation(
-            model,
-            mode,
+        self.bound.across(
+            self.model,
+            self.mode,
             slot,
-            before,
-            &self.gradient,
+            t,
+            (before, &self.after),
             mode_after,
-            &self.after,
-            &mut self.matrix,
-        );
-        let shift = along / closing.abs();
-        let since = self.last_event.map(|last| t.since(last));
-        // Events closer than the run can resolve are the Zeno watch's to
-        // judge (it settles them or stops), not the error bound's: their
-        // order and any state at them are equally unresolvable.
-        let resolution = zeno::resolution(t.value(), self.options.t_end);
-        if since.is_some_and(|since| since <= resolution) {
-            if self.matrix.iter().all(|m| m.is_finite()) {
-                self.errors.map(&self.matrix, 0.0);
-            }
-            return Ok(());
-        }
-        if !guard.internal {
-            self.last_event = Some(t);
-            self.last_time_bound = shift;
-            self.event_time_bound = self.event_time_bound.max(shift);
-        }
-        if !shift.is_finite() {
-            return Err(End::failed(format!(
-                "the `{}` event at t = {} comes at zero closing speed (a graze) with an integration \
-                 error of {along:.2e} in its guard: whether and when it fires cannot be told, so {} \
-                 cannot be trusted past here; tighten the method or use an exact one",
-                guard.name,
-                t.value(),
-                self.integrator.name()
-            )));
-        }
-        if let Some(since) = since.filter(|since| !guard.internal && shift > 0.5 * since) {
-            return Err(End::failed(format!(
-                "the `{}` event at t = {} may be off by {shift:.2e} in time (its guard by {along:.2e}, \
-                 closing at {:.2e}), more than half the {since:.3e} since the previous event: the \
-                 integration error so far ({:.2e} in the state) leaves the events' order and count \
-                 uncertain, so {} cannot be trusted past here; tighten the method or use an exact one",
-                guard.name,
-                t.value(),
-                closing.abs(),
-                self.errors.state_bound(),
-                self.integrator.name()
-            )));
-        }
-        // Where the event was located, the guard is not exactly zero: the
-        // reset came that residual's time early or late (rounding at
-        // least), which leaves `f+ - R f-` times it in the state.
-        let residual = model.guard(mode, slot, before).abs()
-            + f64::EPSILON
-                * self
-                    .gradient
-                    .iter()
-                    .zip(before)
-                    .map(|(g, x)| (g * x).abs())
-                    .sum::<f64>();
-        self.errors
-            .map(&self.matrix, jump * residual / closing.abs());
-        Ok(())
+            self.options.t_end,
+            self.integrator.name(),
+        )
     }
 
     /// A graze or near miss closer than the integration error can resolve.
@@ -937,23 +802,11 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
 
     fn finish_at(&mut self, t: Time) -> End {
         self.close_segment(t.since(self.origin));
-        // An event within its time error of the end may or may not belong
-        // to the run: its count and final state are then uncertain.
-        let next = self.queue.peek().map(|(_, next)| next.since(t));
-        let around = [self.last_event.map(|last| t.since(last)), next];
-        if self.last_time_bound > 0.0
-            && let Some(gap) = around
-                .into_iter()
-                .flatten()
-                .find(|gap| *gap <= self.last_time_bound)
+        if let Err(why) = self
+            .bound
+            .at_end(t, self.queue.peek().map(|(_, next)| next))
         {
-            return End::failed(format!(
-                "an event lies {gap:.2e} from t_end = {}, within the time error of the events \
-                 ({:.2e}): whether it happens before the end is uncertain, so the final state cannot \
-                 be trusted; tighten the method or move t_end",
-                t.value(),
-                self.last_time_bound
-            ));
+            return End::failed(why);
         }
         let mut x = std::mem::take(&mut self.before);
         self.state_at(t.since(self.origin), &mut x);
@@ -970,13 +823,6 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
                 reason: None,
             },
         }
-    }
-
-    /// The round-off allowance of the state: [`ROUNDOFF_ULPS`] ulps of its
-    /// size per event and at the start. An estimate of how round-off grows
-    /// (linearly, as in an exact run over 10^7 impacts), not a bound.
-    fn roundoff(&self) -> f64 {
-        ROUNDOFF_ULPS * f64::EPSILON * self.state_scale * (1 + self.events) as f64
     }
 
     fn outcome(self, end: End) -> Outcome {
@@ -997,10 +843,8 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
         if run.settles > 0 {
             events_by_guard.insert(SETTLE, run.settles);
         }
-        let error_bound = run.errors.state_bound() + run.roundoff();
-        let event_time_bound = run.errors.tracked().then(|| {
-            run.event_time_bound + ROUNDOFF_ULPS * f64::EPSILON * run.origin.value().abs()
-        });
+        let error_bound = run.bound.state_bound(run.events);
+        let event_time_bound = run.bound.event_time_bound(run.origin);
         Outcome {
             zeno: end.status == Status::Zeno || run.zeno_reason.is_some(),
             status: end.status,
@@ -1024,19 +868,11 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
     }
 }
 
-/// Round-off allowed per event, in ulps of the state's size (and of the
-/// time's for event times); see [`Outcome::error_bound`].
-pub const ROUNDOFF_ULPS: f64 = 16.0;
-
 /// Turns of the loop between two progress reports.
 const PROGRESS_EVERY: u64 = 1 << 14;
 
 /// Events between two projections of the event budget.
 const BUDGET_CHECK: u64 = 1 << 20;
-
-fn largest(x: &[f64]) -> f64 {
-    x.iter().fold(0.0, |m: f64, v| m.max(v.abs()))
-}
 
 fn all_finite(x: &[f64]) -> bool {
     x.iter().all(|v| v.is_finite())

@@ -1,0 +1,291 @@
+//! The error bound a run states, kept as the run goes: the numerical
+//! steps' local errors carried along each stretch of flow and across each
+//! event ([`ErrorSet`], [`Tangents`]), each event's time error, and the
+//! round-off allowance of exact flows.
+//!
+//! What it promises, and when it stops a run:
+//! - `error_bound` bounds every state component at the end, and
+//!   `event_time_bound` every event time: an error `d` moves an event by
+//!   `d / closing speed`, and the saltation matrix says what that does to
+//!   the state after the reset.
+//! - An event whose time the error leaves uncertain by half the interval
+//!   since the previous event, one at zero closing speed, or an event
+//!   within its time error of `t_end`, means the events' order, count or
+//!   final state can no longer be told: the run stops and says why.
+//! - Events closer than the run can resolve are the Zeno watch's to judge,
+//!   not the bound's.
+//! - Exact flows add no error: their bound is a round-off allowance of
+//!   [`ROUNDOFF_ULPS`] ulps of the state's size per event (an estimate of
+//!   how round-off grows, not a bound), and an exact run pays for nothing
+//!   else.
+
+use crate::engine::error_set::ErrorSet;
+use crate::engine::model::{HybridModel, Mode};
+use crate::engine::tangent::Tangents;
+use crate::engine::zeno;
+use crate::time::Time;
+
+/// Round-off allowed per event, in ulps of the state's size (and of the
+/// time's for event times).
+pub const ROUNDOFF_ULPS: f64 = 16.0;
+
+/// A run's errors so far and the bounds it will state.
+#[derive(Debug, Clone)]
+pub(crate) struct Bound {
+    errors: ErrorSet,
+    tangents: Tangents,
+    /// Scratch: a tangent or saltation matrix, and a guard's gradient.
+    matrix: Vec<f64>,
+    gradient: Vec<f64>,
+    /// Gradients of a mode's affine guards, computed once per mode.
+    affine_gradients: (Option<Mode>, Vec<f64>),
+    /// The largest event-time error so far, the last event's, and when the
+    /// last logged event fired.
+    event_time_bound: f64,
+    last_time_bound: f64,
+    last_event: Option<Time>,
+    /// The largest state component seen (initial state and events): the
+    /// round-off allowance's scale.
+    state_scale: f64,
+}
+
+impl Bound {
+    /// No error yet, for a run of dimension `n` from `x0`.
+    pub fn new(n: usize, x0: &[f64]) -> Self {
+        Bound {
+            errors: ErrorSet::new(n),
+            tangents: Tangents::new(n),
+            matrix: vec![0.0; n * n],
+            gradient: vec![0.0; n],
+            affine_gradients: (None, Vec::new()),
+            event_time_bound: 0.0,
+            last_time_bound: 0.0,
+            last_event: None,
+            state_scale: x0.iter().fold(0.0, |m: f64, v| m.max(v.abs())),
+        }
+    }
+
+    /// Whether there is no error to carry (an exact run's stays so).
+    #[inline(always)]
+    pub fn idle(&self) -> bool {
+        self.errors.is_empty()
+    }
+
+    /// Carry the errors over a stretch `tau` of an ODE flow in `mode` whose
+    /// states `at(s)` the step's dense output gives, adding `local`.
+    pub fn after_step<M: HybridModel + ?Sized>(
+        &mut self,
+        model: &M,
+        mode: Mode,
+        tau: f64,
+        local: f64,
+        at: impl FnMut(f64, &mut [f64]),
+    ) {
+        if self.errors.tracked() {
+            self.tangents.ode(model, mode, tau, at, &mut self.matrix);
+        }
+        self.errors.map(&self.matrix, local);
+    }
+
+    /// Carry the errors over `tau` of `mode`'s exact flow from `state`.
+    pub fn after_exact<M: HybridModel + ?Sized>(
+        &mut self,
+        model: &M,
+        mode: Mode,
+        state: &[f64],
+        tau: f64,
+    ) {
+        if self.errors.tracked() && !self.errors.is_empty() {
+            self.tangents
+                .exact(model, mode, state, tau, &mut self.matrix);
+            self.errors.map(&self.matrix, 0.0);
+        }
+    }
+
+    /// Add an error of half-width `jump` where the state stands: a resting
+    /// state stands in for an orbit it is not exactly on.
+    pub fn widen(&mut self, jump: f64) {
+        self.errors.widen(jump);
+    }
+
+    /// How far guard `g` of `mode` may be off at `state`: the errors so far
+    /// and a step's `local` error, along the guard's gradient (the graze
+    /// check's margin).
+    pub fn guard_uncertainty<M: HybridModel + ?Sized>(
+        &mut self,
+        model: &M,
+        mode: Mode,
+        g: usize,
+        state: &[f64],
+        local: f64,
+    ) -> f64 {
+        self.gradient_of(model, mode, g, state);
+        self.errors.along(&self.gradient)
+            + self.gradient.iter().map(|d| d.abs()).sum::<f64>() * local
+    }
+
+    /// The gradient of guard `g` of `mode` at `state`, into
+    /// `self.gradient`: once per mode for affine guards.
+    fn gradient_of<M: HybridModel + ?Sized>(
+        &mut self,
+        model: &M,
+        mode: Mode,
+        g: usize,
+        state: &[f64],
+    ) {
+        let n = state.len();
+        if !model.guards(mode)[g].affine {
+            self.tangents
+                .gradient(model, mode, g, state, &mut self.gradient);
+            return;
+        }
+        if self.affine_gradients.0 != Some(mode) {
+            let guards = model.guards(mode).len();
+            let mut all = vec![0.0; guards * n];
+            for (g, row) in all.chunks_mut(n).enumerate() {
+                self.tangents.gradient(model, mode, g, state, row);
+            }
+            self.affine_gradients = (Some(mode), all);
+        }
+        self.gradient
+            .copy_from_slice(&self.affine_gradients.1[g * n..(g + 1) * n]);
+    }
+
+    /// Note an event's state before its reset, for the round-off
+    /// allowance's scale (a plain loop: this runs at every event of an
+    /// exact run too).
+    #[inline(always)]
+    pub fn note_state(&mut self, before: &[f64]) {
+        for x in before {
+            let size = x.abs();
+            if size > self.state_scale {
+                self.state_scale = size;
+            }
+        }
+    }
+
+    /// Carry the errors across the event of guard `slot` of `mode` at `t`,
+    /// from `before` to `after` in `mode_after`, by its saltation matrix,
+    /// and bound the event's time; why the run cannot go on, if it cannot
+    /// (`method` names the method in the reason).
+    #[allow(clippy::too_many_arguments)]
+    #[inline(never)]
+    pub fn across<M: HybridModel + ?Sized>(
+        &mut self,
+        model: &M,
+        mode: Mode,
+        slot: usize,
+        t: Time,
+        (before, after): (&[f64], &[f64]),
+        mode_after: Mode,
+        t_end: f64,
+        method: &str,
+    ) -> Result<(), String> {
+        if self.errors.is_empty() || !self.errors.tracked() {
+            return Ok(());
+        }
+        let guard = model.guards(mode)[slot];
+        self.tangents
+            .gradient(model, mode, slot, before, &mut self.gradient);
+        let along = self.errors.along(&self.gradient);
+        let (closing, jump) = self.tangents.saltation(
+            model,
+            mode,
+            slot,
+            before,
+            &self.gradient,
+            mode_after,
+            after,
+            &mut self.matrix,
+        );
+        let shift = along / closing.abs();
+        let since = self.last_event.map(|last| t.since(last));
+        // Events closer than the run can resolve are the Zeno watch's to
+        // judge (it settles them or stops), not the error bound's: their
+        // order and any state at them are equally unresolvable.
+        if since.is_some_and(|since| since <= zeno::resolution(t.value(), t_end)) {
+            if self.matrix.iter().all(|m| m.is_finite()) {
+                self.errors.map(&self.matrix, 0.0);
+            }
+            return Ok(());
+        }
+        if !guard.internal {
+            self.last_event = Some(t);
+            self.last_time_bound = shift;
+            self.event_time_bound = self.event_time_bound.max(shift);
+        }
+        if !shift.is_finite() {
+            return Err(format!(
+                "the `{}` event at t = {} comes at zero closing speed (a graze) with an integration \
+                 error of {along:.2e} in its guard: whether and when it fires cannot be told, so {method} \
+                 cannot be trusted past here; tighten the method or use an exact one",
+                guard.name,
+                t.value(),
+            ));
+        }
+        if let Some(since) = since.filter(|since| !guard.internal && shift > 0.5 * since) {
+            return Err(format!(
+                "the `{}` event at t = {} may be off by {shift:.2e} in time (its guard by {along:.2e}, \
+                 closing at {:.2e}), more than half the {since:.3e} since the previous event: the \
+                 integration error so far ({:.2e} in the state) leaves the events' order and count \
+                 uncertain, so {method} cannot be trusted past here; tighten the method or use an exact one",
+                guard.name,
+                t.value(),
+                closing.abs(),
+                self.errors.state_bound(),
+            ));
+        }
+        // Where the event was located, the guard is not exactly zero: the
+        // reset came that residual's time early or late (rounding at
+        // least), which leaves `f+ - R f-` times it in the state.
+        let residual = model.guard(mode, slot, before).abs()
+            + f64::EPSILON
+                * self
+                    .gradient
+                    .iter()
+                    .zip(before)
+                    .map(|(g, x)| (g * x).abs())
+                    .sum::<f64>();
+        self.errors
+            .map(&self.matrix, jump * residual / closing.abs());
+        Ok(())
+    }
+
+    /// Whether the run may end at `t`, with its next event predicted at
+    /// `next`: an event within its time error of the end may or may not
+    /// belong to the run, and then its count and final state are uncertain.
+    pub fn at_end(&self, t: Time, next: Option<Time>) -> Result<(), String> {
+        let around = [
+            self.last_event.map(|last| t.since(last)),
+            next.map(|next| next.since(t)),
+        ];
+        match around
+            .into_iter()
+            .flatten()
+            .find(|gap| self.last_time_bound > 0.0 && *gap <= self.last_time_bound)
+        {
+            Some(gap) => Err(format!(
+                "an event lies {gap:.2e} from t_end = {}, within the time error of the events \
+                 ({:.2e}): whether it happens before the end is uncertain, so the final state cannot \
+                 be trusted; tighten the method or move t_end",
+                t.value(),
+                self.last_time_bound
+            )),
+            None => Ok(()),
+        }
+    }
+
+    /// The bound on every state component after `events` events.
+    pub fn state_bound(&self, events: u64) -> f64 {
+        self.errors.state_bound()
+            + ROUNDOFF_ULPS * f64::EPSILON * self.state_scale * (1 + events) as f64
+    }
+
+    /// The bound on every event time of a run that reached `t`; `None`
+    /// where the errors are not tracked.
+    pub fn event_time_bound(&self, t: Time) -> Option<f64> {
+        self.errors
+            .tracked()
+            .then(|| self.event_time_bound + ROUNDOFF_ULPS * f64::EPSILON * t.value().abs())
+    }
+}
