@@ -26,4 +26,4 @@ pub use labels::{Label, Labels};
 pub use local::{Fired, LocalModel, simulate_local};
 pub use model::{Affects, Direction, Flow, Guard, HybridModel, Jump, Mode};
 pub use observer::{EventRecord, EventTimes, Observer, RecordedEvent, Recorder, SETTLE};
-pub use simulation::{Options, Outcome, Status, simulate};
+pub use simulation::{Options, Outcome, Sample, Status, simulate, simulate_sampled};

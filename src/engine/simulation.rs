@@ -144,6 +144,19 @@ pub struct Outcome {
     pub wall_seconds: f64,
 }
 
+/// The state at one of the sample times a run was asked for.
+#[derive(Debug, Clone, Copy)]
+pub struct Sample<'a> {
+    /// The sample time.
+    pub t: f64,
+    /// The mode then.
+    pub mode: Mode,
+    /// The state then (before an event at the same time).
+    pub state: &'a [f64],
+    /// Events logged before it.
+    pub events: u64,
+}
+
 /// Run `model` from state `x0` in `mode` at `t = 0`, reporting events to
 /// `observer`.
 pub fn simulate<M: HybridModel + ?Sized, O: Observer + ?Sized>(
@@ -151,6 +164,22 @@ pub fn simulate<M: HybridModel + ?Sized, O: Observer + ?Sized>(
     mode: Mode,
     x0: &[f64],
     options: &Options,
+    observer: &mut O,
+) -> Outcome {
+    simulate_sampled(model, mode, x0, options, &[], &mut |_| {}, observer)
+}
+
+/// [`simulate`], also calling `on_sample` with the state at each of
+/// `samples` (times in increasing order, up to `t_end`), taken from the
+/// flow as it goes: the run is not restarted there, so sampling changes
+/// neither its steps nor its events.
+pub fn simulate_sampled<M: HybridModel + ?Sized, O: Observer + ?Sized>(
+    model: &M,
+    mode: Mode,
+    x0: &[f64],
+    options: &Options,
+    samples: &[f64],
+    on_sample: &mut dyn FnMut(&Sample),
     observer: &mut O,
 ) -> Outcome {
     // The model is asked nothing about a state it cannot hold.
@@ -173,7 +202,7 @@ pub fn simulate<M: HybridModel + ?Sized, O: Observer + ?Sized>(
     let mut run = Run::new(model, mode, &x0, options);
     let end = match refused {
         Some(reason) => End::failed(reason),
-        None => run.event_loop(observer),
+        None => run.event_loop(observer, samples, on_sample),
     };
     run.outcome(end)
 }
@@ -270,8 +299,14 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
         }
     }
 
-    fn event_loop<O: Observer + ?Sized>(&mut self, observer: &mut O) -> End {
+    fn event_loop<O: Observer + ?Sized>(
+        &mut self,
+        observer: &mut O,
+        samples: &[f64],
+        on_sample: &mut dyn FnMut(&Sample),
+    ) -> End {
         let t_end = self.options.t_end;
+        let mut sampled = 0;
         if let Err(end) = self.start_segment() {
             return end;
         }
@@ -307,8 +342,16 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
                 (Some((_, t)), Some(end)) if end < t => (None, end),
                 (Some((slot, t)), _) => (Some(slot), t),
                 (None, Some(end)) => (None, end),
-                (None, None) => return self.finish_at(Time::new(t_end)),
+                (None, None) => (None, Time::new(f64::INFINITY)),
             };
+            // Samples due before what happens next see the flow as it is.
+            let due = next.1.value().min(t_end);
+            while let Some(&s) = samples.get(sampled)
+                && s <= due
+            {
+                self.sample_at(s, on_sample);
+                sampled += 1;
+            }
             let result = match next {
                 (_, t) if t.value() > t_end => return self.finish_at(Time::new(t_end)),
                 (Some(slot), t) => {
@@ -338,6 +381,19 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
                 return end;
             }
         }
+    }
+
+    /// Report the state at time `s` (not before the current origin).
+    fn sample_at(&mut self, s: f64, on_sample: &mut dyn FnMut(&Sample)) {
+        let mut x = std::mem::take(&mut self.before);
+        self.state_at(Time::new(s).since(self.origin).max(0.0), &mut x);
+        on_sample(&Sample {
+            t: s,
+            mode: self.mode,
+            state: &x,
+            events: self.events,
+        });
+        self.before = x;
     }
 
     /// Every [`BUDGET_CHECK`] events, project the events still needed to

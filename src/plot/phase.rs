@@ -16,7 +16,7 @@
 //!   `sqrt(K - 4 omega^2 f1^2)` for `f1 < 0` (24). Passing `theta1 = 0` is
 //!   an impact of `b` at zero, so the strain model simulates it.
 
-use crate::engine::{HybridModel, Mode, Options, simulate};
+use crate::engine::{HybridModel, Mode, Options, Sample, simulate_sampled};
 use crate::models::mechanism::angle::{AngleMechanism, Charts};
 use crate::models::mechanism::strain::FLIGHT;
 use crate::models::mechanism::{Mechanism, Phase, StrainMechanism};
@@ -426,8 +426,8 @@ fn trajectory(m: Mechanism, plane: Plane, level: f64) -> Vec<(f64, f64)> {
     }
 }
 
-/// States at evenly spaced times over `[0, t_end]`, each run on from the
-/// previous sample by the engine, with the mode and the events so far.
+/// States at evenly spaced times over `[0, t_end]` of one run, with the
+/// mode and the events so far.
 fn sample<M: HybridModel>(
     model: &M,
     mode: Mode,
@@ -435,12 +435,16 @@ fn sample<M: HybridModel>(
     t_end: f64,
 ) -> Vec<(Mode, u64, Vec<f64>)> {
     let mut out = vec![(mode, 0, x0.to_vec())];
-    let (mut mode, mut x, mut events) = (mode, x0.to_vec(), 0);
     let dt = t_end / (2 * SAMPLES) as f64;
-    for _ in 0..2 * SAMPLES {
-        let o = simulate(model, mode, &x, &Options::until(dt), &mut ());
-        (mode, x, events) = (o.final_mode, o.final_state, events + o.events);
-        out.push((mode, events, x.clone()));
-    }
+    let times: Vec<f64> = (1..=2 * SAMPLES).map(|k| k as f64 * dt).collect();
+    simulate_sampled(
+        model,
+        mode,
+        x0,
+        &Options::until(t_end),
+        &times,
+        &mut |s: &Sample| out.push((s.mode, s.events, s.state.to_vec())),
+        &mut (),
+    );
     out
 }

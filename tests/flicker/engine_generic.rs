@@ -161,3 +161,68 @@ fn a_quiet_guard_is_dropped_from_the_queue_without_a_prediction() {
     assert!(!outcome.events_by_guard.contains_key("alarm"));
     assert_eq!(model.alarm_predictions.get(), 1);
 }
+
+/// Samples are taken from the flow as the run goes: they change neither
+/// its steps nor its events, they lie on the orbit, and one at an event's
+/// time sees the state before the reset.
+#[test]
+fn sampling_a_run_changes_nothing_and_reads_the_flow() {
+    use flicker::engine::{Method, Sample, Tolerances, simulate_sampled};
+    use flicker::models::mechanism::strain::FLIGHT;
+    use flicker::models::mechanism::{ExactOrbit, Mechanism, StrainMechanism};
+
+    let m = Mechanism {
+        eta: 0.8,
+        omega: 1.0,
+    };
+    let model = StrainMechanism { mechanism: m };
+    let x0 = [0.3, 0.0];
+    let exact = ExactOrbit::new(m, x0[0], x0[1]);
+    let first_impact = exact.impact_time(0);
+    // Evenly spaced times, and one exactly at the first impact.
+    let mut times: Vec<f64> = (1..=500).map(|k| k as f64 * 0.1).collect();
+    times.push(first_impact);
+    times.sort_by(f64::total_cmp);
+    let tol = Tolerances {
+        rtol: 1e-10,
+        atol: 1e-10,
+    };
+    for method in [Method::Exact, Method::Dopri5(tol)] {
+        let mut options = Options::until(50.0);
+        options.method = method;
+        let mut plain = Recorder::default();
+        let alone = simulate(&model, FLIGHT, &x0, &options, &mut plain);
+        let mut sampled = Recorder::default();
+        let mut seen = Vec::new();
+        let with = simulate_sampled(
+            &model,
+            FLIGHT,
+            &x0,
+            &options,
+            &times,
+            &mut |s: &Sample| seen.push((s.t, s.state.to_vec())),
+            &mut sampled,
+        );
+        assert_eq!(alone.final_state, with.final_state, "{method:?}");
+        assert_eq!(plain.events, sampled.events, "{method:?}");
+        assert_eq!(seen.len(), times.len(), "{method:?}");
+        for (t, x) in &seen {
+            let (eps, rate) = exact.state_at(*t);
+            // Exact: the closed form to round-off; Dormand-Prince: within
+            // the error bound the run states.
+            let allowed = with.error_bound.max(1e-12);
+            assert!((x[0] - eps).abs() <= allowed, "{method:?} t = {t}: {x:?}");
+            // Within an impact's time error the rate may be either side of
+            // its flip; the exact flow's sample at the impact itself sees
+            // the state before the reset, still closing.
+            let near = (0..exact.impacts_until(51.0)).any(|k| {
+                (exact.impact_time(k) - t).abs() <= with.event_time_bound.unwrap().max(1e-12)
+            });
+            if method == Method::Exact && *t == first_impact {
+                assert!(x[1] < 0.0, "{x:?}");
+            } else if !near {
+                assert!((x[1] - rate).abs() <= allowed, "{method:?} t = {t}: {x:?}");
+            }
+        }
+    }
+}

@@ -3,8 +3,8 @@
 //! profiles at the snapshot times and the trace at the sample times.
 
 use crate::engine::{
-    EventRecord, HybridModel, LocalModel, Method, Observer, Options, Outcome, Status, simulate,
-    simulate_local,
+    HybridModel, LocalModel, Method, Observer, Options, Outcome, Sample, Status, simulate_local,
+    simulate_sampled,
 };
 use crate::models::chain::{Chain, TaylorChain};
 use crate::runner::{
@@ -191,8 +191,7 @@ fn run_exact(
     ))
 }
 
-/// The chain as an ODE, run from sample time to sample time (the state is
-/// continuous there, so a restart changes nothing) to take the profiles.
+/// The chain as an ODE, sampled for the profiles and the trace as it runs.
 fn run_ode(
     scene: &ChainScene,
     chain: &Chain,
@@ -202,7 +201,7 @@ fn run_ode(
     observer: &mut dyn Observer,
 ) -> Result<Report, SceneError> {
     let n = chain.units;
-    let mut x: Vec<f64> = gaps
+    let x: Vec<f64> = gaps
         .iter()
         .scan(0.0, |y, d| {
             *y += d;
@@ -211,65 +210,32 @@ fn run_ode(
         .chain(scene.velocity.iter().copied())
         .collect();
     let mut sampler = Sampler::new(scene, chain);
-    let mut stops = scene.due_times();
-    stops.push(scene.t_end);
-    let energy_initial = chain.energy(0, &x).unwrap_or(0.0);
-    let scale = chain.energy_scale(energy_initial);
-    let mut total: Option<Outcome> = None;
-    let mut reached = 0.0;
-    // Largest energy error of any leg, against the run's initial energy.
-    let mut energy_error: f64 = 0.0;
-    for &stop in &stops {
-        if stop > reached {
-            // Each leg gets what is left of the run's budgets.
-            let spent = total
-                .as_ref()
-                .map_or((0, 0.0), |o| (o.events, o.wall_seconds));
-            let mut options = options.clone();
-            options.t_end = stop - reached;
-            options.max_events = options.max_events.saturating_sub(spent.0);
-            options.max_wall_seconds = options.max_wall_seconds.map(|w| (w - spent.1).max(0.0));
-            let mut leg = Leg {
-                inner: &mut *observer,
-                seq: total.as_ref().map_or(0, |o| o.events),
-                t: reached,
-            };
-            let o = simulate(chain, 0, &x, &options, &mut leg);
-            x.copy_from_slice(&o.final_state);
-            reached += o.t_reached;
-            if let (Some(e0), Some(err)) = (o.energy_initial, o.max_energy_error) {
-                let leg_scale = chain.energy_scale(e0);
-                energy_error =
-                    energy_error.max((err * leg_scale + (e0 - energy_initial).abs()) / scale);
-            }
-            let stopped = o.status != Status::Completed;
-            total = Some(match total {
-                None => o,
-                Some(t) => combine(t, o),
-            });
-            if stopped {
-                break;
-            }
-        }
-        let (ys, vs) = x.split_at(n);
-        let energy = chain.energy(0, &x);
-        sampler.at(stop, || {
-            let gaps = (0..n)
-                .map(|i| ys[i] - if i > 0 { ys[i - 1] } else { 0.0 })
-                .collect();
-            (
-                State {
+    let times = scene.due_times();
+    let outcome = simulate_sampled(
+        chain,
+        0,
+        &x,
+        options,
+        &times,
+        &mut |sample: &Sample| {
+            let (ys, vs) = sample.state.split_at(n);
+            sampler.at(sample.t, || {
+                let gaps = (0..n)
+                    .map(|i| ys[i] - if i > 0 { ys[i - 1] } else { 0.0 })
+                    .collect();
+                let state = State {
                     gaps,
                     velocities: vs.to_vec(),
-                },
-                energy,
-            )
-        });
-    }
-    let mut outcome = total.expect("t_end > 0 gives one leg");
-    outcome.t_reached = reached;
-    outcome.t_end = scene.t_end;
-    outcome.max_energy_error = Some(energy_error);
+                };
+                (state, chain.energy(0, sample.state))
+            })
+        },
+        observer,
+    );
+    let (momentum, right_end) = (
+        chain.momentum(&outcome.final_state),
+        outcome.final_state[n - 1],
+    );
     let name = method.name();
     let description =
         format!("chain of {n} units as a linear ODE in positions and velocities, by {name}");
@@ -278,9 +244,9 @@ fn run_ode(
         name,
         description,
         FieldOutputs {
-            momentum: chain.momentum(&x),
+            momentum,
             momentum_balance_error: None,
-            right_end: x[n - 1],
+            right_end,
             profiles: sampler.profiles,
             trace: sampler.trace,
             classical: None,
@@ -303,54 +269,5 @@ fn report(
             ("right_end", fields.right_end),
         ],
         fields: Some(fields),
-    }
-}
-
-/// Two legs of one run as one outcome.
-fn combine(mut a: Outcome, b: Outcome) -> Outcome {
-    for (guard, n) in b.events_by_guard {
-        *a.events_by_guard.entry(guard).or_insert(0) += n;
-    }
-    Outcome {
-        status: b.status,
-        reason: b.reason,
-        events: a.events + b.events,
-        zeno: a.zeno || b.zeno,
-        energy_final: b.energy_final,
-        final_state: b.final_state,
-        flow_evaluations: a.flow_evaluations + b.flow_evaluations,
-        // Each leg starts its error set afresh, so neither the sum nor an
-        // event-time bound carries the first leg's error through the second.
-        error_bound: a.error_bound + b.error_bound,
-        event_time_bound: None,
-        wall_seconds: a.wall_seconds + b.wall_seconds,
-        ..a
-    }
-}
-
-/// One leg's events as the run's: numbered on from `seq`, timed from `t`
-/// (each leg counts from 1 and starts its clock at 0).
-struct Leg<'o> {
-    inner: &'o mut dyn Observer,
-    seq: u64,
-    t: f64,
-}
-
-impl Observer for Leg<'_> {
-    fn on_event(&mut self, event: &EventRecord) -> std::io::Result<()> {
-        let moved = EventRecord {
-            seq: event.seq + self.seq,
-            t: event.t + self.t,
-            ..*event
-        };
-        self.inner.on_event(&moved)
-    }
-
-    fn on_progress(&mut self, t: f64, events: u64) {
-        self.inner.on_progress(t + self.t, events + self.seq);
-    }
-
-    fn wants_details(&self) -> bool {
-        self.inner.wants_details()
     }
 }
