@@ -19,7 +19,7 @@
 //!   how round-off grows, not a bound), and an exact run pays for nothing
 //!   else.
 
-use crate::engine::error_set::ErrorSet;
+use crate::engine::error_set::{ErrorSet, TRACKED};
 use crate::engine::model::{HybridModel, Mode};
 use crate::engine::tangent::Tangents;
 use crate::engine::zeno;
@@ -39,6 +39,8 @@ pub(crate) struct Bound {
     gradient: Vec<f64>,
     /// Gradients of a mode's affine guards, computed once per mode.
     affine_gradients: (Option<Mode>, Vec<f64>),
+    /// The same, summed in size, where errors are not tracked.
+    affine_sums: (Option<Mode>, Vec<f64>),
     /// The largest event-time error so far, the last event's, and when the
     /// last logged event fired.
     event_time_bound: f64,
@@ -55,9 +57,10 @@ impl Bound {
         Bound {
             errors: ErrorSet::new(n),
             tangents: Tangents::new(n),
-            matrix: vec![0.0; n * n],
+            matrix: vec![0.0; if n <= TRACKED { n * n } else { 0 }],
             gradient: vec![0.0; n],
             affine_gradients: (None, Vec::new()),
+            affine_sums: (None, Vec::new()),
             event_time_bound: 0.0,
             last_time_bound: 0.0,
             last_event: None,
@@ -119,9 +122,39 @@ impl Bound {
         state: &[f64],
         local: f64,
     ) -> f64 {
+        if !self.errors.tracked() && model.guards(mode)[g].affine {
+            // An untracked set has one scale for every direction: what an
+            // affine guard needs of its gradient is the sum of its sizes,
+            // kept per guard (a long chain's gradients would cost O(N) per
+            // guard per step).
+            let sum = self.affine_sum(model, mode, g, state);
+            let unit = [1.0];
+            return sum * (self.errors.along(&unit) + local);
+        }
         self.gradient_of(model, mode, g, state);
         self.errors.along(&self.gradient)
             + self.gradient.iter().map(|d| d.abs()).sum::<f64>() * local
+    }
+
+    /// `sum |d g / d x_i|` of affine guard `g` of `mode`, once per mode.
+    fn affine_sum<M: HybridModel + ?Sized>(
+        &mut self,
+        model: &M,
+        mode: Mode,
+        g: usize,
+        state: &[f64],
+    ) -> f64 {
+        if self.affine_sums.0 != Some(mode) {
+            let sums = (0..model.guards(mode).len())
+                .map(|g| {
+                    self.tangents
+                        .gradient(model, mode, g, state, &mut self.gradient);
+                    self.gradient.iter().map(|d| d.abs()).sum()
+                })
+                .collect();
+            self.affine_sums = (Some(mode), sums);
+        }
+        self.affine_sums.1[g]
     }
 
     /// The gradient of guard `g` of `mode` at `state`, into

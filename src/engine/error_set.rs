@@ -44,6 +44,8 @@ pub struct ErrorSet {
     /// squares (the untracked graze check's scale).
     sum: f64,
     squares: f64,
+    /// Set once a non-finite error entered: every bound is then infinite.
+    poisoned: bool,
     order: [usize; TRACKED],
 }
 
@@ -62,6 +64,7 @@ impl ErrorSet {
             radii: [0.0; TRACKED],
             sum: 0.0,
             squares: 0.0,
+            poisoned: false,
             order: std::array::from_fn(|i| i),
         }
     }
@@ -83,7 +86,10 @@ impl ErrorSet {
     pub fn map(&mut self, m: &[f64], local: f64) {
         self.sum += local;
         self.squares += local * local;
-        if !self.tracked() {
+        if !local.is_finite() || !m.iter().all(|x| x.is_finite()) {
+            self.poisoned = true;
+        }
+        if !self.tracked() || self.poisoned {
             return;
         }
         let n = self.n;
@@ -136,12 +142,19 @@ impl ErrorSet {
     /// rare event: the identity is built each time).
     pub fn widen(&mut self, local: f64) {
         let n = self.n;
+        if !self.tracked() {
+            self.sum += local;
+            return;
+        }
         let identity: Vec<f64> = (0..n * n).map(|k| f64::from(k % (n + 1) == 0)).collect();
         self.map(&identity, local);
     }
 
     /// The largest error any state component may carry.
     pub fn state_bound(&self) -> f64 {
+        if self.poisoned {
+            return f64::INFINITY;
+        }
         if !self.tracked() {
             return self.sum;
         }
@@ -160,6 +173,9 @@ impl ErrorSet {
     /// times the root-sum-square of the local errors, as if independent.
     pub fn along(&self, gradient: &[f64]) -> f64 {
         let n = self.n;
+        if self.poisoned {
+            return f64::INFINITY;
+        }
         if !self.tracked() {
             return gradient.iter().map(|g| g.abs()).sum::<f64>() * self.squares.sqrt();
         }

@@ -10,6 +10,7 @@
 //!
 //! [`ErrorSet`]: crate::engine::error_set::ErrorSet
 
+use crate::engine::error_set::TRACKED;
 use crate::engine::model::{Flow, HybridModel, Mode};
 
 /// Scratch for the linearisations of one run; matrices are row-major
@@ -46,9 +47,11 @@ impl Tangents {
             x: vec![0.0; n],
             up: vec![0.0; n],
             down: vec![0.0; n],
-            a: vec![0.0; n * n],
-            b: vec![0.0; n * n],
-            c: vec![0.0; n * n],
+            // Matrices only where errors are tracked (a long chain as an
+            // ODE would hold gigabytes it never uses).
+            a: vec![0.0; if n <= TRACKED { n * n } else { 0 }],
+            b: vec![0.0; if n <= TRACKED { n * n } else { 0 }],
+            c: vec![0.0; if n <= TRACKED { n * n } else { 0 }],
         }
     }
 
@@ -282,6 +285,11 @@ fn exp(n: usize, a: &[f64], out: &mut [f64], term: &mut [f64], next: &mut [f64])
     let norm = (0..n)
         .map(|i| (0..n).map(|j| a[i * n + j].abs()).sum::<f64>())
         .fold(0.0, f64::max);
+    if !norm.is_finite() {
+        // No exponential to take: the bound that uses it becomes infinite.
+        out.fill(f64::NAN);
+        return;
+    }
     let squarings = if norm > 0.5 {
         (norm / 0.5).log2().ceil() as i32
     } else {
