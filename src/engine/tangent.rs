@@ -240,7 +240,6 @@ impl Tangents {
         let n = self.n;
         let mut reset = std::mem::take(&mut self.a);
         // The reset's Jacobian, by central differences.
-        self.x.copy_from_slice(before);
         for j in 0..n {
             let h = step_for(before[j]);
             self.up.copy_from_slice(before);
