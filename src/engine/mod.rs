@@ -1,6 +1,7 @@
 //! The generic hybrid-systems engine: models declare flows, guards and
-//! resets ([`model`]); the simulation owns the event queue, event location
-//! and the loop ([`simulation`]).
+//! resets ([`model`]); one run loop (`run_loop.rs`) drives either source
+//! of segments, the whole state ([`simulation`]) or an event-local model
+//! ([`local`]), and returns the [`Outcome`] of a run ([`run`]).
 
 pub mod adaptive;
 pub mod bound;
@@ -9,12 +10,15 @@ pub mod dopri5;
 pub mod error_set;
 pub mod integrator;
 pub mod labels;
+mod ledger;
 pub mod linear;
 pub mod local;
 pub mod locate;
 pub mod model;
 pub mod observer;
 pub mod queue;
+pub mod run;
+mod run_loop;
 pub mod simulation;
 pub mod tangent;
 pub mod verlet;
@@ -26,4 +30,5 @@ pub use labels::{Label, Labels};
 pub use local::{Fired, LocalModel, simulate_local};
 pub use model::{Affects, Direction, Flow, Guard, HybridModel, Jump, Mode};
 pub use observer::{EventRecord, EventTimes, Observer, RecordedEvent, Recorder, SETTLE};
-pub use simulation::{Options, Outcome, Sample, Status, simulate, simulate_sampled};
+pub use run::{Options, Outcome, Status};
+pub use simulation::{Sample, simulate, simulate_sampled};

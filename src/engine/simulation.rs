@@ -1,148 +1,32 @@
-//! The event-driven loop: predict, pop the earliest event, advance, reset,
-//! re-predict, record.
+//! The whole-state source of segments: the engine holds the model's state
+//! and advances it, for models small enough to copy at every event.
 //!
-//! The loop never asks which integrator a mode uses. A mode's flow gives a
+//! It never asks which integrator a mode uses. A mode's flow gives a
 //! *segment*: for an exact flow, the whole future (guards predicted by the
 //! model's exact crossing times); for an ODE, one accepted step with dense
 //! output (guards located on it, see [`locate`]). The queue holds one
 //! prediction per guard; whichever comes first, the earliest prediction or
-//! the end of the current step, happens next.
-//!
-//! How a run can end, in [`Status`]: it reaches `t_end`; events of one guard
-//! accumulate faster than the run can resolve (Zeno), and the model either
-//! settles into a resting mode or the run stops there; a method fails (step
-//! size collapse, non-finite state, event budget spent, the log could not be
-//! written); or it is interrupted. The run never spins.
+//! the end of the current step, happens next. Along the way it carries the
+//! run's error bound ([`bound`]) and stops where an event cannot be decided
+//! (a graze within the integration error, a non-finite state, a step size
+//! collapse). Order, samples, budgets, Zeno, the energy audit and counts
+//! are the one run loop's (`src/engine/run_loop.rs`).
 //!
 //! [`locate`]: crate::engine::locate
+//! [`bound`]: crate::engine::bound
 
-use std::collections::BTreeMap;
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::Instant;
-
-use crate::engine::adaptive::{StepFailure, Tolerances};
+use crate::engine::adaptive::StepFailure;
 use crate::engine::bound::Bound;
-use crate::engine::integrator::{Crossing, Integrator, Method, Motion, motion};
+use crate::engine::integrator::{Crossing, Integrator, Motion, motion};
 use crate::engine::labels::Labels;
+use crate::engine::ledger::{Final, Ledger};
 use crate::engine::locate::scan_step;
 use crate::engine::model::{Affects, Direction, HybridModel, Mode};
 use crate::engine::observer::{EventRecord, Observer, SETTLE};
 use crate::engine::queue::EventQueue;
-use crate::engine::zeno::ZenoWatch;
+use crate::engine::run::{Options, Outcome};
+use crate::engine::run_loop::{End, Segments, drive};
 use crate::time::Time;
-
-/// How to run a model.
-#[derive(Debug, Clone)]
-pub struct Options {
-    /// Simulated time to stop at (the run starts at 0).
-    pub t_end: f64,
-    /// Stop with `failed` after this many events (guards against runs that
-    /// would take forever without being Zeno).
-    pub max_events: u64,
-    /// How to advance the flows ([`Method::Auto`]: each mode's cheapest
-    /// exact description).
-    pub method: Method,
-    /// Tolerances of Dormand-Prince where [`Method::Auto`] needs it (modes
-    /// whose only flow is an ODE).
-    pub tolerances: Tolerances,
-    /// Set from outside (a signal handler) to stop the run cleanly.
-    pub stop: Option<Arc<AtomicBool>>,
-    /// Stop with `failed` after this much wall time (seconds), if set.
-    pub max_wall_seconds: Option<f64>,
-}
-
-impl Options {
-    /// Run to `t_end` with a budget of 10^9 events and default tolerances.
-    pub fn until(t_end: f64) -> Self {
-        Options {
-            t_end,
-            max_events: 1_000_000_000,
-            method: Method::Auto,
-            tolerances: Tolerances::default(),
-            stop: None,
-            max_wall_seconds: None,
-        }
-    }
-}
-
-/// How a run ended.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Status {
-    /// Reached `t_end`.
-    Completed,
-    /// A Zeno accumulation was recognised (see [`Outcome::reason`]); the run
-    /// either settled into resting contact and went on, or stopped there.
-    Zeno,
-    /// A method failed; the result cannot be trusted past `t_reached`.
-    Failed,
-    /// Stopped from outside.
-    Interrupted,
-}
-
-impl Status {
-    /// The status as the summary writes it: `completed`, `zeno`, `failed` or
-    /// `interrupted`.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Status::Completed => "completed",
-            Status::Zeno => "zeno",
-            Status::Failed => "failed",
-            Status::Interrupted => "interrupted",
-        }
-    }
-}
-
-/// What a run did.
-#[derive(Debug, Clone)]
-pub struct Outcome {
-    /// How the run ended.
-    pub status: Status,
-    /// Why the run is not plainly `completed`.
-    pub reason: Option<String>,
-    /// The simulated time the run was asked to reach.
-    pub t_end: f64,
-    /// The simulated time it reached: `t_end` unless it stopped early.
-    pub t_reached: f64,
-    /// Non-internal events (impacts and other resets).
-    pub events: u64,
-    /// Events per guard name; Zeno settlings under [`SETTLE`].
-    pub events_by_guard: BTreeMap<&'static str, u64>,
-    /// Whether a Zeno accumulation was recognised, whether the run then
-    /// settled and went on or stopped there.
-    pub zeno: bool,
-    /// The model's energy at the start, if it has one.
-    pub energy_initial: Option<f64>,
-    /// The model's energy at the end, if it has one.
-    pub energy_final: Option<f64>,
-    /// Largest `|E - E(0)| / scale` seen at any event and at the end.
-    pub max_energy_error: Option<f64>,
-    /// The mode the run ended in.
-    pub final_mode: Mode,
-    /// That mode's name.
-    pub final_mode_name: &'static str,
-    /// Names of the components of `final_state`.
-    pub final_state_names: Vec<&'static str>,
-    /// The state at `t_reached`.
-    pub final_state: Vec<f64>,
-    /// Evaluations of the flow: right-hand sides and propagators of
-    /// numerical methods, flow maps and crossing times of exact ones.
-    pub flow_evaluations: u64,
-    /// The largest error any state component may carry at the end: the
-    /// numerical steps' local errors carried through the flow and across
-    /// every event (see [`bound`](crate::engine::bound)), plus a round-off allowance of
-    /// [`ROUNDOFF_ULPS`](crate::engine::bound::ROUNDOFF_ULPS) ulps of the state's size per event. Above
-    /// [`TRACKED`](crate::engine::error_set::TRACKED) state components,
-    /// the plain sum of the local errors instead.
-    pub error_bound: f64,
-    /// The largest error any event time may carry: each event's share of
-    /// the state error divided by its closing speed, plus a round-off
-    /// allowance of [`ROUNDOFF_ULPS`](crate::engine::bound::ROUNDOFF_ULPS) ulps of the time reached; `None`
-    /// where the errors are not tracked.
-    pub event_time_bound: Option<f64>,
-    /// Wall time the run took, in seconds.
-    pub wall_seconds: f64,
-}
 
 /// The state at one of the sample times a run was asked for.
 #[derive(Debug, Clone, Copy)]
@@ -199,33 +83,21 @@ pub fn simulate_sampled<M: HybridModel + ?Sized, O: Observer + ?Sized>(
     } else {
         x0.to_vec()
     };
-    let mut run = Run::new(model, mode, &x0, options);
+    let energy_initial = model.energy(mode, &x0);
+    let energy_scale = energy_initial.map_or(1.0, |e| model.energy_scale(e));
+    let mut ledger = Ledger::new(options, energy_initial, energy_scale);
+    let mut run = Run::new(model, mode, &x0, options, on_sample);
     let end = match refused {
         Some(reason) => End::failed(reason),
-        None => run.event_loop(observer, samples, on_sample),
+        None => drive(&mut run, &mut ledger, samples, observer),
     };
-    run.outcome(end)
+    run.outcome(end, ledger)
 }
 
-/// Why the loop stopped, with a reason for anything but completion.
-struct End {
-    status: Status,
-    reason: Option<String>,
-}
-
-impl End {
-    fn failed(reason: String) -> Self {
-        End {
-            status: Status::Failed,
-            reason: Some(reason),
-        }
-    }
-}
-
-struct Run<'m, M: HybridModel + ?Sized> {
+struct Run<'m, 's, M: HybridModel + ?Sized> {
     model: &'m M,
     options: &'m Options,
-    started: Instant,
+    on_sample: &'s mut dyn FnMut(&Sample),
     mode: Mode,
     /// Time of the last event (or step end); `state` is the state then.
     origin: Time,
@@ -248,184 +120,39 @@ struct Run<'m, M: HybridModel + ?Sized> {
     /// checked for firing at once, and so is the barrier guard that just
     /// fired (`Some(slot)`, within the same mode).
     fresh: Option<Option<usize>>,
-    zeno: ZenoWatch,
-    /// Set once the run has settled a Zeno accumulation and gone on.
-    zeno_reason: Option<String>,
-    settles: u64,
-    /// The event count at which to check the budget next, and the count
-    /// and time at the previous check.
-    budget_check: (u64, u64, Time),
     before: Vec<f64>,
     after: Vec<f64>,
-    events: u64,
-    /// Event counts per mode and guard slot.
-    counts: Vec<Vec<u64>>,
-    energy_initial: Option<f64>,
-    energy_scale: f64,
-    max_energy_error: Option<f64>,
 }
 
-impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
-    fn new(model: &'m M, mode: Mode, x0: &[f64], options: &'m Options) -> Self {
-        let n = model.dimension();
-        let energy_initial = model.energy(mode, x0);
-        Run {
-            model,
-            options,
-            started: Instant::now(),
-            mode,
-            origin: Time::new(0.0),
-            state: x0.to_vec(),
-            queue: EventQueue::default(),
-            integrator: Integrator::for_method(options.method, n, options.tolerances),
-            motion: Motion::Frozen,
-            motions: Vec::new(),
-            exact_evaluations: 0,
-            bound: Bound::new(n, x0),
-            stepped: false,
-            step_end: None,
-            fresh: Some(None),
-            zeno: ZenoWatch::new(options.t_end),
-            zeno_reason: None,
-            settles: 0,
-            budget_check: (BUDGET_CHECK, 0, Time::new(0.0)),
-            before: vec![0.0; n],
-            after: vec![0.0; n],
-            events: 0,
-            counts: Vec::new(),
-            energy_initial,
-            energy_scale: energy_initial.map_or(1.0, |e| model.energy_scale(e)),
-            max_energy_error: energy_initial.map(|_| 0.0),
+impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
+    fn origin(&self) -> Time {
+        self.origin
+    }
+
+    fn begin(&mut self, _: &mut Ledger) -> Result<(), End> {
+        self.start_segment()
+    }
+
+    #[inline]
+    fn next(&self) -> (Option<usize>, Time) {
+        // An event at the very end of a step happens before the step ends.
+        match (self.queue.peek(), self.step_end) {
+            (Some((_, t)), Some(end)) if end < t => (None, end),
+            (Some((slot, t)), _) => (Some(slot), t),
+            (None, Some(end)) => (None, end),
+            (None, None) => (None, Time::new(f64::INFINITY)),
         }
     }
 
-    fn event_loop<O: Observer + ?Sized>(
-        &mut self,
-        observer: &mut O,
-        samples: &[f64],
-        on_sample: &mut dyn FnMut(&Sample),
-    ) -> End {
-        let t_end = self.options.t_end;
-        let mut sampled = 0;
-        if let Err(end) = self.start_segment() {
-            return end;
-        }
-        let mut turn: u64 = 0;
-        loop {
-            turn = turn.wrapping_add(1);
-            if self
-                .options
-                .stop
-                .as_ref()
-                .is_some_and(|s| s.load(Ordering::Relaxed))
-            {
-                return End {
-                    status: Status::Interrupted,
-                    reason: Some("stopped by a signal".into()),
-                };
-            }
-            if turn.is_multiple_of(PROGRESS_EVERY) {
-                observer.on_progress(self.origin.value(), self.events);
-            }
-            if turn.is_multiple_of(1024)
-                && let Some(limit) = self.options.max_wall_seconds
-                && self.started.elapsed().as_secs_f64() > limit
-            {
-                return End::failed(format!(
-                    "wall-time budget of {limit} s spent at t = {:e} after {} events",
-                    self.origin.value(),
-                    self.events
-                ));
-            }
-            // An event at the very end of a step happens before the step ends.
-            let next = match (self.queue.peek(), self.step_end) {
-                (Some((_, t)), Some(end)) if end < t => (None, end),
-                (Some((slot, t)), _) => (Some(slot), t),
-                (None, Some(end)) => (None, end),
-                (None, None) => (None, Time::new(f64::INFINITY)),
-            };
-            // Samples due before what happens next see the flow as it is.
-            let due = next.1.value().min(t_end);
-            while let Some(&s) = samples.get(sampled)
-                && s <= due
-            {
-                self.sample_at(s, on_sample);
-                sampled += 1;
-            }
-            let result = match next {
-                (_, t) if t.value() > t_end => return self.finish_at(Time::new(t_end)),
-                (Some(slot), t) => {
-                    self.queue.pop();
-                    self.fire(slot, t, observer)
-                }
-                (None, t) => {
-                    self.close_segment(t.since(self.origin));
-                    self.integrator.end(&mut self.state);
-                    self.origin = t;
-                    self.start_segment()
-                }
-            };
-            if let Err(end) = result {
-                return end;
-            }
-            if self.events > self.options.max_events {
-                return End::failed(format!(
-                    "event budget: more than max_events = {} events by t = {:e}; raise max_events or shorten t_end",
-                    self.options.max_events,
-                    self.origin.value()
-                ));
-            }
-            if self.events >= self.budget_check.0
-                && let Err(end) = self.check_budget(self.origin)
-            {
-                return end;
-            }
-        }
-    }
-
-    /// Report the state at time `s` (not before the current origin).
-    fn sample_at(&mut self, s: f64, on_sample: &mut dyn FnMut(&Sample)) {
-        let mut x = std::mem::take(&mut self.before);
-        self.state_at(Time::new(s).since(self.origin).max(0.0), &mut x);
-        on_sample(&Sample {
-            t: s,
-            mode: self.mode,
-            state: &x,
-            events: self.events,
-        });
-        self.before = x;
-    }
-
-    /// Every [`BUDGET_CHECK`] events, project the events still needed to
-    /// reach `t_end` at the recent rate, so that a run that cannot finish
-    /// within `max_events` says so early instead of grinding to the limit
-    /// (which fails the run when event `max_events + 1` fires).
-    fn check_budget(&mut self, t: Time) -> Result<(), End> {
-        let (_, events_then, t_then) = self.budget_check;
-        let max = self.options.max_events;
-        let rate = (self.events - events_then) as f64 / t.since(t_then);
-        let needed = self.events as f64 + rate * Time::new(self.options.t_end).since(t);
-        if needed > max as f64 {
-            return Err(End::failed(format!(
-                "event budget: {} events by t = {:e}, and at the recent rate ({rate:.3e} events per unit time) \
-                 reaching t_end = {} needs about {needed:.3e}, more than max_events = {max}; \
-                 raise max_events or shorten t_end",
-                self.events,
-                t.value(),
-                self.options.t_end
-            )));
-        }
-        self.budget_check = (self.events + BUDGET_CHECK, self.events, t);
-        Ok(())
-    }
-
-    /// Fire guard `slot` at time `t`: reset, record, watch for Zeno, re-predict.
+    /// Reset, record, watch for Zeno, re-predict.
     fn fire<O: Observer + ?Sized>(
         &mut self,
         slot: usize,
         t: Time,
+        ledger: &mut Ledger,
         observer: &mut O,
     ) -> Result<(), End> {
+        self.queue.pop();
         let (model, mode) = (self.model, self.mode);
         let guard = model.guards(mode)[slot];
         let mut before = std::mem::take(&mut self.before);
@@ -447,9 +174,12 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
         } else if guard.internal {
             Ok(())
         } else {
-            self.count(mode, slot);
+            ledger.count(mode, slot);
             let labels = model.labels(mode, slot, &before);
-            self.record(guard.name, t, jump.mode, &before, &labels, observer)
+            ledger.log(
+                self.event(guard.name, t, jump.mode, &before, &labels),
+                observer,
+            )
         };
         self.before = before;
         recorded?;
@@ -458,8 +188,8 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
         self.mode = jump.mode;
         // Internal switches are watched too: a chart that flickers at one
         // instant must not spin either.
-        if self.zeno.observe(mode, slot, t) {
-            return self.settle(guard.name, t, observer);
+        if let Some(what) = ledger.zeno(mode, slot, guard.name, t) {
+            return self.settle(what, t, ledger, observer);
         }
         match (self.motion, jump.affects) {
             (Motion::Exact, Affects::Range { first, count }) if jump.mode == mode => {
@@ -484,6 +214,70 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
                 self.fresh = Some(fired);
                 self.start_segment()
             }
+        }
+    }
+
+    fn renew(&mut self, t: Time) -> Result<(), End> {
+        self.close_segment(t.since(self.origin));
+        self.integrator.end(&mut self.state);
+        self.origin = t;
+        self.start_segment()
+    }
+
+    /// The state at time `s` (not before the current origin).
+    fn sample(&mut self, s: f64, ledger: &mut Ledger) {
+        let mut x = std::mem::take(&mut self.before);
+        self.state_at(Time::new(s).since(self.origin).max(0.0), &mut x);
+        (self.on_sample)(&Sample {
+            t: s,
+            mode: self.mode,
+            state: &x,
+            events: ledger.events(),
+        });
+        self.before = x;
+    }
+
+    fn finish(&mut self, t: Time) -> Result<(), End> {
+        self.close_segment(t.since(self.origin));
+        self.bound
+            .at_end(t, self.queue.peek().map(|(_, next)| next))
+            .map_err(End::failed)?;
+        let mut x = std::mem::take(&mut self.before);
+        self.state_at(t.since(self.origin), &mut x);
+        self.state.copy_from_slice(&x);
+        self.before = x;
+        self.origin = t;
+        Ok(())
+    }
+}
+
+impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
+    fn new(
+        model: &'m M,
+        mode: Mode,
+        x0: &[f64],
+        options: &'m Options,
+        on_sample: &'s mut dyn FnMut(&Sample),
+    ) -> Self {
+        let n = model.dimension();
+        Run {
+            model,
+            options,
+            on_sample,
+            mode,
+            origin: Time::new(0.0),
+            state: x0.to_vec(),
+            queue: EventQueue::default(),
+            integrator: Integrator::for_method(options.method, n, options.tolerances),
+            motion: Motion::Frozen,
+            motions: Vec::new(),
+            exact_evaluations: 0,
+            bound: Bound::new(n, x0),
+            stepped: false,
+            step_end: None,
+            fresh: Some(None),
+            before: vec![0.0; n],
+            after: vec![0.0; n],
         }
     }
 
@@ -547,74 +341,45 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
         t
     }
 
-    fn count(&mut self, mode: Mode, slot: usize) {
-        if self.counts.len() <= mode {
-            self.counts.resize(mode + 1, Vec::new());
-        }
-        let counts = &mut self.counts[mode];
-        if counts.len() <= slot {
-            counts.resize(slot + 1, 0);
-        }
-        counts[slot] += 1;
-    }
-
-    /// Send one event (from `before` in the current mode to `self.after` in
-    /// `mode_after`) to the observer and keep the energy audit.
-    fn record<O: Observer + ?Sized>(
-        &mut self,
+    /// The event of guard `name` at `t`, from `before` in the current mode
+    /// to `self.after` in `mode_after`, with the model's energies.
+    fn event<'a>(
+        &'a self,
         name: &'static str,
         t: Time,
         mode_after: Mode,
-        before: &[f64],
-        labels: &Labels,
-        observer: &mut O,
-    ) -> Result<(), End> {
+        before: &'a [f64],
+        labels: &'a Labels,
+    ) -> EventRecord<'a> {
         let (model, mode) = (self.model, self.mode);
-        self.events += 1;
-        let energy_before = model.energy(mode, before);
-        let energy_after = model.energy(mode_after, &self.after);
-        self.audit_energy(energy_before);
-        self.audit_energy(energy_after);
-        let event = EventRecord {
-            seq: self.events,
+        EventRecord {
+            seq: 0,
             t: t.value(),
             guard: name,
             mode_before: model.mode_name(mode),
             mode_after: model.mode_name(mode_after),
-            energy_before,
-            energy_after,
+            energy_before: model.energy(mode, before),
+            energy_after: model.energy(mode_after, &self.after),
             names_before: model.state_names(mode),
             before,
             names_after: model.state_names(mode_after),
             after: &self.after,
             labels,
-        };
-        observer
-            .on_event(&event)
-            .map_err(|e| End::failed(format!("could not write the event log: {e}")))
+        }
     }
 
-    /// Events of the guard `name` came faster than the run can resolve: let
-    /// the model settle into resting contact, or stop.
+    /// Events came faster than the run can resolve (`what`): let the model
+    /// settle into resting contact, or stop.
     fn settle<O: Observer + ?Sized>(
         &mut self,
-        name: &str,
+        what: String,
         t: Time,
+        ledger: &mut Ledger,
         observer: &mut O,
     ) -> Result<(), End> {
-        let what = format!(
-            "events of guard `{name}` accumulate at t = {:e} faster than the run can resolve ({})",
-            t.value(),
-            self.zeno.describe()
-        );
         self.after.copy_from_slice(&self.state);
         let Some(rest) = self.model.settle(self.mode, &mut self.after) else {
-            return Err(End {
-                status: Status::Zeno,
-                reason: Some(format!(
-                    "{what}; the model has no resting mode, so the run stops here"
-                )),
-            });
+            return Err(Ledger::unsettled(&what));
         };
         let before = std::mem::take(&mut self.state);
         // The resting state stands in for an orbit it is not exactly on:
@@ -625,16 +390,13 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
             .map(|(a, b)| (a - b).abs())
             .fold(0.0, f64::max);
         self.bound.widen(jump);
-        self.settles += 1;
-        let recorded = self.record(SETTLE, t, rest, &before, &Labels::NONE, observer);
+        let into = format!("`{}`", self.model.mode_name(rest));
+        let event = self.event(SETTLE, t, rest, &before, &Labels::NONE);
+        let recorded = ledger.settled(what, &into, event, observer);
         self.state = before;
         recorded?;
         std::mem::swap(&mut self.state, &mut self.after);
         self.mode = rest;
-        self.zeno_reason = Some(format!(
-            "{what}; settled into `{}`",
-            self.model.mode_name(rest)
-        ));
         self.integrator.restart();
         self.fresh = Some(None);
         self.start_segment()
@@ -848,87 +610,22 @@ impl<'m, M: HybridModel + ?Sized> Run<'m, M> {
         }
     }
 
-    fn audit_energy(&mut self, energy: Option<f64>) {
-        if let (Some(e), Some(e0), Some(max)) =
-            (energy, self.energy_initial, self.max_energy_error.as_mut())
-        {
-            *max = max.max((e - e0).abs() / self.energy_scale);
-        }
-    }
-
-    fn finish_at(&mut self, t: Time) -> End {
-        self.close_segment(t.since(self.origin));
-        if let Err(why) = self
-            .bound
-            .at_end(t, self.queue.peek().map(|(_, next)| next))
-        {
-            return End::failed(why);
-        }
-        let mut x = std::mem::take(&mut self.before);
-        self.state_at(t.since(self.origin), &mut x);
-        self.state.copy_from_slice(&x);
-        self.before = x;
-        self.origin = t;
-        match self.zeno_reason.clone() {
-            Some(reason) => End {
-                status: Status::Zeno,
-                reason: Some(reason),
-            },
-            None => End {
-                status: Status::Completed,
-                reason: None,
-            },
-        }
-    }
-
-    fn outcome(self, end: End) -> Outcome {
+    fn outcome(self, end: End, ledger: Ledger) -> Outcome {
         let model = self.model;
-        let energy_final = model.energy(self.mode, &self.state);
-        let mut run = self;
-        run.audit_energy(energy_final);
-        let mut events_by_guard = BTreeMap::new();
-        for (mode, counts) in run.counts.iter().enumerate() {
-            for (slot, &n) in counts.iter().enumerate() {
-                if n > 0 {
-                    *events_by_guard
-                        .entry(model.guards(mode)[slot].name)
-                        .or_insert(0) += n;
-                }
-            }
-        }
-        if run.settles > 0 {
-            events_by_guard.insert(SETTLE, run.settles);
-        }
-        let error_bound = run.bound.state_bound(run.events);
-        let event_time_bound = run.bound.event_time_bound(run.origin);
-        Outcome {
-            zeno: end.status == Status::Zeno || run.zeno_reason.is_some(),
-            status: end.status,
-            reason: end.reason,
-            t_end: run.options.t_end,
-            t_reached: run.origin.value(),
-            events: run.events,
-            events_by_guard,
-            energy_initial: run.energy_initial,
-            energy_final,
-            max_energy_error: run.max_energy_error,
-            final_mode: run.mode,
-            final_mode_name: model.mode_name(run.mode),
-            final_state_names: model.state_names(run.mode).to_vec(),
-            final_state: run.state,
-            flow_evaluations: run.integrator.evaluations() + run.exact_evaluations,
-            error_bound,
-            event_time_bound,
-            wall_seconds: run.started.elapsed().as_secs_f64(),
-        }
+        let last = Final {
+            t_reached: self.origin,
+            mode: self.mode,
+            mode_name: model.mode_name(self.mode),
+            state_names: model.state_names(self.mode),
+            energy: model.energy(self.mode, &self.state),
+            flow_evaluations: self.integrator.evaluations() + self.exact_evaluations,
+            error_bound: self.bound.state_bound(ledger.events()),
+            event_time_bound: self.bound.event_time_bound(self.origin),
+            state: self.state,
+        };
+        ledger.outcome(end, last, |mode, slot| model.guards(mode)[slot].name)
     }
 }
-
-/// Turns of the loop between two progress reports.
-const PROGRESS_EVERY: u64 = 1 << 14;
-
-/// Events between two projections of the event budget.
-const BUDGET_CHECK: u64 = 1 << 20;
 
 fn all_finite(x: &[f64]) -> bool {
     x.iter().all(|v| v.is_finite())

@@ -1,0 +1,292 @@
+//! A run's books, kept the same way whichever source of segments drives it:
+//! the events logged and counted per guard, the energy audit, the Zeno
+//! watch and what was settled, the budgets and the stop flag, and the
+//! [`Outcome`] they add up to. The rules are the loop's, in
+//! [`run_loop`](crate::engine::run_loop).
+
+use std::collections::BTreeMap;
+use std::sync::atomic::Ordering;
+use std::time::Instant;
+
+use crate::engine::model::Mode;
+use crate::engine::observer::{EventRecord, Observer, SETTLE};
+use crate::engine::run::{Options, Outcome, Status};
+use crate::engine::run_loop::{BUDGET_CHECK, CLOCK_EVERY, End, PROGRESS_SECONDS};
+use crate::engine::zeno::ZenoWatch;
+use crate::time::Time;
+
+/// What only the source knows at the end of a run.
+pub(crate) struct Final<'a> {
+    pub t_reached: Time,
+    pub mode: Mode,
+    pub mode_name: &'static str,
+    pub state_names: &'a [&'static str],
+    pub state: Vec<f64>,
+    pub energy: Option<f64>,
+    pub flow_evaluations: u64,
+    pub error_bound: f64,
+    pub event_time_bound: Option<f64>,
+}
+
+pub(crate) struct Ledger<'o> {
+    options: &'o Options,
+    started: Instant,
+    turn: u64,
+    /// Wall time of the last progress report.
+    reported: f64,
+    /// The event count at which to project the budget next, and the count
+    /// and time at the previous projection.
+    budget_check: (u64, u64, Time),
+    events: u64,
+    /// Event counts per mode and guard.
+    counts: Vec<Vec<u64>>,
+    zeno: ZenoWatch,
+    settles: u64,
+    /// Set once the run has settled a Zeno accumulation and gone on.
+    zeno_reason: Option<String>,
+    energy_initial: Option<f64>,
+    energy_scale: f64,
+    max_energy_error: Option<f64>,
+}
+
+impl<'o> Ledger<'o> {
+    /// Books for a run under `options` whose initial energy is
+    /// `energy_initial`, errors measured against `energy_scale`.
+    pub fn new(options: &'o Options, energy_initial: Option<f64>, energy_scale: f64) -> Self {
+        Ledger {
+            options,
+            started: Instant::now(),
+            turn: 0,
+            reported: 0.0,
+            budget_check: (BUDGET_CHECK, 0, Time::new(0.0)),
+            events: 0,
+            counts: Vec::new(),
+            zeno: ZenoWatch::new(options.t_end),
+            settles: 0,
+            zeno_reason: None,
+            energy_initial,
+            energy_scale,
+            max_energy_error: energy_initial.map(|_| 0.0),
+        }
+    }
+
+    pub fn t_end(&self) -> f64 {
+        self.options.t_end
+    }
+
+    /// Events logged so far, settlings included.
+    pub fn events(&self) -> u64 {
+        self.events
+    }
+
+    /// The stop flag at every turn; the wall-time budget and progress every
+    /// [`CLOCK_EVERY`] turns.
+    #[inline]
+    pub fn look_outside<O: Observer + ?Sized>(
+        &mut self,
+        now: Time,
+        observer: &mut O,
+    ) -> Result<(), End> {
+        if self
+            .options
+            .stop
+            .as_ref()
+            .is_some_and(|s| s.load(Ordering::Relaxed))
+        {
+            return Err(End {
+                status: Status::Interrupted,
+                reason: Some("stopped by a signal".into()),
+            });
+        }
+        self.turn = self.turn.wrapping_add(1);
+        if self.turn.is_multiple_of(CLOCK_EVERY) {
+            self.read_clock(now, observer)?;
+        }
+        Ok(())
+    }
+
+    #[inline(never)]
+    fn read_clock<O: Observer + ?Sized>(&mut self, now: Time, observer: &mut O) -> Result<(), End> {
+        let elapsed = self.started.elapsed().as_secs_f64();
+        if let Some(limit) = self.options.max_wall_seconds
+            && elapsed > limit
+        {
+            return Err(End::failed(format!(
+                "wall-time budget of {limit} s spent at t = {:e} after {} events",
+                now.value(),
+                self.events
+            )));
+        }
+        if elapsed - self.reported >= PROGRESS_SECONDS {
+            observer.on_progress(now.value(), self.events);
+            self.reported = elapsed;
+        }
+        Ok(())
+    }
+
+    /// The event budget after a turn that reached `now`.
+    #[inline]
+    pub fn check_events(&mut self, now: Time) -> Result<(), End> {
+        if self.events > self.options.max_events {
+            return Err(End::failed(format!(
+                "event budget: more than max_events = {} events by t = {:e}; raise max_events or shorten t_end",
+                self.options.max_events,
+                now.value()
+            )));
+        }
+        if self.events >= self.budget_check.0 {
+            return self.project_budget(now);
+        }
+        Ok(())
+    }
+
+    /// Project the events still needed to reach `t_end` at the recent rate,
+    /// so that a run that cannot finish within `max_events` says so early
+    /// instead of grinding to the limit.
+    #[inline(never)]
+    fn project_budget(&mut self, t: Time) -> Result<(), End> {
+        let (_, events_then, t_then) = self.budget_check;
+        let max = self.options.max_events;
+        let rate = (self.events - events_then) as f64 / t.since(t_then);
+        let needed = self.events as f64 + rate * Time::new(self.options.t_end).since(t);
+        if needed > max as f64 {
+            return Err(End::failed(format!(
+                "event budget: {} events by t = {:e}, and at the recent rate ({rate:.3e} events per unit time) \
+                 reaching t_end = {} needs about {needed:.3e}, more than max_events = {max}; \
+                 raise max_events or shorten t_end",
+                self.events,
+                t.value(),
+                self.options.t_end
+            )));
+        }
+        self.budget_check = (self.events + BUDGET_CHECK, self.events, t);
+        Ok(())
+    }
+
+    /// Count a non-internal event of guard `slot` in `mode`.
+    #[inline]
+    pub fn count(&mut self, mode: Mode, slot: usize) {
+        if self.counts.len() <= mode {
+            self.counts.resize(mode + 1, Vec::new());
+        }
+        let counts = &mut self.counts[mode];
+        if counts.len() <= slot {
+            counts.resize(slot + 1, 0);
+        }
+        counts[slot] += 1;
+    }
+
+    /// Log `event` (its `seq` is the ledger's to number), auditing the
+    /// energies it carries.
+    #[inline]
+    pub fn log<O: Observer + ?Sized>(
+        &mut self,
+        mut event: EventRecord,
+        observer: &mut O,
+    ) -> Result<(), End> {
+        self.events += 1;
+        event.seq = self.events;
+        self.audit(event.energy_before);
+        self.audit(event.energy_after);
+        observer
+            .on_event(&event)
+            .map_err(|e| End::failed(format!("could not write the event log: {e}")))
+    }
+
+    /// Audit one value of the energy.
+    #[inline]
+    pub fn audit(&mut self, energy: Option<f64>) {
+        if let (Some(e), Some(e0), Some(max)) =
+            (energy, self.energy_initial, self.max_energy_error.as_mut())
+        {
+            *max = max.max((e - e0).abs() / self.energy_scale);
+        }
+    }
+
+    /// Show the watch that guard `slot` (named `name`) of `mode` fired at
+    /// `t`; if its events are now Zeno, what was seen, for the reason.
+    #[inline]
+    pub fn zeno(&mut self, mode: Mode, slot: usize, name: &str, t: Time) -> Option<String> {
+        self.zeno.observe(mode, slot, t).then(|| {
+            format!(
+                "events of guard `{name}` accumulate at t = {:e} faster than the run can resolve ({})",
+                t.value(),
+                self.zeno.describe()
+            )
+        })
+    }
+
+    /// The Zeno accumulation `what` has no resting mode: the run stops.
+    pub fn unsettled(what: &str) -> End {
+        End::zeno(format!(
+            "{what}; the model has no resting mode, so the run stops here"
+        ))
+    }
+
+    /// Log the settling of the Zeno accumulation `what` into `rest` and go
+    /// on; the run will end `zeno`.
+    pub fn settled<O: Observer + ?Sized>(
+        &mut self,
+        what: String,
+        rest: &str,
+        event: EventRecord,
+        observer: &mut O,
+    ) -> Result<(), End> {
+        self.settles += 1;
+        self.zeno_reason = Some(format!("{what}; settled into {rest}"));
+        self.log(event, observer)
+    }
+
+    /// How a run that reached `t_end` ended.
+    pub fn completed(&self) -> End {
+        match &self.zeno_reason {
+            Some(reason) => End::zeno(reason.clone()),
+            None => End {
+                status: Status::Completed,
+                reason: None,
+            },
+        }
+    }
+
+    /// The outcome of a run that ended as `end`, `guard_name` naming the
+    /// guards counted.
+    pub fn outcome(
+        mut self,
+        end: End,
+        last: Final,
+        guard_name: impl Fn(Mode, usize) -> &'static str,
+    ) -> Outcome {
+        self.audit(last.energy);
+        let mut events_by_guard = BTreeMap::new();
+        for (mode, counts) in self.counts.iter().enumerate() {
+            for (slot, &n) in counts.iter().enumerate() {
+                if n > 0 {
+                    *events_by_guard.entry(guard_name(mode, slot)).or_insert(0) += n;
+                }
+            }
+        }
+        if self.settles > 0 {
+            events_by_guard.insert(SETTLE, self.settles);
+        }
+        Outcome {
+            zeno: end.status == Status::Zeno || self.zeno_reason.is_some(),
+            status: end.status,
+            reason: end.reason,
+            t_end: self.options.t_end,
+            t_reached: last.t_reached.value(),
+            events: self.events,
+            events_by_guard,
+            energy_initial: self.energy_initial,
+            energy_final: last.energy,
+            max_energy_error: self.max_energy_error,
+            final_mode: last.mode,
+            final_mode_name: last.mode_name,
+            final_state_names: last.state_names.to_vec(),
+            final_state: last.state,
+            flow_evaluations: last.flow_evaluations,
+            error_bound: last.error_bound,
+            event_time_bound: last.event_time_bound,
+            wall_seconds: self.started.elapsed().as_secs_f64(),
+        }
+    }
+}

@@ -1,0 +1,154 @@
+//! The one event loop every run goes through, and its rules.
+//!
+//! A run is driven by a *source of segments* ([`Segments`]): the whole-state
+//! path ([`simulate`]) holds the model's state and advances it along an
+//! exact flow or one integration step at a time; the event-local path
+//! ([`simulate_local`]) leaves the state with a large model and asks it for
+//! each guard's next crossing. A source answers what happens next (the
+//! earliest predicted event, or the end of its current segment), fires
+//! events, starts segments and reports sample states. Everything else is
+//! the loop's and the [`Ledger`]'s, written here once:
+//!
+//! - **Order.** Events happen in strict time order, ties by guard index; an
+//!   event at the very end of a segment happens before the segment ends.
+//!   Nothing past `t_end` happens: the source is asked to reach `t_end` and
+//!   say whether it can vouch for the state there.
+//! - **Samples.** Sample times (increasing, up to `t_end`) due before what
+//!   happens next are reported from the flow as it is: a sample at an
+//!   event's time sees the state before the reset, and sampling changes
+//!   neither steps nor events.
+//! - **Looking outside.** The stop flag is read at every turn; every
+//!   [`CLOCK_EVERY`] turns the wall clock is read, for the wall-time budget
+//!   and for a progress report every [`PROGRESS_SECONDS`].
+//! - **Event budget.** A run fails when event `max_events + 1` is logged;
+//!   every [`BUDGET_CHECK`] events it projects the events still needed to
+//!   reach `t_end` at the recent rate, and fails early if they exceed the
+//!   budget.
+//! - **Zeno.** Every firing, internal guards included, is shown to the
+//!   [`ZenoWatch`](crate::engine::zeno::ZenoWatch); when one guard's
+//!   events become unresolvable the model may settle into resting contact
+//!   (logged as [`SETTLE`](crate::engine::observer::SETTLE), the run goes on
+//!   and ends `zeno`) or the run stops there, `zeno`.
+//! - **Energy.** The model's energy is audited against its initial value
+//!   wherever the source computes it (at each event for the whole-state
+//!   path; at logged events and samples for the event-local one, whose
+//!   energy is a sum over the whole model) and at the end; the largest
+//!   relative error is the outcome's `max_energy_error`.
+//! - **Counts.** Non-internal events are counted per guard, settlings
+//!   apart; the outcome reports them by guard name.
+//!
+//! [`simulate`]: crate::engine::simulate
+//! [`simulate_local`]: crate::engine::simulate_local
+
+use crate::engine::ledger::Ledger;
+use crate::engine::observer::Observer;
+use crate::engine::run::Status;
+use crate::time::Time;
+
+/// Why the loop stopped, with a reason for anything but completion.
+#[derive(Debug, Clone)]
+pub(crate) struct End {
+    pub status: Status,
+    pub reason: Option<String>,
+}
+
+impl End {
+    /// A run that cannot be trusted past this point, and why.
+    pub fn failed(reason: String) -> Self {
+        End {
+            status: Status::Failed,
+            reason: Some(reason),
+        }
+    }
+
+    /// A Zeno accumulation the run stopped at.
+    pub fn zeno(reason: String) -> Self {
+        End {
+            status: Status::Zeno,
+            reason: Some(reason),
+        }
+    }
+}
+
+/// A source of segments: what a run advances, the loop's rules aside.
+pub(crate) trait Segments {
+    /// The time of the last event or segment boundary.
+    fn origin(&self) -> Time;
+
+    /// Predict what happens first from the initial state.
+    fn begin(&mut self, ledger: &mut Ledger) -> Result<(), End>;
+
+    /// What happens next: `(Some(guard), t)`, the earliest predicted
+    /// event; `(None, t)`, the end of the current segment; `t` infinite if
+    /// nothing is ahead.
+    fn next(&self) -> (Option<usize>, Time);
+
+    /// Fire `guard` at `t`: reset, log through the ledger, re-predict.
+    fn fire<O: Observer + ?Sized>(
+        &mut self,
+        guard: usize,
+        t: Time,
+        ledger: &mut Ledger,
+        observer: &mut O,
+    ) -> Result<(), End>;
+
+    /// The current segment ends at `t`: start the next one there.
+    fn renew(&mut self, t: Time) -> Result<(), End>;
+
+    /// Report the state at sample time `s` (not past what happens next).
+    fn sample(&mut self, s: f64, ledger: &mut Ledger);
+
+    /// Reach `t_end` with nothing more to happen before it, or say why the
+    /// state there cannot be vouched for.
+    fn finish(&mut self, t_end: Time) -> Result<(), End>;
+}
+
+/// Run `source` to `t_end` under the loop's rules, reporting events to
+/// `observer` and the state at each of `samples` to the source.
+pub(crate) fn drive<S: Segments + ?Sized, O: Observer + ?Sized>(
+    source: &mut S,
+    ledger: &mut Ledger,
+    samples: &[f64],
+    observer: &mut O,
+) -> End {
+    match turns(source, ledger, samples, observer) {
+        Ok(()) => ledger.completed(),
+        Err(end) => end,
+    }
+}
+
+fn turns<S: Segments + ?Sized, O: Observer + ?Sized>(
+    source: &mut S,
+    ledger: &mut Ledger,
+    samples: &[f64],
+    observer: &mut O,
+) -> Result<(), End> {
+    let t_end = ledger.t_end();
+    source.begin(ledger)?;
+    let mut samples = samples.iter().copied().peekable();
+    loop {
+        ledger.look_outside(source.origin(), observer)?;
+        let (guard, t) = source.next();
+        let due = t.value().min(t_end);
+        while let Some(s) = samples.next_if(|&s| s <= due) {
+            source.sample(s, ledger);
+        }
+        if t.value() > t_end {
+            return source.finish(Time::new(t_end));
+        }
+        match guard {
+            Some(guard) => source.fire(guard, t, ledger, observer)?,
+            None => source.renew(t)?,
+        }
+        ledger.check_events(source.origin())?;
+    }
+}
+
+/// Turns of the loop between two readings of the wall clock.
+pub const CLOCK_EVERY: u64 = 64;
+
+/// Wall time between two progress reports, in seconds.
+pub const PROGRESS_SECONDS: f64 = 0.2;
+
+/// Events between two projections of the event budget.
+pub const BUDGET_CHECK: u64 = 1 << 20;
