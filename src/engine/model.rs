@@ -214,6 +214,13 @@ pub trait HybridModel {
     /// Apply the reset of `guard`, which has just fired at state `x`.
     fn reset(&self, mode: Mode, guard: usize, x: &mut [f64]) -> Jump;
 
+    /// Whether the run ends at the event of `guard` in `mode` (status
+    /// `completed`, at the event's time, in the state after its reset).
+    fn terminal(&self, mode: Mode, guard: usize) -> bool {
+        let _ = (mode, guard);
+        false
+    }
+
     /// The conserved (or monitored) energy at `x`, if the model has one.
     fn energy(&self, mode: Mode, x: &[f64]) -> Option<f64> {
         let _ = (mode, x);

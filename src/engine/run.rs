@@ -76,7 +76,8 @@ impl Status {
 pub struct Outcome {
     /// How the run ended.
     pub status: Status,
-    /// Why the run is not plainly `completed`.
+    /// Why the run is not plainly `completed` (or, for a run a terminal
+    /// transition ended before `t_end`, which one).
     pub reason: Option<String>,
     /// The simulated time the run was asked to reach.
     pub t_end: f64,

@@ -24,7 +24,7 @@ use crate::engine::locate::scan_step;
 use crate::engine::model::{Affects, Direction, HybridModel, Mode};
 use crate::engine::observer::{EventRecord, Observer, SETTLE};
 use crate::engine::queue::EventQueue;
-use crate::engine::run::{Options, Outcome};
+use crate::engine::run::{Options, Outcome, Status};
 use crate::engine::run_loop::{End, Segments, drive};
 use crate::time::Time;
 
@@ -186,6 +186,16 @@ impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
         std::mem::swap(&mut self.state, &mut self.after);
         self.origin = t;
         self.mode = jump.mode;
+        if model.terminal(mode, slot) {
+            return Err(End {
+                status: Status::Completed,
+                reason: Some(format!(
+                    "the terminal transition `{}` fired at t = {}",
+                    guard.name,
+                    t.value()
+                )),
+            });
+        }
         // Internal switches are watched too: a chart that flickers at one
         // instant must not spin either.
         if let Some(what) = ledger.zeno(mode, slot, guard.name, t) {

@@ -5,6 +5,7 @@
 //! [`HybridModel`]: crate::engine::HybridModel
 //! [`LocalModel`]: crate::engine::LocalModel
 
+pub mod automaton;
 pub mod chain;
 pub mod continuum;
 pub mod mechanism;

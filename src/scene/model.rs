@@ -163,8 +163,8 @@ const SCENE_SCHEMA_TITLE: &str = "flicker scene";
 const SCENE_SCHEMA_DESCRIPTION: &str = "A scene file for `flicker run`. The schema states the shape; `flicker check SCENE.json` also checks what a schema cannot (an energy no state has, an initial angle given to the strain formulation, ...).";
 
 impl Registry {
-    /// The models this crate ships: the mechanism, the chain and the
-    /// continuum.
+    /// The models this crate ships: the mechanism, the chain, the
+    /// continuum, and automata defined in the file.
     pub fn builtin() -> Self {
         let kind = |model, validate, schema| Kind {
             model,
@@ -187,6 +187,11 @@ impl Registry {
                     "continuum",
                     crate::models::continuum::scene::scene,
                     include_str!("../models/continuum/scene.schema.json"),
+                ),
+                kind(
+                    "automaton",
+                    crate::models::automaton::scene::scene,
+                    include_str!("../models/automaton/scene.schema.json"),
                 ),
             ],
         }

@@ -1,5 +1,6 @@
 //! flicker's integration tests: one binary, one module per behaviour.
 
+mod automata;
 mod bouncing_ball;
 mod chain;
 mod chain_cli;

@@ -29,7 +29,7 @@ fn bundled_scenes_pass_the_scene_schema_and_check() {
     let validator = schema("scene.schema.json");
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("models");
     let mut seen = 0;
-    for dir in [root.clone(), root.join("stress")] {
+    for dir in [root.clone(), root.join("stress"), root.join("automata")] {
         for entry in std::fs::read_dir(&dir).unwrap() {
             let path = entry.unwrap().path();
             if path.extension().is_some_and(|e| e == "json") {

@@ -1,0 +1,10 @@
+//! The expressions of an automaton file: parsed to a syntax tree
+//! ([`parse`]), compiled to a register tape ([`tape`]) that is evaluated,
+//! differentiated and expanded in Taylor series without walking text.
+
+pub mod derivative;
+pub mod parse;
+pub mod tape;
+
+pub use parse::{Ast, ParseError, parse};
+pub use tape::{CompileError, Op, Scope, Tape};

@@ -1,0 +1,319 @@
+//! An automaton compiled to tapes, as the engine runs it: a
+//! [`HybridModel`] whose modes are ODEs, whose guards and resets are the
+//! file's expressions.
+//!
+//! Each mode's rates are one tape (its subexpressions shared); each guard,
+//! each reset and the energy are tapes of their own. When an expression
+//! reads the clock `t`, the state gains a last component `t` with rate 1,
+//! so that the flows stay autonomous as the engine wants them (the log and
+//! the summary show it as a state). What the compiled form reveals is
+//! offered to the methods: a mode whose rates are affine is linear (its `A`
+//! and `b` read off exactly by forward differentiation), a mode of the
+//! shape `[q; v]` with `q' = v` and `v'` free of `v` is second order.
+
+use std::collections::HashSet;
+use std::sync::{Mutex, OnceLock};
+
+use nalgebra::{DMatrix, DVector};
+
+use crate::engine::{Flow, Guard, HybridModel, Jump, Mode};
+use crate::models::automaton::definition::{Definition, Source};
+use crate::models::automaton::expr::derivative::jacobian;
+use crate::models::automaton::expr::{Ast, Scope, Tape};
+use crate::scene::SceneError;
+
+/// A compiled automaton.
+#[derive(Debug, Clone)]
+pub struct Automaton {
+    states: Vec<&'static str>,
+    /// Whether the last state component is the clock.
+    clock: bool,
+    modes: Vec<CompiledMode>,
+    energy: Option<Tape>,
+    initial: Vec<f64>,
+    initial_mode: Mode,
+}
+
+#[derive(Debug, Clone)]
+struct CompiledMode {
+    name: &'static str,
+    /// The rate of every state component.
+    flow: Tape,
+    /// The text of each state's rate, for diagnoses.
+    rates: Vec<Option<Source>>,
+    guards: Vec<Guard>,
+    guard_tapes: Vec<Tape>,
+    resets: Vec<Reset>,
+    kind: Flow,
+    linear: Option<(DMatrix<f64>, DVector<f64>)>,
+    second_order: bool,
+}
+
+#[derive(Debug, Clone)]
+struct Reset {
+    /// The new values of `targets`, from the state before the event.
+    tape: Tape,
+    targets: Vec<usize>,
+    to: Mode,
+    terminal: bool,
+}
+
+impl Automaton {
+    /// Compile `definition`; an expression naming what its scope does not
+    /// know fails with its field, the character and the nearest name.
+    pub fn compile(definition: &Definition) -> Result<Automaton, SceneError> {
+        let clock = definition.reads_clock();
+        let mut inputs = definition.states.clone();
+        if clock {
+            inputs.push("t".into());
+        }
+        let n = inputs.len();
+        let scope = Scope {
+            inputs: inputs.clone(),
+            constants: definition.parameters.clone(),
+        };
+        let compile = |sources: &[&Source]| -> Result<Tape, SceneError> {
+            let asts: Vec<&Ast> = sources.iter().map(|s| &s.ast).collect();
+            Tape::compile(&asts, &scope).map_err(|e| {
+                // Which of the sources the error is in: the first that fails alone.
+                let culprit = sources
+                    .iter()
+                    .find(|s| Tape::compile(&[&s.ast], &scope).is_err())
+                    .unwrap_or(&sources[0]);
+                culprit.error(e.at, &e.message)
+            })
+        };
+        let zero = Source {
+            text: "0".into(),
+            path: String::new(),
+            ast: Ast::Number(0.0),
+        };
+        let one = Source {
+            text: "1".into(),
+            path: String::new(),
+            ast: Ast::Number(1.0),
+        };
+        let mut modes = Vec::new();
+        for mode in &definition.modes {
+            let mut rates: Vec<&Source> = mode
+                .flow
+                .iter()
+                .map(|r| r.as_ref().unwrap_or(&zero))
+                .collect();
+            if clock {
+                rates.push(&one);
+            }
+            let flow = compile(&rates)?;
+            let mut guards = Vec::new();
+            let mut guard_tapes = Vec::new();
+            let mut resets = Vec::new();
+            for t in &mode.transitions {
+                let tape = compile(&[&t.guard])?;
+                guards.push(Guard {
+                    name: intern(&t.name),
+                    direction: t.direction,
+                    affine: tape.affine(),
+                    internal: false,
+                    barrier: t.barrier,
+                });
+                guard_tapes.push(tape);
+                let sources: Vec<&Source> = t.reset.iter().map(|(_, s)| s).collect();
+                resets.push(Reset {
+                    tape: if sources.is_empty() {
+                        Tape {
+                            ops: Vec::new(),
+                            outputs: Vec::new(),
+                        }
+                    } else {
+                        compile(&sources)?
+                    },
+                    targets: t.reset.iter().map(|(i, _)| *i).collect(),
+                    to: t.to,
+                    terminal: t.terminal,
+                });
+            }
+            let still = flow.constant().is_some_and(|c| c.iter().all(|&r| r == 0.0));
+            let linear = flow.affine().then(|| {
+                let a = jacobian(&flow, &vec![0.0; n]);
+                let mut b = vec![0.0; n];
+                flow.eval_scratch(&vec![0.0; n], &mut b);
+                (a, DVector::from_vec(b))
+            });
+            let half = n / 2;
+            let second_order = !clock
+                && n % 2 == 0
+                && (0..half).all(|i| {
+                    flow.ops[flow.outputs[i] as usize]
+                        == crate::models::automaton::expr::Op::Input((half + i) as u32)
+                })
+                && (half..n).all(|i| (half..n).all(|j| !flow.depends_on(i, j as u32)));
+            modes.push(CompiledMode {
+                name: intern(&mode.name),
+                flow,
+                rates: mode.flow.clone(),
+                guards,
+                guard_tapes,
+                resets,
+                kind: if still { Flow::Frozen } else { Flow::Ode },
+                linear,
+                second_order,
+            });
+        }
+        let energy = definition
+            .energy
+            .as_ref()
+            .map(|e| compile(&[e]))
+            .transpose()?;
+        let mut initial = definition.initial.clone();
+        if clock {
+            initial.push(0.0);
+        }
+        Ok(Automaton {
+            states: inputs.iter().map(|s| intern(s)).collect(),
+            clock,
+            modes,
+            energy,
+            initial,
+            initial_mode: definition.initial_mode,
+        })
+    }
+
+    /// The state the file starts from (the clock at 0 where there is one).
+    pub fn initial(&self) -> &[f64] {
+        &self.initial
+    }
+
+    /// The mode the file starts in.
+    pub fn initial_mode(&self) -> Mode {
+        self.initial_mode
+    }
+
+    /// Every mode.
+    pub fn modes(&self) -> Vec<Mode> {
+        (0..self.modes.len()).collect()
+    }
+
+    /// Whether the state carries the clock as its last component.
+    pub fn has_clock(&self) -> bool {
+        self.clock
+    }
+
+    /// Whether every mode's flow is affine (the linear propagator runs it).
+    pub fn all_linear(&self) -> bool {
+        self.modes
+            .iter()
+            .all(|m| m.linear.is_some() || m.kind == Flow::Frozen)
+    }
+
+    /// Whether the run ends at the event of `guard` in `mode`.
+    pub fn is_terminal(&self, mode: Mode, guard: usize) -> bool {
+        self.modes[mode].resets[guard].terminal
+    }
+}
+
+impl HybridModel for Automaton {
+    fn dimension(&self) -> usize {
+        self.states.len()
+    }
+
+    fn state_names(&self, _: Mode) -> &[&'static str] {
+        &self.states
+    }
+
+    fn mode_name(&self, mode: Mode) -> &'static str {
+        self.modes[mode].name
+    }
+
+    fn guards(&self, mode: Mode) -> &[Guard] {
+        &self.modes[mode].guards
+    }
+
+    #[inline]
+    fn guard(&self, mode: Mode, guard: usize, x: &[f64]) -> f64 {
+        self.modes[mode].guard_tapes[guard].eval1(x)
+    }
+
+    fn flow(&self, mode: Mode) -> Flow {
+        self.modes[mode].kind
+    }
+
+    #[inline]
+    fn rhs(&self, mode: Mode, x: &[f64], dx: &mut [f64]) {
+        self.modes[mode].flow.eval_scratch(x, dx);
+    }
+
+    fn has_rhs(&self, _: Mode) -> bool {
+        true
+    }
+
+    fn second_order(&self, mode: Mode) -> bool {
+        self.modes[mode].second_order
+    }
+
+    fn linear(&self, mode: Mode) -> Option<(DMatrix<f64>, DVector<f64>)> {
+        self.modes[mode].linear.clone()
+    }
+
+    fn is_linear(&self, mode: Mode) -> bool {
+        self.modes[mode].linear.is_some()
+    }
+
+    fn reset(&self, mode: Mode, guard: usize, x: &mut [f64]) -> Jump {
+        let reset = &self.modes[mode].resets[guard];
+        // Every new value from the values before the event, all at once.
+        let mut new = vec![0.0; reset.targets.len()];
+        reset.tape.eval_scratch(x, &mut new);
+        for (&i, v) in reset.targets.iter().zip(new) {
+            x[i] = v;
+        }
+        Jump::to(reset.to)
+    }
+
+    fn terminal(&self, mode: Mode, guard: usize) -> bool {
+        self.is_terminal(mode, guard)
+    }
+
+    fn energy(&self, _: Mode, x: &[f64]) -> Option<f64> {
+        self.energy.as_ref().map(|e| e.eval1(x))
+    }
+
+    fn energy_scale(&self, initial_energy: f64) -> f64 {
+        initial_energy.abs().max(f64::MIN_POSITIVE)
+    }
+
+    /// Which rate is not finite at `x`, and its expression.
+    fn diagnose(&self, mode: Mode, x: &[f64]) -> Option<String> {
+        let m = &self.modes[mode];
+        let mut rates = vec![0.0; self.states.len()];
+        m.flow.eval_scratch(x, &mut rates);
+        let i = rates.iter().position(|r| !r.is_finite())?;
+        let text = m
+            .rates
+            .get(i)
+            .and_then(|r| r.as_ref())
+            .map_or("0", |s| s.text.as_str());
+        Some(format!(
+            "in mode `{}` the rate of `{}`, `{text}`, is {} there",
+            m.name, self.states[i], rates[i]
+        ))
+    }
+}
+
+/// A name that lives as long as the program: the engine's logs take
+/// `&'static str`. Each distinct name is stored once, however many scenes
+/// use it.
+fn intern(name: &str) -> &'static str {
+    static NAMES: OnceLock<Mutex<HashSet<&'static str>>> = OnceLock::new();
+    let mut names = NAMES
+        .get_or_init(Default::default)
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner());
+    match names.get(name) {
+        Some(known) => known,
+        None => {
+            let leaked: &'static str = Box::leak(name.to_string().into_boxed_str());
+            names.insert(leaked);
+            leaked
+        }
+    }
+}

@@ -1,0 +1,253 @@
+//! An automaton scene: the file's keys, and what it offers the tools
+//! ([`SceneModel`]). The format is in the [module doc](super).
+
+use std::sync::Arc;
+
+use crate::engine::integrator::{methods_for, runs};
+use crate::engine::{HybridModel, Method, Observer, Tolerances, simulate};
+use crate::models::automaton::definition::Definition;
+use crate::models::automaton::model::Automaton;
+use crate::runner::{Control, Report};
+use crate::scene::fields::Fields;
+use crate::scene::solver::{SolverSpec, check_steps};
+use crate::scene::{Scene, SceneError, SceneModel};
+
+/// Default event budget of an automaton run.
+const MAX_EVENTS: u64 = 1_000_000_000;
+
+/// A validated automaton scene: the definition, compiled once.
+#[derive(Debug, Clone)]
+pub struct AutomatonScene {
+    /// The model as the file defines it.
+    pub definition: Definition,
+    /// The compiled model.
+    pub automaton: Arc<Automaton>,
+    /// Simulated time to run to.
+    pub t_end: f64,
+    /// The solver as written.
+    pub solver: SolverSpec,
+    /// The method it resolves to (`Auto`: the cheapest exact one).
+    pub method: Method,
+    /// Tolerances of the adaptive methods.
+    pub tolerances: Tolerances,
+    /// Event budget.
+    pub max_events: u64,
+    /// Free text.
+    pub description: Option<String>,
+}
+
+/// Validate the keys of an automaton scene.
+pub fn scene(mut f: Fields) -> Result<Scene, SceneError> {
+    let description = f.optional_string("description")?.map(str::to_string);
+    let definition = Definition::read(&mut f)?;
+    let automaton = Arc::new(Automaton::compile(&definition)?);
+    let t_end = f.number_where("t_end", "> 0", |t| t > 0.0)?;
+    let max_events = f.optional_count("max_events")?.unwrap_or(MAX_EVENTS);
+    let mut scene = AutomatonScene {
+        definition,
+        automaton,
+        t_end,
+        solver: SolverSpec::default(),
+        method: Method::Auto,
+        tolerances: Tolerances::default(),
+        max_events,
+        description,
+    };
+    let solver = match f.optional("solver") {
+        Some(value) => SolverSpec::from_json(value)?,
+        None => SolverSpec::default(),
+    };
+    scene.set_solver(solver)?;
+    f.finish()?;
+    Ok(Scene::new(scene))
+}
+
+impl AutomatonScene {
+    /// The method a run uses, and why: `Auto` resolves to the exact linear
+    /// propagator where every flow is affine, else to Dormand-Prince.
+    pub fn resolved(&self) -> (Method, String) {
+        let tol = self.tolerances;
+        match self.method {
+            Method::Auto if self.automaton.all_linear() => (
+                Method::Linear,
+                "every mode's flow is affine: exact linear propagator, events located on it".into(),
+            ),
+            Method::Auto => (
+                Method::Dopri5(tol),
+                format!(
+                    "a mode's flow is not affine: Dormand-Prince 5(4), rtol {:e}, atol {:e}",
+                    tol.rtol, tol.atol
+                ),
+            ),
+            Method::Linear => (
+                self.method,
+                "exact linear propagator, events located on it".into(),
+            ),
+            Method::Dopri5(t) => (
+                self.method,
+                format!("Dormand-Prince 5(4), rtol {:e}, atol {:e}", t.rtol, t.atol),
+            ),
+            Method::Dop853(t) => (
+                self.method,
+                format!(
+                    "DOP853 (Dormand-Prince 8(5,3)), rtol {:e}, atol {:e}",
+                    t.rtol, t.atol
+                ),
+            ),
+            Method::Verlet { step } => (self.method, format!("Stormer-Verlet, step {step:e}")),
+            Method::Exact => (self.method, "closed form".into()),
+        }
+    }
+}
+
+impl SceneModel for AutomatonScene {
+    fn model(&self) -> &'static str {
+        "automaton"
+    }
+
+    fn t_end(&self) -> f64 {
+        self.t_end
+    }
+
+    fn set_t_end(&mut self, t_end: f64) -> Result<(), SceneError> {
+        check_steps(self.method, t_end)?;
+        self.t_end = t_end;
+        Ok(())
+    }
+
+    fn solver(&self) -> &SolverSpec {
+        &self.solver
+    }
+
+    fn set_solver(&mut self, spec: SolverSpec) -> Result<(), SceneError> {
+        let (method, tolerances) = spec.resolve()?;
+        if method != Method::Auto {
+            let modes = self.automaton.modes();
+            runs(&*self.automaton, &modes, method).map_err(|why| {
+                SceneError::field(
+                    "solver.method",
+                    format!("{why} (this automaton runs {})", self.methods().join(", ")),
+                )
+            })?;
+        }
+        check_steps(method, self.t_end)?;
+        (self.method, self.tolerances, self.solver) = (method, tolerances, spec);
+        Ok(())
+    }
+
+    fn methods(&self) -> Vec<&'static str> {
+        methods_for(&*self.automaton, &self.automaton.modes())
+    }
+
+    /// The shortest period `2 pi / |lambda|` of the linear modes' flows, or
+    /// a hundredth of `t_end` where no mode is linear.
+    fn time_scale(&self) -> f64 {
+        let model = &*self.automaton;
+        let rates = self.automaton.modes().into_iter().filter_map(|m| {
+            let (a, _) = model.linear(m)?;
+            let rho = a
+                .complex_eigenvalues()
+                .iter()
+                .map(|l| l.norm())
+                .fold(0.0, f64::max);
+            (rho > 0.0).then(|| std::f64::consts::TAU / rho)
+        });
+        rates
+            .fold(None, |s: Option<f64>, p| Some(s.map_or(p, |s| s.min(p))))
+            .unwrap_or(self.t_end / 100.0)
+    }
+
+    fn describe(&self) -> Vec<String> {
+        let model = &*self.automaton;
+        let d = &self.definition;
+        let mut lines = vec![format!(
+            "{} state(s) ({}){}, {} parameter(s), t_end {}",
+            d.states.len(),
+            d.states.join(", "),
+            if model.has_clock() {
+                " and the clock t"
+            } else {
+                ""
+            },
+            d.parameters.len(),
+            self.t_end
+        )];
+        for (i, mode) in d.modes.iter().enumerate() {
+            let mut traits = Vec::new();
+            if model.is_linear(i) {
+                traits.push("affine flow");
+            }
+            if model.second_order(i) {
+                traits.push("second order");
+            }
+            let transitions: Vec<String> = mode
+                .transitions
+                .iter()
+                .map(|t| {
+                    let to = &d.modes[t.to].name;
+                    format!("`{}` -> {to}", t.name)
+                })
+                .collect();
+            lines.push(format!(
+                "mode {}{}{}: {}",
+                mode.name,
+                if i == d.initial_mode {
+                    " (initial)"
+                } else {
+                    ""
+                },
+                if traits.is_empty() {
+                    String::new()
+                } else {
+                    format!(" [{}]", traits.join(", "))
+                },
+                if transitions.is_empty() {
+                    "no transitions".into()
+                } else {
+                    transitions.join(", ")
+                }
+            ));
+        }
+        let (method, why) = self.resolved();
+        lines.push(format!("method {}: {why}", method.name()));
+        lines.push(format!(
+            "methods that can run it: {}",
+            self.methods().join(", ")
+        ));
+        lines
+    }
+
+    fn run(&self, control: &Control, observer: &mut dyn Observer) -> Result<Report, SceneError> {
+        let (method, description) = self.resolved();
+        let options = control.options(self.t_end, self.max_events, method, self.tolerances);
+        let model = &*self.automaton;
+        let outcome = simulate(
+            model,
+            model.initial_mode(),
+            model.initial(),
+            &options,
+            observer,
+        );
+        let final_state = outcome
+            .final_state_names
+            .iter()
+            .copied()
+            .zip(outcome.final_state.iter().copied())
+            .collect();
+        Ok(Report {
+            outcome,
+            method: method.name(),
+            description,
+            final_state,
+            fields: None,
+        })
+    }
+
+    fn clone_box(&self) -> Box<dyn SceneModel> {
+        Box::new(self.clone())
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+}
