@@ -83,7 +83,7 @@ pub fn compare(
     let mut rows = Vec::new();
     for method in &plan.methods {
         let settings: Vec<SolverSpec> = match method.as_str() {
-            "dopri5" | "dop853" => plan
+            "dopri5" | "dop853" | "taylor" => plan
                 .tolerances
                 .iter()
                 .map(|&tol| spec(method, Some(tol), None))

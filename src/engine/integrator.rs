@@ -9,8 +9,9 @@ use crate::engine::adaptive::{EmbeddedPair, StepFailure, Tolerances};
 use crate::engine::dop853::Dop853;
 use crate::engine::dopri5::Dopri5;
 use crate::engine::linear::Linear;
-use crate::engine::locate::Interpolant;
+use crate::engine::locate::{Interpolant, StepScan};
 use crate::engine::model::{Flow, HybridModel, Mode};
+use crate::engine::taylor::Taylor;
 use crate::engine::verlet::Verlet;
 
 /// How to advance the flows.
@@ -27,6 +28,8 @@ pub enum Method {
     Dopri5(Tolerances),
     /// Dormand and Prince's 8th-order pair DOP853 with these tolerances.
     Dop853(Tolerances),
+    /// Taylor's method with these tolerances (order and step from them).
+    Taylor(Tolerances),
     /// Stormer-Verlet with this fixed step.
     Verlet {
         /// The fixed step.
@@ -43,6 +46,7 @@ impl Method {
             Method::Linear => "linear",
             Method::Dopri5(_) => "dopri5",
             Method::Dop853(_) => "dop853",
+            Method::Taylor(_) => "taylor",
             Method::Verlet { .. } => "verlet",
         }
     }
@@ -83,6 +87,10 @@ pub fn motion<M: HybridModel + ?Sized>(
                 "mode `{name}` gives no right-hand side to integrate"
             ))
         }
+        (_, Method::Taylor(_)) if !model.has_series(mode) => Err(format!(
+            "mode `{name}` gives no Taylor series of its flow and guards (expressions compiled from a file do, \
+             unless they use abs, min or max)"
+        )),
         (_, Method::Verlet { .. }) if !model.second_order(mode) => Err(format!(
             "mode `{name}` is not of the form q'' = a(q) (its acceleration depends on the velocity), which Stormer-Verlet needs"
         )),
@@ -117,14 +125,16 @@ pub fn runs<M: HybridModel + ?Sized>(
 }
 
 /// The names of the methods a user can choose that run every one of
-/// `modes` of `model` ([`runs`]), in the order exact, linear, dopri5,
-/// dop853, verlet: the one place that says which methods a model takes.
+/// `modes` of `model` ([`runs`]), in the order exact, linear, taylor,
+/// dopri5, dop853, verlet: the one place that says which methods a model
+/// takes.
 pub fn methods_for<M: HybridModel + ?Sized>(model: &M, modes: &[Mode]) -> Vec<&'static str> {
     // Tolerances and steps never decide whether a method applies.
     let tol = Tolerances::default();
     [
         Method::Exact,
         Method::Linear,
+        Method::Taylor(tol),
         Method::Dopri5(tol),
         Method::Dop853(tol),
         Method::Verlet { step: 1.0 },
@@ -148,6 +158,8 @@ pub enum Integrator {
     Verlet(Verlet),
     /// The exact propagator of linear flows.
     Linear(Linear),
+    /// Taylor's method.
+    Taylor(Taylor),
 }
 
 impl Integrator {
@@ -159,6 +171,7 @@ impl Integrator {
             Method::Linear => Integrator::Linear(Linear::new(dimension)),
             Method::Dopri5(tol) => Integrator::Dopri5(Dopri5::new(dimension, tol)),
             Method::Dop853(tol) => Integrator::Dop853(Dop853::new(dimension, tol)),
+            Method::Taylor(tol) => Integrator::Taylor(Taylor::new(dimension, tol)),
             Method::Auto | Method::Exact => Integrator::Dopri5(Dopri5::new(dimension, tolerances)),
         }
     }
@@ -170,6 +183,7 @@ impl Integrator {
             Integrator::Dop853(_) => "DOP853",
             Integrator::Verlet(_) => "Stormer-Verlet",
             Integrator::Linear(_) => "linear propagator",
+            Integrator::Taylor(_) => "Taylor's method",
         }
     }
 
@@ -180,6 +194,7 @@ impl Integrator {
             Integrator::Dop853(m) => m.restart(),
             Integrator::Verlet(m) => m.restart(),
             Integrator::Linear(m) => m.restart(),
+            Integrator::Taylor(m) => m.restart(),
         }
     }
 
@@ -197,6 +212,7 @@ impl Integrator {
             Integrator::Dop853(m) => m.step(model, mode, y0, h_max, h_min),
             Integrator::Verlet(m) => m.step(model, mode, y0, h_max, h_min),
             Integrator::Linear(m) => m.step(model, mode, y0, h_max, h_min),
+            Integrator::Taylor(m) => m.step(model, mode, y0, h_max, h_min),
         }
     }
 
@@ -207,6 +223,7 @@ impl Integrator {
             Integrator::Dop853(m) => m.dense().h,
             Integrator::Verlet(m) => m.h(),
             Integrator::Linear(m) => m.h(),
+            Integrator::Taylor(m) => m.h(),
         }
     }
 
@@ -217,6 +234,7 @@ impl Integrator {
             Integrator::Dop853(m) => m.dense().eval(tau, x),
             Integrator::Verlet(m) => m.eval(tau, x),
             Integrator::Linear(m) => m.eval(tau, x),
+            Integrator::Taylor(m) => m.eval(tau, x),
         }
     }
 
@@ -227,6 +245,7 @@ impl Integrator {
             Integrator::Dop853(m) => m.dense().end(x),
             Integrator::Verlet(m) => m.end(x),
             Integrator::Linear(m) => m.end(x),
+            Integrator::Taylor(m) => m.end(x),
         }
     }
 
@@ -236,7 +255,25 @@ impl Integrator {
             Integrator::Dopri5(_) => Interpolant::Polynomial { degree: 4 },
             Integrator::Dop853(_) => Interpolant::Polynomial { degree: 7 },
             Integrator::Verlet(_) => Interpolant::Polynomial { degree: 3 },
-            Integrator::Linear(_) => Interpolant::Other,
+            Integrator::Linear(_) | Integrator::Taylor(_) => Interpolant::Other,
+        }
+    }
+
+    /// Where the method locates a guard's crossing itself, on its own
+    /// series (Taylor's method, see [`Taylor::locate`]): the scan of the
+    /// last step for `guard`; `None` where the dense output is to be
+    /// scanned.
+    pub fn locate<M: HybridModel + ?Sized>(
+        &mut self,
+        model: &M,
+        mode: Mode,
+        guard: usize,
+        check_start: bool,
+        uncertainty: f64,
+    ) -> Option<Result<StepScan, String>> {
+        match self {
+            Integrator::Taylor(m) => Some(m.locate(model, mode, guard, check_start, uncertainty)),
+            _ => None,
         }
     }
 
@@ -265,6 +302,7 @@ impl Integrator {
             Integrator::Dop853(m) => m.local_error(),
             Integrator::Verlet(m) => m.local_error(),
             Integrator::Linear(m) => m.local_error(),
+            Integrator::Taylor(m) => m.local_error(),
         }
     }
 
@@ -275,6 +313,7 @@ impl Integrator {
             Integrator::Dop853(m) => m.evaluations(),
             Integrator::Verlet(m) => m.evaluations,
             Integrator::Linear(m) => m.evaluations(),
+            Integrator::Taylor(m) => m.evaluations(),
         }
     }
 }

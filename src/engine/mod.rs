@@ -21,6 +21,7 @@ pub mod run;
 mod run_loop;
 pub mod simulation;
 pub mod tangent;
+pub mod taylor;
 pub mod verlet;
 pub mod zeno;
 

@@ -182,6 +182,37 @@ pub trait HybridModel {
         false
     }
 
+    /// Whether the model gives the Taylor series of its flow in `mode` and
+    /// of its guards along it ([`flow_series`](HybridModel::flow_series),
+    /// [`guard_series`](HybridModel::guard_series)): what Taylor's method
+    /// needs.
+    fn has_series(&self, mode: Mode) -> bool {
+        let _ = mode;
+        false
+    }
+
+    /// The normalised Taylor coefficients of orders `0..=order` of the flow
+    /// from `x` in `mode`: `series[i * (order + 1) + k]` is `x_i^(k)(0) / k!`.
+    fn flow_series(&self, mode: Mode, x: &[f64], order: usize, series: &mut [f64]) {
+        let _ = (x, order, series);
+        unreachable!("mode {} gives no Taylor series", self.mode_name(mode))
+    }
+
+    /// The Taylor coefficients of guard `guard` along a flow whose series
+    /// is `series` (laid out as [`flow_series`](HybridModel::flow_series)
+    /// writes it), into `out` (`order + 1` of them).
+    fn guard_series(
+        &self,
+        mode: Mode,
+        guard: usize,
+        series: &[f64],
+        order: usize,
+        out: &mut [f64],
+    ) {
+        let _ = (guard, series, order, out);
+        unreachable!("mode {} gives no Taylor series", self.mode_name(mode))
+    }
+
     /// `(A, b)` if the flow in `mode` is linear, `x' = A x + b`: what the
     /// exact linear propagator needs.
     fn linear(&self, mode: Mode) -> Option<(DMatrix<f64>, DVector<f64>)> {

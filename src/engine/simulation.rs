@@ -459,11 +459,27 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
                         self.bound
                             .guard_uncertainty(model, mode, g, &self.state, local)
                     };
-                    let (step, x) = (&self.integrator, &mut self.before[..n]);
-                    let scan = scan_step(guard, check_start, interpolant, uncertainty, |s| {
-                        step.eval(s * h, x);
-                        model.guard(mode, g, x)
-                    });
+                    let scan =
+                        match self
+                            .integrator
+                            .locate(model, mode, g, check_start, uncertainty)
+                        {
+                            Some(Ok(scan)) => scan,
+                            Some(Err(why)) => {
+                                return Err(End::failed(format!(
+                                    "{} at t = {}: {why}",
+                                    self.integrator.name(),
+                                    self.origin.value()
+                                )));
+                            }
+                            None => {
+                                let (step, x) = (&self.integrator, &mut self.before[..n]);
+                                scan_step(guard, check_start, interpolant, uncertainty, |s| {
+                                    step.eval(s * h, x);
+                                    model.guard(mode, g, x)
+                                })
+                            }
+                        };
                     if scan.margin <= uncertainty {
                         return Err(self.undecidable(g, scan.margin, uncertainty));
                     }

@@ -3,24 +3,27 @@
 //! ```json
 //! "solver": {"method": "dopri5", "rtol": 1e-9, "atol": 1e-9}
 //! "solver": {"method": "dop853", "rtol": 1e-9, "atol": 1e-9}
+//! "solver": {"method": "taylor", "rtol": 1e-15, "atol": 1e-15}
 //! "solver": {"method": "verlet", "step": 0.01}
 //! "solver": {"method": "linear"}
 //! "solver": {"method": "exact"}
 //! ```
 //!
 //! Without `method` (or without `solver`) a scene runs the cheapest exact
-//! description its model offers; `rtol` and `atol` then set Dormand-Prince's
-//! tolerances where a model has only an ODE. Each key belongs to its
-//! methods: `step` to `verlet`, `rtol`/`atol` to `dopri5` and `dop853`.
+//! description its model offers; `rtol` and `atol` then set the tolerances
+//! of the method it takes where a model has only an ODE. Each key belongs
+//! to its methods: `step` to `verlet`, `rtol`/`atol` to `dopri5`, `dop853`
+//! and `taylor` (default 1e-12 for the first two, machine epsilon for
+//! `taylor`).
 
 use serde_json::Value;
 
-use crate::engine::{Method, Tolerances};
+use crate::engine::{Method, Tolerances, taylor};
 use crate::scene::SceneError;
 use crate::scene::fields::Fields;
 
 /// The method names a scene or `--method` may give.
-pub const METHODS: [&str; 5] = ["exact", "linear", "dopri5", "dop853", "verlet"];
+pub const METHODS: [&str; 6] = ["exact", "linear", "taylor", "dopri5", "dop853", "verlet"];
 
 /// The solver as written, before it is checked against the model.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -89,12 +92,16 @@ impl SolverSpec {
             )
         };
         let method = match self.method.as_deref() {
-            None | Some("dopri5" | "dop853") if step.is_some() => {
+            None | Some("dopri5" | "dop853" | "taylor") if step.is_some() => {
                 return Err(not_for("step", self.method.as_deref().unwrap_or("auto")));
             }
             None => Method::Auto,
             Some("dopri5") => Method::Dopri5(tolerances),
             Some("dop853") => Method::Dop853(tolerances),
+            Some("taylor") => Method::Taylor(Tolerances {
+                rtol: rtol.unwrap_or(taylor::DEFAULT_TOLERANCE),
+                atol: atol.unwrap_or(taylor::DEFAULT_TOLERANCE),
+            }),
             Some(other @ ("verlet" | "linear" | "exact")) if rtol.is_some() || atol.is_some() => {
                 return Err(not_for(if rtol.is_some() { "rtol" } else { "atol" }, other));
             }

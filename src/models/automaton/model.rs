@@ -11,6 +11,7 @@
 //! and `b` read off exactly by forward differentiation), a mode of the
 //! shape `[q; v]` with `q' = v` and `v'` free of `v` is second order.
 
+use std::cell::RefCell;
 use std::collections::HashSet;
 use std::sync::{Mutex, OnceLock};
 
@@ -19,6 +20,7 @@ use nalgebra::{DMatrix, DVector};
 use crate::engine::{Flow, Guard, HybridModel, Jump, Mode};
 use crate::models::automaton::definition::{Definition, Source};
 use crate::models::automaton::expr::derivative::jacobian;
+use crate::models::automaton::expr::series::Series;
 use crate::models::automaton::expr::{Ast, Scope, Tape};
 use crate::scene::SceneError;
 
@@ -47,6 +49,9 @@ struct CompiledMode {
     kind: Flow,
     linear: Option<(DMatrix<f64>, DVector<f64>)>,
     second_order: bool,
+    /// No `abs`, `min` or `max` in the flow or a guard: Taylor series hold
+    /// over a whole step.
+    smooth: bool,
 }
 
 #[derive(Debug, Clone)]
@@ -147,7 +152,9 @@ impl Automaton {
                         == crate::models::automaton::expr::Op::Input((half + i) as u32)
                 })
                 && (half..n).all(|i| (half..n).all(|j| !flow.depends_on(i, j as u32)));
+            let smooth = flow.smooth() && guard_tapes.iter().all(Tape::smooth);
             modes.push(CompiledMode {
+                smooth,
                 name: intern(&mode.name),
                 flow,
                 rates: mode.flow.clone(),
@@ -250,6 +257,26 @@ impl HybridModel for Automaton {
         self.modes[mode].second_order
     }
 
+    fn has_series(&self, mode: Mode) -> bool {
+        self.modes[mode].smooth
+    }
+
+    fn flow_series(&self, mode: Mode, x: &[f64], order: usize, series: &mut [f64]) {
+        SERIES.with_borrow_mut(|s| s.flow(&self.modes[mode].flow, x, order, series));
+    }
+
+    fn guard_series(
+        &self,
+        mode: Mode,
+        guard: usize,
+        series: &[f64],
+        order: usize,
+        out: &mut [f64],
+    ) {
+        let tape = &self.modes[mode].guard_tapes[guard];
+        SERIES.with_borrow_mut(|s| s.compose(tape, series, order, out));
+    }
+
     fn linear(&self, mode: Mode) -> Option<(DMatrix<f64>, DVector<f64>)> {
         self.modes[mode].linear.clone()
     }
@@ -297,6 +324,12 @@ impl HybridModel for Automaton {
             m.name, self.states[i], rates[i]
         ))
     }
+}
+
+thread_local! {
+    /// Scratch for Taylor series (models are shared, read only, between
+    /// the threads of a sweep).
+    static SERIES: RefCell<Series> = RefCell::new(Series::default());
 }
 
 /// A name that lives as long as the program: the engine's logs take

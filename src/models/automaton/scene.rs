@@ -4,7 +4,7 @@
 use std::sync::Arc;
 
 use crate::engine::integrator::{methods_for, runs};
-use crate::engine::{HybridModel, Method, Observer, Tolerances, simulate};
+use crate::engine::{HybridModel, Method, Observer, Tolerances, simulate, taylor};
 use crate::models::automaton::definition::Definition;
 use crate::models::automaton::model::Automaton;
 use crate::runner::{Control, Report};
@@ -64,19 +64,48 @@ pub fn scene(mut f: Fields) -> Result<Scene, SceneError> {
 
 impl AutomatonScene {
     /// The method a run uses, and why: `Auto` resolves to the exact linear
-    /// propagator where every flow is affine, else to Dormand-Prince.
+    /// propagator where every flow is affine, else to Taylor's method at
+    /// machine precision (unless told `rtol`/`atol`), else (a flow or guard
+    /// with `abs`, `min` or `max`) to Dormand-Prince.
     pub fn resolved(&self) -> (Method, String) {
         let tol = self.tolerances;
+        let modes = self.automaton.modes();
         match self.method {
             Method::Auto if self.automaton.all_linear() => (
                 Method::Linear,
                 "every mode's flow is affine: exact linear propagator, events located on it".into(),
             ),
+            Method::Auto if runs(&*self.automaton, &modes, Method::Taylor(tol)).is_ok() => {
+                let tol = Tolerances {
+                    rtol: self.solver.rtol.unwrap_or(taylor::DEFAULT_TOLERANCE),
+                    atol: self.solver.atol.unwrap_or(taylor::DEFAULT_TOLERANCE),
+                };
+                (
+                    Method::Taylor(tol),
+                    format!(
+                        "a mode's flow is not affine: Taylor's method of order {}, rtol {:e}, atol {:e}, \
+                         events on each guard's series",
+                        taylor::order_for(tol),
+                        tol.rtol,
+                        tol.atol
+                    ),
+                )
+            }
             Method::Auto => (
                 Method::Dopri5(tol),
                 format!(
-                    "a mode's flow is not affine: Dormand-Prince 5(4), rtol {:e}, atol {:e}",
+                    "a mode's flow is not affine and uses abs, min or max (no Taylor series): \
+                     Dormand-Prince 5(4), rtol {:e}, atol {:e}",
                     tol.rtol, tol.atol
+                ),
+            ),
+            Method::Taylor(t) => (
+                self.method,
+                format!(
+                    "Taylor's method of order {}, rtol {:e}, atol {:e}, events on each guard's series",
+                    taylor::order_for(t),
+                    t.rtol,
+                    t.atol
                 ),
             ),
             Method::Linear => (

@@ -47,6 +47,10 @@ pub(crate) fn run(
                     format!("strain formulation: DOP853 (Dormand-Prince 8(5,3)), rtol {:e}, atol {:e}", tol.rtol, tol.atol),
                 ),
                 Method::Verlet { step } => ("verlet", format!("strain formulation: Stormer-Verlet, step {step:e}")),
+                Method::Taylor(tol) => (
+                    "taylor",
+                    format!("strain formulation: Taylor's method, rtol {:e}, atol {:e}", tol.rtol, tol.atol),
+                ),
             };
             Ok(Report {
                 outcome,

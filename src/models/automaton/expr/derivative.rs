@@ -37,14 +37,6 @@ pub fn jacobian(tape: &Tape, x: &[f64]) -> DMatrix<f64> {
             Op::Mul(a, b) => combine(Some((a, v(b))), Some((b, v(a)))),
             Op::Div(a, b) => combine(Some((a, 1.0 / v(b))), Some((b, -v(a) / (v(b) * v(b))))),
             Op::Neg(a) => combine(Some((a, -1.0)), None),
-            Op::Powi(a, k) => {
-                let c = if k == 0 {
-                    0.0
-                } else {
-                    k as f64 * v(a).powi(k - 1)
-                };
-                combine(Some((a, c)), None)
-            }
             Op::Pow(a, b) => {
                 let (base, exponent) = (v(a), v(b));
                 let cb = if base > 0.0 {

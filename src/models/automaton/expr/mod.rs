@@ -4,6 +4,7 @@
 
 pub mod derivative;
 pub mod parse;
+pub mod series;
 pub mod tape;
 
 pub use parse::{Ast, ParseError, parse};

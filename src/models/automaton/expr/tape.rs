@@ -6,7 +6,9 @@
 //! Instructions whose operands are all constant are folded; an instruction
 //! already on the tape (same operation, same operands) is reused, so the
 //! expressions compiled into one tape share their common subexpressions;
-//! integer powers become [`Op::Powi`]; what no output needs is dropped.
+//! integer powers become products (and a quotient for negative ones), so
+//! that every power of a series is a product of series; what no output
+//! needs is dropped.
 //! The same tape is what the Taylor recurrences and derivatives walk.
 
 use std::cell::RefCell;
@@ -135,8 +137,6 @@ pub enum Op {
     Div(Reg, Reg),
     /// `-a`
     Neg(Reg),
-    /// `a^n` for a small integer `n`.
-    Powi(Reg, i32),
     /// `a^b`
     Pow(Reg, Reg),
     /// `f(a)`
@@ -158,7 +158,6 @@ impl Op {
             Op::Mul(a, b) => r(a) * r(b),
             Op::Div(a, b) => r(a) / r(b),
             Op::Neg(a) => -r(a),
-            Op::Powi(a, n) => r(a).powi(n),
             Op::Pow(a, b) => r(a).powf(r(b)),
             Op::Call(f, a) => f.apply(r(a)),
             Op::Call2(f, a, b) => f.apply(r(a), r(b)),
@@ -169,7 +168,7 @@ impl Op {
     pub fn operands(self) -> impl Iterator<Item = Reg> {
         let (a, b) = match self {
             Op::Const(_) | Op::Input(_) => (None, None),
-            Op::Neg(a) | Op::Powi(a, _) | Op::Call(_, a) => (Some(a), None),
+            Op::Neg(a) | Op::Call(_, a) => (Some(a), None),
             Op::Add(a, b)
             | Op::Sub(a, b)
             | Op::Mul(a, b)
@@ -190,7 +189,6 @@ impl Op {
             Op::Mul(a, b) => Op::Mul(m(a), m(b)),
             Op::Div(a, b) => Op::Div(m(a), m(b)),
             Op::Neg(a) => Op::Neg(m(a)),
-            Op::Powi(a, n) => Op::Powi(m(a), n),
             Op::Pow(a, b) => Op::Pow(m(a), m(b)),
             Op::Call(f, a) => Op::Call(f, m(a)),
             Op::Call2(f, a, b) => Op::Call2(f, m(a), m(b)),
@@ -208,7 +206,6 @@ impl Op {
             Op::Mul(a, b) => (4, r(a.min(b)), r(a.max(b))),
             Op::Div(a, b) => (5, r(a), r(b)),
             Op::Neg(a) => (6, r(a), 0),
-            Op::Powi(a, n) => (7, r(a), n as u32 as u64),
             Op::Pow(a, b) => (8, r(a), r(b)),
             Op::Call(f, a) => (16 + f as u8, r(a), 0),
             Op::Call2(f, a, b) => (48 + f as u8, r(a), r(b)),
@@ -333,13 +330,22 @@ impl Tape {
                 Op::Neg(a) => d(a),
                 Op::Mul(a, b) if d(a) == 0 || d(b) == 0 => d(a).max(d(b)),
                 Op::Div(a, b) if d(b) == 0 => d(a),
-                Op::Powi(a, 1) => d(a),
-                Op::Powi(_, 0) => 0,
                 _ if op.operands().all(|r| d(r) == 0) => 0,
                 _ => 2,
             };
         }
         self.outputs.iter().all(|&r| degree[r as usize] <= 1)
+    }
+
+    /// Whether every instruction is smooth: no `abs`, `min` or `max`, whose
+    /// branch a Taylor series cannot see switch.
+    pub fn smooth(&self) -> bool {
+        !self.ops.iter().any(|op| {
+            matches!(
+                op,
+                Op::Call(Fun::Abs, _) | Op::Call2(Fun2::Min | Fun2::Max, _, _)
+            )
+        })
     }
 
     /// Whether output `output` reads input `input`, through any instruction.
@@ -446,11 +452,37 @@ impl Builder<'_> {
         })
     }
 
-    /// `a^b`: integer exponents up to 64 in size as [`Op::Powi`].
+    /// `a^b`: an integer exponent up to 64 in size as products, by
+    /// squaring (`x^4` is `(x x)(x x)`), and `1 / a^n` for a negative one.
     fn power(&mut self, a: Reg, b: Reg) -> Reg {
         match self.constant(b) {
-            Some(n) if n == n.round() && n.abs() <= 64.0 => self.push(Op::Powi(a, n as i32)),
+            Some(n) if n == n.round() && n.abs() <= 64.0 => {
+                let positive = self.integer_power(a, n.abs() as u32);
+                if n < 0.0 {
+                    let one = self.push(Op::Const(1.0));
+                    self.push(Op::Div(one, positive))
+                } else {
+                    positive
+                }
+            }
             _ => self.push(Op::Pow(a, b)),
+        }
+    }
+
+    /// `a^n` by squaring and multiplying.
+    fn integer_power(&mut self, a: Reg, n: u32) -> Reg {
+        match n {
+            0 => self.push(Op::Const(1.0)),
+            1 => a,
+            _ => {
+                let half = self.integer_power(a, n / 2);
+                let square = self.push(Op::Mul(half, half));
+                if n % 2 == 1 {
+                    self.push(Op::Mul(square, a))
+                } else {
+                    square
+                }
+            }
         }
     }
 
@@ -633,11 +665,18 @@ mod tests {
     }
 
     #[test]
-    fn integer_powers_are_powi() {
-        let tape = compile(&["x^3", "x^-2", "x^0.5"]).unwrap();
-        assert!(tape.ops.contains(&Op::Powi(0, 3)));
-        assert!(tape.ops.contains(&Op::Powi(0, -2)));
-        assert!(tape.ops.iter().any(|op| matches!(op, Op::Pow(..))));
+    fn integer_powers_are_products() {
+        // x^2, x^3 = x^2 x, x^-2 = 1 / x^2: two products, one quotient.
+        let tape = compile(&["x^3", "x^-2", "x^0.5", "v^0", "v^1"]).unwrap();
+        let count = |f: fn(&Op) -> bool| tape.ops.iter().filter(|op| f(op)).count();
+        assert_eq!(count(|op| matches!(op, Op::Mul(..))), 2, "{:?}", tape.ops);
+        assert_eq!(count(|op| matches!(op, Op::Div(..))), 1);
+        assert_eq!(count(|op| matches!(op, Op::Pow(..))), 1);
+        let out = eval(&tape, &[1.5, 2.0, 0.0]);
+        assert_eq!(
+            out,
+            vec![1.5 * 1.5 * 1.5, 1.0 / (1.5 * 1.5), 1.5f64.sqrt(), 1.0, 2.0]
+        );
     }
 
     #[test]

@@ -1,0 +1,330 @@
+//! Taylor's method: each step is the flow's own Taylor series, of an order
+//! and over a step chosen from the tolerance, and each guard's crossing is
+//! found on the guard's own Taylor series along the step.
+//!
+//! The model gives the series ([`HybridModel::flow_series`] and
+//! [`HybridModel::guard_series`]; a model compiled from expressions gets
+//! them by automatic recurrences). Following Jorba and Zou (2005), as
+//! heyoka does: with the tolerance `eps = min(rtol, atol)`, the order is
+//! `p = ceil(-ln(eps) / 2) + 1`, and the step is `h = rho / e^2 *
+//! exp(-0.7 / (p - 1))`, where `rho` estimates the series' radius of
+//! convergence from its last two coefficients (relative to the state's
+//! size where `rtol` governs, absolute where `atol` does). The first term
+//! left out is then about `eps` of the state.
+//!
+//! A guard's series on the step is a polynomial of degree `p`; its first
+//! crossing in the guard's direction is found by the certified search of
+//! [`first_fall`] (every piece of the step proven free of a crossing,
+//! monotone through one, or halved), so no root of the polynomial in the
+//! step is missed. A crossing that curves back, or a near miss, reports how
+//! deep its dip or how high its turning point is, which the run compares
+//! with its error to refuse a graze it cannot decide.
+//!
+//! [`HybridModel::flow_series`]: crate::engine::HybridModel::flow_series
+//! [`HybridModel::guard_series`]: crate::engine::HybridModel::guard_series
+
+use crate::engine::adaptive::{StepFailure, Tolerances};
+use crate::engine::locate::StepScan;
+use crate::engine::model::{Direction, HybridModel, Mode};
+use crate::numerics::polynomial::eval;
+use crate::numerics::taylor::{eval2, first_fall};
+
+/// The tolerance `taylor` takes unless told: machine epsilon, as heyoka.
+pub const DEFAULT_TOLERANCE: f64 = f64::EPSILON;
+
+/// Taylor's method's working state: the series of the current step.
+#[derive(Debug, Clone)]
+pub struct Taylor {
+    tolerances: Tolerances,
+    order: usize,
+    /// `series[i * (order + 1) + k]`: coefficient `k` of component `i`.
+    series: Vec<f64>,
+    /// A guard's series, scratch.
+    guard: Vec<f64>,
+    h: f64,
+    local_error: f64,
+    /// Series asked of the model (flows and guards).
+    evaluations: u64,
+}
+
+impl Taylor {
+    /// Taylor's method on states of `dimension` components.
+    pub fn new(dimension: usize, tolerances: Tolerances) -> Self {
+        let order = order_for(tolerances);
+        Taylor {
+            tolerances,
+            order,
+            series: vec![0.0; dimension * (order + 1)],
+            guard: vec![0.0; order + 1],
+            h: 0.0,
+            local_error: 0.0,
+            evaluations: 0,
+        }
+    }
+
+    /// The series' order.
+    pub fn order(&self) -> usize {
+        self.order
+    }
+
+    /// Nothing to forget: a step depends only on its start.
+    pub fn restart(&mut self) {}
+
+    /// Expand the flow at `y0` and choose the step, at most `h_max`.
+    pub fn step<M: HybridModel + ?Sized>(
+        &mut self,
+        model: &M,
+        mode: Mode,
+        y0: &[f64],
+        h_max: f64,
+        h_min: f64,
+    ) -> Result<(), StepFailure> {
+        let p = self.order;
+        let w = p + 1;
+        model.flow_series(mode, y0, p, &mut self.series);
+        self.evaluations += 1;
+        if !self.series.iter().all(|c| c.is_finite()) {
+            return Err(StepFailure::NonFinite);
+        }
+        let norm = |k: usize| {
+            self.series
+                .chunks_exact(w)
+                .fold(0.0_f64, |m, c| m.max(c[k].abs()))
+        };
+        let size = y0.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+        let Tolerances { rtol, atol } = self.tolerances;
+        // Relative where the state is large enough for rtol to govern.
+        let scale = if rtol * size > atol { size } else { 1.0 };
+        let radius = |k: usize| {
+            let n = norm(k);
+            if n == 0.0 {
+                f64::INFINITY
+            } else {
+                (scale / n).powf(1.0 / k as f64)
+            }
+        };
+        let rho = radius(p - 1).min(radius(p));
+        let h = (rho / std::f64::consts::E.powi(2) * (-0.7 / (p - 1) as f64).exp()).min(h_max);
+        if !(h >= h_min) {
+            return Err(StepFailure::Collapsed { h });
+        }
+        self.h = h;
+        // The last term kept, the size of the first left out.
+        self.local_error = norm(p) * h.powi(p as i32);
+        Ok(())
+    }
+
+    /// Length of the last step.
+    pub fn h(&self) -> f64 {
+        self.h
+    }
+
+    /// The state `tau` into the step: each component's series summed.
+    pub fn eval(&self, tau: f64, x: &mut [f64]) {
+        for (xi, c) in x.iter_mut().zip(self.series.chunks_exact(self.order + 1)) {
+            *xi = eval(c, tau);
+        }
+    }
+
+    /// The state at the end of the step.
+    pub fn end(&self, x: &mut [f64]) {
+        self.eval(self.h, x);
+    }
+
+    /// The last term kept, at the step's length.
+    pub fn local_error(&self) -> f64 {
+        self.local_error
+    }
+
+    /// Series asked of the model so far.
+    pub fn evaluations(&self) -> u64 {
+        self.evaluations
+    }
+
+    /// The first crossing of `guard` on the step in its direction, as a
+    /// fraction of the step, and how clearly the step decides (see
+    /// [`StepScan`]; turning points are looked for only where the guard
+    /// may come within `uncertainty` of zero). With `check_start` (the
+    /// guard sits on zero after a reset) it fires at once if it moves on
+    /// its way; otherwise a guard that starts past zero must first come
+    /// back before it can cross.
+    pub fn locate<M: HybridModel + ?Sized>(
+        &mut self,
+        model: &M,
+        mode: Mode,
+        guard: usize,
+        check_start: bool,
+        uncertainty: f64,
+    ) -> Result<StepScan, String> {
+        let p = self.order;
+        model.guard_series(mode, guard, &self.series, p, &mut self.guard);
+        self.evaluations += 1;
+        if !self.guard.iter().all(|c| c.is_finite()) {
+            return Err(format!(
+                "the series of guard `{}` is not finite",
+                model.guards(mode)[guard].name
+            ));
+        }
+        let h = self.h;
+        let (first, margin) = match model.guards(mode)[guard].direction {
+            Direction::Falling => falls(&self.guard, h, check_start, uncertainty)?,
+            Direction::Rising => {
+                self.guard.iter_mut().for_each(|c| *c = -*c);
+                falls(&self.guard, h, check_start, uncertainty)?
+            }
+            Direction::Either => {
+                let (a, ma) = falls(&self.guard, h, check_start, uncertainty)?;
+                self.guard.iter_mut().for_each(|c| *c = -*c);
+                let (b, mb) = falls(&self.guard, h, check_start, uncertainty)?;
+                let first = match (a, b) {
+                    (Some(a), Some(b)) => Some(a.min(b)),
+                    (a, b) => a.or(b),
+                };
+                (first, ma.min(mb))
+            }
+        };
+        Ok(StepScan {
+            crossing: first.map(|tau| (tau / h).min(1.0)),
+            margin,
+        })
+    }
+}
+
+/// The order for `tolerances`: `ceil(-ln(eps) / 2) + 1`, `eps = min(rtol,
+/// atol)`, at least 2 and at most 60.
+pub fn order_for(tolerances: Tolerances) -> usize {
+    let eps = tolerances.rtol.min(tolerances.atol).max(f64::MIN_POSITIVE);
+    ((-eps.ln() / 2.0).ceil() as usize + 1).clamp(2, 60)
+}
+
+/// The first fall of `c` through zero on `[0, h]` (see [`first_fall`]),
+/// and the margin: for a crossing that curves back, the depth its dip
+/// would reach, `p'^2 / (2 p'')`; without one, the lowest turning point
+/// still above zero, where it may come within `uncertainty` of zero;
+/// infinite when nothing comes that close.
+fn falls(
+    c: &[f64],
+    h: f64,
+    check_start: bool,
+    uncertainty: f64,
+) -> Result<(Option<f64>, f64), String> {
+    // Most steps: the guard stays further from zero than the errors can
+    // move it, which its coefficients show at once.
+    if lowest(c, h) > uncertainty {
+        return Ok((None, f64::INFINITY));
+    }
+    let from = if !check_start && c[0] <= 0.0 {
+        // Already past zero: it must come back up before it can cross.
+        let back: Vec<f64> = c.iter().map(|x| -x).collect();
+        match first_fall(&back, 0.0, h)? {
+            Some(up) => up,
+            None => return Ok((None, f64::INFINITY)),
+        }
+    } else {
+        0.0
+    };
+    let crossing = first_fall(c, from, h)?;
+    let end = crossing.unwrap_or(h);
+    let mut margin = f64::INFINITY;
+    let slope: Vec<f64> = c
+        .iter()
+        .enumerate()
+        .skip(1)
+        .map(|(k, x)| k as f64 * x)
+        .collect();
+    // Turning points (the slope rising through zero) before the crossing,
+    // unless the guard falls all the way there.
+    let falling_throughout = slope
+        .iter()
+        .skip(1)
+        .rev()
+        .fold(0.0, |acc, d| (acc + d.max(0.0)) * end)
+        + slope.first().copied().unwrap_or(0.0)
+        < 0.0;
+    if !falling_throughout {
+        let minus_slope: Vec<f64> = slope.iter().map(|x| -x).collect();
+        let mut at = from;
+        for _ in 0..8 {
+            match first_fall(&minus_slope, at, end)? {
+                // A guard already rising where the search starts is not at a
+                // turning point there.
+                Some(turn) if turn > at => {
+                    let (value, _, _) = eval2(c, turn);
+                    if value > 0.0 {
+                        margin = margin.min(value);
+                    }
+                    if turn >= end {
+                        break;
+                    }
+                    at = turn + (end - turn) * 1e-9;
+                }
+                _ => break,
+            }
+        }
+    }
+    if let Some(t) = crossing {
+        let (_, slope, curvature) = eval2(c, t);
+        if curvature > 0.0 && t > 0.0 {
+            margin = margin.min(slope * slope / (2.0 * curvature));
+        }
+    }
+    Ok((crossing, margin))
+}
+
+/// A lower bound of `sum c_k s^k` on `[0, h]`: `c_0 - sum_{k >= 1} |c_k| h^k`.
+fn lowest(c: &[f64], h: f64) -> f64 {
+    c[0] - c
+        .iter()
+        .skip(1)
+        .rev()
+        .fold(0.0, |acc, x| (acc + x.abs()) * h)
+        * (1.0 + 1e-12)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn orders_follow_the_tolerance() {
+        let tol = |e: f64| Tolerances { rtol: e, atol: e };
+        assert_eq!(order_for(tol(1e-15)), 19);
+        assert_eq!(order_for(tol(1e-12)), 15);
+        assert_eq!(
+            order_for(Tolerances {
+                rtol: 1e-6,
+                atol: 1e-16
+            }),
+            20
+        );
+    }
+
+    #[test]
+    fn a_fall_a_graze_and_a_near_miss() {
+        // (s - 1)(s - 2) falls through zero at 1 (coming from above) and rises at 2.
+        let (t, margin) = falls(&[2.0, -3.0, 1.0], 3.0, false, 0.0).unwrap();
+        assert!((t.unwrap() - 1.0).abs() < 1e-15);
+        // Slope -1 and curvature 2 at the root: a dip of 1/4 if it curves back.
+        assert!((margin - 0.25).abs() < 1e-12, "{margin}");
+        // (s - 1)^2 + 1e-6: a near miss whose turning point is 1e-6 above zero.
+        let (t, margin) = falls(&[1.0 + 1e-6, -2.0, 1.0], 3.0, false, 0.0).unwrap();
+        assert_eq!(t, None);
+        assert!((margin - 1e-6).abs() < 1e-12, "{margin}");
+        // Starting below zero and falling further: no crossing without check_start...
+        assert_eq!(falls(&[-1e-3, -1.0], 1.0, false, 0.0).unwrap().0, None);
+        // ...and at once with it (a reset that did not turn the motion round).
+        assert_eq!(falls(&[0.0, -1.0], 1.0, true, 0.0).unwrap().0, Some(0.0));
+        // On zero and rising, then back: the bounce's return.
+        let (t, _) = falls(&[0.0, 1.0, -1.0], 2.0, true, 0.0).unwrap();
+        assert!((t.unwrap() - 1.0).abs() < 1e-15);
+        // Just above zero and rising (a state just after an impact): no
+        // turning point at the start, so nothing near.
+        let (t, margin) = falls(&[5e-17, 1.0, 1.0], 2.0, true, 0.0).unwrap();
+        assert_eq!((t, margin), (None, f64::INFINITY));
+        // Far from zero for the whole step: decided from the coefficients.
+        assert_eq!(
+            falls(&[1.0, -0.1, 0.01], 2.0, false, 1e-3).unwrap(),
+            (None, f64::INFINITY)
+        );
+    }
+}

@@ -1,0 +1,459 @@
+//! Taylor coefficients of any order, by automatic recurrences along the
+//! tape (as heyoka does): each instruction computes the `k`-th normalised
+//! coefficient of its value from the first `k` of its operands.
+//!
+//! For a flow `x' = f(x)` ([`Series::flow`]) the orders are built up in
+//! turn: once every register has its order `k`, the state's order `k + 1`
+//! is `f_k / (k + 1)`. A guard's series along the step ([`Series::compose`])
+//! is the same recurrences with the state's series as inputs. The
+//! recurrences come from differentiating each function's defining
+//! relation: `p = a^c` from `a p' = c a' p`, `e = exp a` from `e' = a' e`,
+//! `sin` and `cos` together, `tan` from `t' = (1 + t^2) a'`, `asin` and
+//! `acos` from `sqrt(1 - a^2) y' = +-a'`, `atan2(y, x)` from
+//! `(x^2 + y^2) theta' = x y' - y x'`. Each keeps at most two helper series
+//! (the partner `cos` of a `sin`, the `1 - a^2` and its root of an `asin`).
+//!
+//! `abs`, `min` and `max` follow the branch their value takes at the
+//! series' origin: a series is not told where a branch switches, so a
+//! method that trusts a whole step to one series must not take them (see
+//! [`Tape::smooth`]).
+
+use crate::models::automaton::expr::tape::{Fun, Fun2, Op, Tape};
+
+/// Scratch for the series of one tape.
+#[derive(Debug, Clone, Default)]
+pub struct Series {
+    /// Orders kept per register (`order + 1` coefficients).
+    width: usize,
+    /// Coefficients, register by register.
+    main: Vec<f64>,
+    /// First and second helper series of each register.
+    aux: [Vec<f64>; 2],
+}
+
+impl Series {
+    fn prepare(&mut self, tape: &Tape, order: usize) {
+        self.width = order + 1;
+        let len = tape.ops.len() * self.width;
+        let [aux0, aux1] = &mut self.aux;
+        for buffer in [&mut self.main, aux0, aux1] {
+            buffer.clear();
+            buffer.resize(len, 0.0);
+        }
+    }
+
+    /// The series of the flow `x' = f(x)` from `x0`, `f` being `tape`
+    /// (whose outputs are the rates of its inputs, in order): `out[i *
+    /// (order + 1) + k]` is the `k`-th normalised coefficient of `x_i`.
+    pub fn flow(&mut self, tape: &Tape, x0: &[f64], order: usize, out: &mut [f64]) {
+        self.prepare(tape, order);
+        let w = self.width;
+        for (i, &x) in x0.iter().enumerate() {
+            out[i * w] = x;
+        }
+        for k in 0..=order {
+            for r in 0..tape.ops.len() {
+                self.coefficient(tape, r, k, out);
+            }
+            if k < order {
+                for (i, &o) in tape.outputs.iter().enumerate() {
+                    out[i * w + k + 1] = self.main[o as usize * w + k] / (k + 1) as f64;
+                }
+            }
+        }
+    }
+
+    /// The series of `tape`'s first output when its inputs follow `inputs`
+    /// (laid out as [`Series::flow`] writes them), into `out` (`order + 1`).
+    pub fn compose(&mut self, tape: &Tape, inputs: &[f64], order: usize, out: &mut [f64]) {
+        self.prepare(tape, order);
+        for k in 0..=order {
+            for r in 0..tape.ops.len() {
+                self.coefficient(tape, r, k, inputs);
+            }
+        }
+        let o = tape.outputs[0] as usize * self.width;
+        out[..=order].copy_from_slice(&self.main[o..o + order + 1]);
+    }
+
+    /// Coefficient `k` of register `r`, its operands known to order `k`.
+    #[inline]
+    fn coefficient(&mut self, tape: &Tape, r: usize, k: usize, inputs: &[f64]) {
+        let w = self.width;
+        let at = |reg: u32| reg as usize * w;
+        let out = r * w;
+        let kf = k as f64;
+        let one = |_: usize| 1.0;
+        let index = |j: usize| j as f64;
+        let m = &self.main;
+        let value = match tape.ops[r] {
+            Op::Const(c) => {
+                if k == 0 {
+                    c
+                } else {
+                    0.0
+                }
+            }
+            Op::Input(i) => inputs[i as usize * w + k],
+            Op::Add(a, b) => m[at(a) + k] + m[at(b) + k],
+            Op::Sub(a, b) => m[at(a) + k] - m[at(b) + k],
+            Op::Neg(a) => -m[at(a) + k],
+            // A constant factor or divisor scales; the general case convolves.
+            Op::Mul(a, b) if constant(tape, a) => m[at(a)] * m[at(b) + k],
+            Op::Mul(a, b) if constant(tape, b) => m[at(a) + k] * m[at(b)],
+            Op::Mul(a, b) => conv(m, at(a), m, at(b), k, 0, one),
+            Op::Div(a, b) if constant(tape, b) => m[at(a) + k] / m[at(b)],
+            Op::Div(a, b) => {
+                let sum = if k == 0 {
+                    0.0
+                } else {
+                    conv(m, at(b), m, out, k, 1, one)
+                };
+                (m[at(a) + k] - sum) / m[at(b)]
+            }
+            Op::Pow(a, b) if k == 0 && constant(tape, b) => m[at(a)].powf(m[at(b)]),
+            Op::Pow(a, b) if constant(tape, b) => {
+                // a p' = c a' p.
+                let c = m[at(b)];
+                let sum = conv(m, at(a), m, out, k, 1, |j| c * j as f64 - (k - j) as f64);
+                sum / (kf * m[at(a)])
+            }
+            Op::Pow(a, b) => {
+                // exp(b log a): aux 0 holds log a, aux 1 holds b log a.
+                let log = log_coefficient(m, at(a), &self.aux[0], out, k);
+                self.aux[0][out + k] = log;
+                let product = conv(m, at(b), &self.aux[0], out, k, 0, one);
+                self.aux[1][out + k] = product;
+                if k == 0 {
+                    m[at(a)].powf(m[at(b)])
+                } else {
+                    conv(&self.aux[1], out, m, out, k, 1, index) / kf
+                }
+            }
+            Op::Call(f, a) => self.call(f, at(a), out, k),
+            Op::Call2(f, a, b) => self.call2(f, at(a), at(b), out, k),
+        };
+        self.main[out + k] = value;
+    }
+
+    /// Coefficient `k` of `f(a)`, keeping its helper series.
+    fn call(&mut self, f: Fun, a: usize, out: usize, k: usize) -> f64 {
+        let (m, [aux, aux2]) = (&self.main, &mut self.aux);
+        let kf = k as f64;
+        let a0 = m[a];
+        // sum_{j=1}^{k} j a_j y_{k-j}: the coefficient k - 1 of a' y.
+        let slope_times = |y: &[f64]| -> f64 {
+            let mut sum = 0.0;
+            for j in 1..=k {
+                sum += j as f64 * m[a + j] * y[out + k - j];
+            }
+            sum
+        };
+        // sum_{j=1}^{k-1} j y_j z_{k-j}: the part of (z y')_(k-1) below y_k.
+        let known = |y: &[f64], z: &[f64]| -> f64 {
+            let mut sum = 0.0;
+            for j in 1..k {
+                sum += j as f64 * y[out + j] * z[out + k - j];
+            }
+            sum
+        };
+        match f {
+            Fun::Sin | Fun::Cos | Fun::Sinh | Fun::Cosh => {
+                // The function and its partner (cos of sin, ...) in aux.
+                let (hyperbolic, is_sin) = match f {
+                    Fun::Sin => (false, true),
+                    Fun::Cos => (false, false),
+                    Fun::Sinh => (true, true),
+                    _ => (true, false),
+                };
+                if k == 0 {
+                    let (s, c) = if hyperbolic {
+                        (a0.sinh(), a0.cosh())
+                    } else {
+                        a0.sin_cos()
+                    };
+                    let (value, partner) = if is_sin { (s, c) } else { (c, s) };
+                    aux[out] = partner;
+                    return value;
+                }
+                // s' = a' c, c' = -+ a' s (minus for the circular cos).
+                let partner_series = &aux[..];
+                let main_series = m;
+                let value_from_partner = slope_times(partner_series) / kf;
+                let partner_from_value = slope_times(main_series) / kf;
+                let sign = if hyperbolic { 1.0 } else { -1.0 };
+                // For sin: value' = a' partner, partner' = -a' value.
+                // For cos: value' = -a' partner, partner' = a' value.
+                let (value, partner) = if is_sin {
+                    (value_from_partner, sign * partner_from_value)
+                } else {
+                    (sign * value_from_partner, partner_from_value)
+                };
+                aux[out + k] = partner;
+                value
+            }
+            Fun::Tan | Fun::Tanh => {
+                // t' = (1 +- t^2) a', the factor in aux.
+                let sign = if f == Fun::Tan { 1.0 } else { -1.0 };
+                if k == 0 {
+                    let t = if f == Fun::Tan { a0.tan() } else { a0.tanh() };
+                    aux[out] = 1.0 + sign * t * t;
+                    return t;
+                }
+                let t = slope_times(aux) / kf;
+                // The factor's order k needs t_k itself.
+                let mut square = 2.0 * m[out] * t;
+                for j in 1..k {
+                    square += m[out + j] * m[out + k - j];
+                }
+                aux[out + k] = sign * square;
+                t
+            }
+            Fun::Exp => {
+                if k == 0 {
+                    a0.exp()
+                } else {
+                    slope_times(m) / kf
+                }
+            }
+            Fun::Log => log_coefficient(m, a, m, out, k),
+            Fun::Sqrt => sqrt_coefficient(|j| m[a + j], m, out, k),
+            Fun::Asin | Fun::Acos | Fun::Atan => {
+                // w = 1 -+ a^2 in aux; for asin/acos its root in aux2.
+                let sign = if f == Fun::Atan { 1.0 } else { -1.0 };
+                let mut square = 0.0;
+                for j in 0..=k {
+                    square += m[a + j] * m[a + k - j];
+                }
+                aux[out + k] = if k == 0 { 1.0 } else { 0.0 } + sign * square;
+                let scale = if f == Fun::Atan {
+                    aux
+                } else {
+                    let root = sqrt_coefficient(|j| aux[out + j], aux2, out, k);
+                    aux2[out + k] = root;
+                    aux2
+                };
+                if k == 0 {
+                    return match f {
+                        Fun::Asin => a0.asin(),
+                        Fun::Acos => a0.acos(),
+                        _ => a0.atan(),
+                    };
+                }
+                // scale y' = +-a'.
+                let direction = if f == Fun::Acos { -1.0 } else { 1.0 };
+                (direction * kf * m[a + k] - known(m, scale)) / (kf * scale[out])
+            }
+            Fun::Abs => {
+                let sign = if a0 < 0.0 { -1.0 } else { 1.0 };
+                sign * m[a + k]
+            }
+        }
+    }
+
+    /// Coefficient `k` of `f(a, b)`.
+    fn call2(&mut self, f: Fun2, a: usize, b: usize, out: usize, k: usize) -> f64 {
+        let (m, [aux, _]) = (&self.main, &mut self.aux);
+        let kf = k as f64;
+        match f {
+            Fun2::Min | Fun2::Max => {
+                let take_a = if f == Fun2::Min {
+                    m[a] <= m[b]
+                } else {
+                    m[a] >= m[b]
+                };
+                if take_a { m[a + k] } else { m[b + k] }
+            }
+            Fun2::Hypot | Fun2::Atan2 => {
+                // w = a^2 + b^2 in aux.
+                let mut square = 0.0;
+                for j in 0..=k {
+                    square += m[a + j] * m[a + k - j] + m[b + j] * m[b + k - j];
+                }
+                aux[out + k] = square;
+                if f == Fun2::Hypot {
+                    return sqrt_coefficient(|j| aux[out + j], m, out, k);
+                }
+                if k == 0 {
+                    return m[a].atan2(m[b]);
+                }
+                // atan2(y = a, x = b): w theta' = x y' - y x'.
+                let mut sum = 0.0;
+                for j in 1..=k {
+                    sum += j as f64 * (m[b + k - j] * m[a + j] - m[a + k - j] * m[b + j]);
+                }
+                for j in 1..k {
+                    sum -= j as f64 * m[out + j] * aux[out + k - j];
+                }
+                sum / (kf * aux[out])
+            }
+        }
+    }
+}
+
+/// `sum_{j = lo..=k} weight(j) x[xs + j] y[ys + k - j]`: the Cauchy
+/// product's coefficient `k`, weighted.
+#[inline(always)]
+fn conv(
+    x: &[f64],
+    xs: usize,
+    y: &[f64],
+    ys: usize,
+    k: usize,
+    lo: usize,
+    weight: impl Fn(usize) -> f64,
+) -> f64 {
+    let mut sum = 0.0;
+    for j in lo..=k {
+        sum += weight(j) * x[xs + j] * y[ys + k - j];
+    }
+    sum
+}
+
+/// Coefficient `k` of `log a` (`a` at `a_at` in `a_series`), its earlier
+/// coefficients at `out` in `log_series`: `a l' = a'`.
+fn log_coefficient(a_series: &[f64], a_at: usize, log_series: &[f64], out: usize, k: usize) -> f64 {
+    let a0 = a_series[a_at];
+    if k == 0 {
+        return a0.ln();
+    }
+    let mut sum = 0.0;
+    for j in 1..k {
+        sum += j as f64 * log_series[out + j] * a_series[a_at + k - j];
+    }
+    (a_series[a_at + k] - sum / k as f64) / a0
+}
+
+/// Coefficient `k` of `sqrt(w)`, `w_j` given by `w`, the root's earlier
+/// coefficients at `out` in `root`: `s^2 = w`.
+fn sqrt_coefficient(w: impl Fn(usize) -> f64, root: &[f64], out: usize, k: usize) -> f64 {
+    if k == 0 {
+        return w(0).sqrt();
+    }
+    let mut sum = 0.0;
+    for j in 1..k {
+        sum += root[out + j] * root[out + k - j];
+    }
+    (w(k) - sum) / (2.0 * root[out])
+}
+
+/// Whether register `r` of `tape` is a constant.
+fn constant(tape: &Tape, r: u32) -> bool {
+    matches!(tape.ops[r as usize], Op::Const(_))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::models::automaton::expr::parse::parse;
+    use crate::models::automaton::expr::tape::Scope;
+
+    fn tape(texts: &[&str], inputs: &[&str]) -> Tape {
+        let scope = Scope {
+            inputs: inputs.iter().map(|s| s.to_string()).collect(),
+            constants: vec![("c".into(), 0.3)],
+        };
+        let asts: Vec<_> = texts.iter().map(|t| parse(t).unwrap()).collect();
+        Tape::compile(&asts.iter().collect::<Vec<_>>(), &scope).unwrap()
+    }
+
+    fn factorial(k: usize) -> f64 {
+        (1..=k).map(|i| i as f64).product()
+    }
+
+    /// x' = v, v' = -x from (1, 0): x = cos t, v = -sin t.
+    #[test]
+    fn the_harmonic_oscillator_expands_to_cosine_and_sine() {
+        let t = tape(&["v", "-x"], &["x", "v"]);
+        let order = 20;
+        let mut out = vec![0.0; 2 * (order + 1)];
+        Series::default().flow(&t, &[1.0, 0.0], order, &mut out);
+        for k in 0..=order {
+            let cos = if k % 2 == 0 {
+                (-1f64).powi(k as i32 / 2) / factorial(k)
+            } else {
+                0.0
+            };
+            let minus_sin = if k % 2 == 1 {
+                -(-1f64).powi((k as i32 - 1) / 2) / factorial(k)
+            } else {
+                0.0
+            };
+            // Each order divides once more: a few ulps by order 20.
+            assert!((out[k] - cos).abs() <= 1e-15 * cos.abs(), "x_{k}");
+            assert!(
+                (out[order + 1 + k] - minus_sin).abs() <= 1e-15 * minus_sin.abs(),
+                "v_{k}"
+            );
+        }
+    }
+
+    /// x' = x^2 from 1 is 1 / (1 - t): every coefficient 1; x' = -x^1.5
+    /// from 1 is (1 + t/2)^-2.
+    #[test]
+    fn nonlinear_flows_expand_to_their_closed_forms() {
+        let order = 15;
+        let mut out = vec![0.0; order + 1];
+        Series::default().flow(&tape(&["x^2"], &["x"]), &[1.0], order, &mut out);
+        assert!(out.iter().all(|&c| (c - 1.0).abs() < 1e-15), "{out:?}");
+        Series::default().flow(&tape(&["-x^1.5"], &["x"]), &[1.0], order, &mut out);
+        // (1 + t/2)^-2 = sum (k + 1) (-1/2)^k t^k.
+        for (k, &c) in out.iter().enumerate() {
+            let want = (k + 1) as f64 * (-0.5f64).powi(k as i32);
+            assert!((c - want).abs() < 1e-14 * want.abs(), "{k}: {c} vs {want}");
+        }
+    }
+
+    /// Every function of a moving argument: the series summed at a small
+    /// time equals the function evaluated there, to the size of the first
+    /// term left out.
+    #[test]
+    fn every_function_composes_with_a_moving_argument() {
+        let texts = [
+            "sin(x)",
+            "cos(x)",
+            "tan(x)",
+            "sinh(x)",
+            "cosh(x)",
+            "tanh(x)",
+            "exp(x)",
+            "log(x)",
+            "sqrt(x)",
+            "asin(x - 0.3)",
+            "acos(x - 0.3)",
+            "atan(x)",
+            "abs(x - 2)",
+            "x^c",
+            "x^y",
+            "x / y",
+            "x * y - y",
+            "atan2(x, y)",
+            "atan2(y, -x)",
+            "hypot(x, y)",
+            "min(x, y)",
+            "max(x, y)",
+            "pow(x, 3) - x^-2",
+        ];
+        // x(t) = 0.7 + 0.4 t - 0.3 t^2, y(t) = 1.1 - 0.2 t + 0.5 t^3.
+        let order = 24;
+        let w = order + 1;
+        let mut inputs = vec![0.0; 2 * w];
+        inputs[..3].copy_from_slice(&[0.7, 0.4, -0.3]);
+        inputs[w..w + 4].copy_from_slice(&[1.1, -0.2, 0.0, 0.5]);
+        let s = 0.05;
+        let (x, y) = (0.7 + 0.4 * s - 0.3 * s * s, 1.1 - 0.2 * s + 0.5 * s * s * s);
+        for text in texts {
+            let t = tape(&[text], &["x", "y"]);
+            let mut out = vec![0.0; w];
+            Series::default().compose(&t, &inputs, order, &mut out);
+            let summed = out.iter().rev().fold(0.0, |acc, c| acc * s + c);
+            let mut direct = [0.0];
+            t.eval(&[x, y], &mut vec![0.0; t.registers()], &mut direct);
+            assert!(
+                (summed - direct[0]).abs() < 1e-14 * direct[0].abs().max(1.0),
+                "{text}: {summed} vs {}",
+                direct[0]
+            );
+        }
+    }
+}
