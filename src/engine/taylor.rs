@@ -191,11 +191,14 @@ impl Taylor {
 }
 
 /// The order for `tolerances`: `ceil(-ln(eps) / 2) + 1`, `eps = min(rtol,
-/// atol)`, at least 2 and at most 60.
+/// atol)`, at least 2 and at most [`MAX_ORDER`].
 pub fn order_for(tolerances: Tolerances) -> usize {
     let eps = tolerances.rtol.min(tolerances.atol).max(f64::MIN_POSITIVE);
-    ((-eps.ln() / 2.0).ceil() as usize + 1).clamp(2, 60)
+    ((-eps.ln() / 2.0).ceil() as usize + 1).clamp(2, MAX_ORDER)
 }
+
+/// The highest order taken (tolerances down to 1e-51).
+pub const MAX_ORDER: usize = 60;
 
 /// The first fall of `c` through zero on `[0, h]` (see [`first_fall`]),
 /// and the margin: for a crossing that curves back, the depth its dip
@@ -213,10 +216,14 @@ fn falls(
     if lowest(c, h) > uncertainty {
         return Ok((None, f64::INFINITY));
     }
+    // Series are at most MAX_ORDER + 1 long: scratch on the stack.
+    let n = c.len();
+    let mut scratch = [0.0; MAX_ORDER + 1];
     let from = if !check_start && c[0] <= 0.0 {
         // Already past zero: it must come back up before it can cross.
-        let back: Vec<f64> = c.iter().map(|x| -x).collect();
-        match first_fall(&back, 0.0, h)? {
+        let back = &mut scratch[..n];
+        back.iter_mut().zip(c).for_each(|(b, x)| *b = -x);
+        match first_fall(back, 0.0, h)? {
             Some(up) => up,
             None => return Ok((None, f64::INFINITY)),
         }
@@ -226,26 +233,27 @@ fn falls(
     let crossing = first_fall(c, from, h)?;
     let end = crossing.unwrap_or(h);
     let mut margin = f64::INFINITY;
-    let slope: Vec<f64> = c
-        .iter()
-        .enumerate()
-        .skip(1)
-        .map(|(k, x)| k as f64 * x)
-        .collect();
+    let slope = &mut scratch[..n - 1];
+    for (k, d) in slope.iter_mut().enumerate() {
+        *d = (k + 1) as f64 * c[k + 1];
+    }
     // Turning points (the slope rising through zero) before the crossing,
-    // unless the guard falls all the way there.
-    let falling_throughout = slope
-        .iter()
-        .skip(1)
-        .rev()
-        .fold(0.0, |acc, d| (acc + d.max(0.0)) * end)
-        + slope.first().copied().unwrap_or(0.0)
-        < 0.0;
+    // unless the guard stays clear of zero or falls all the way there.
+    let near = lowest(c, end) <= uncertainty;
+    let falling_throughout = !near
+        || slope
+            .iter()
+            .skip(1)
+            .rev()
+            .fold(0.0, |acc, d| (acc + d.max(0.0)) * end)
+            + slope.first().copied().unwrap_or(0.0)
+            < 0.0;
     if !falling_throughout {
-        let minus_slope: Vec<f64> = slope.iter().map(|x| -x).collect();
+        slope.iter_mut().for_each(|d| *d = -*d);
+        let minus_slope = &*slope;
         let mut at = from;
         for _ in 0..8 {
-            match first_fall(&minus_slope, at, end)? {
+            match first_fall(minus_slope, at, end)? {
                 // A guard already rising where the search starts is not at a
                 // turning point there.
                 Some(turn) if turn > at => {
@@ -271,13 +279,14 @@ fn falls(
     Ok((crossing, margin))
 }
 
-/// A lower bound of `sum c_k s^k` on `[0, h]`: `c_0 - sum_{k >= 1} |c_k| h^k`.
+/// A lower bound of `sum c_k s^k` on `[0, h]`: `c_0 + sum_{k >= 1}
+/// min(0, c_k) h^k` (the terms that can pull it down, at their largest).
 fn lowest(c: &[f64], h: f64) -> f64 {
-    c[0] - c
+    c[0] + c
         .iter()
         .skip(1)
         .rev()
-        .fold(0.0, |acc, x| (acc + x.abs()) * h)
+        .fold(0.0, |acc, x| (acc + x.min(0.0)) * h)
         * (1.0 + 1e-12)
 }
 

@@ -1,0 +1,124 @@
+//! Automata defined in JSON: the bundled mechanism (`models/automata/
+//! mechanism.json`) run by Taylor's method, against the closed form and
+//! against the built-in exact model, measured in the same run.
+//!
+//! `cargo bench --bench automata` prints:
+//! - accuracy of `taylor` at its default tolerance (machine epsilon) after
+//!   10^4 and 10^6 impacts (eta 1.2, from strain 0.5 at rest), against the
+//!   closed form as `benches/mechanism.rs` computes it (whose own rounding,
+//!   `t mod T_imp` in doubles, is about 1e-11 at 10^6 impacts);
+//! - impacts per second, medians of 5 runs, on heyoka's case (eta 0.8,
+//!   H0 0.1, starting at an impact, to t = 10^5: 43,468 impacts) for
+//!   `taylor` and for the built-in exact model, and their ratio.
+//!
+//! heyoka itself is timed beside it by `benches/peers/heyoka_mechanism.py`.
+
+use std::time::Instant;
+
+use serde_json::{Value, json};
+
+use flicker::models::mechanism::{ExactOrbit, Mechanism};
+use flicker::runner::Control;
+use flicker::scene::Registry;
+
+mod timing;
+
+use timing::median_of;
+
+/// The bundled automaton with `parameters`, `initial` and `t_end` replaced,
+/// run by `method`: (strain, rate, largest energy error, impacts).
+fn run(parameters: Value, initial: Value, t_end: f64, method: &str) -> (f64, f64, f64, u64) {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/models/automata/mechanism.json"
+    );
+    let mut scene: Value = serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    scene["parameters"] = parameters;
+    scene["initial"] = initial;
+    scene["t_end"] = json!(t_end);
+    scene["solver"] = json!({"method": method});
+    let scene = Registry::builtin().from_value(&scene).unwrap();
+    let report = scene.run(&Control::default(), &mut ()).unwrap();
+    let o = report.outcome;
+    assert_eq!(o.status.as_str(), "completed", "{:?}", o.reason);
+    (
+        o.final_state[0],
+        o.final_state[1],
+        o.max_energy_error.unwrap(),
+        o.events,
+    )
+}
+
+fn main() {
+    let m = Mechanism {
+        eta: 1.2,
+        omega: 1.0,
+    };
+    let (eps0, rate0) = (0.5, 0.0);
+    println!(
+        "taylor at machine precision against the closed form (eta 1.2, from strain 0.5 at rest)"
+    );
+    for impacts in [10_000u64, 1_000_000] {
+        let exact = ExactOrbit::new(m, eps0, rate0);
+        let period = m.impact_period(m.energy(eps0, rate0));
+        let t_end = m.time_to_closing(eps0, rate0).unwrap() + (impacts as f64 - 0.63) * period;
+        let start = Instant::now();
+        let (eps, rate, energy, events) = run(
+            json!({"eta": 1.2, "omega": 1.0}),
+            json!({"strain": eps0, "strain_rate": rate0}),
+            t_end,
+            "taylor",
+        );
+        let seconds = start.elapsed().as_secs_f64();
+        let (e, r) = exact.state_at(t_end);
+        println!(
+            "  {impacts:>8} impacts: count {events} (exact {}), |d eps| {:.1e}, |d eps'| {:.1e}, energy {:.1e}, {seconds:.3} s",
+            exact.impacts_until(t_end),
+            (eps - e).abs(),
+            (rate - r).abs(),
+            energy
+        );
+    }
+
+    println!();
+    println!("heyoka's case (eta 0.8, H0 0.1, from an impact, t = 1e5), medians of 5");
+    let parameters = json!({"eta": 0.8, "omega": 1.0});
+    let initial = json!({"strain": 0.0, "strain_rate": "omega * sqrt(2 * 0.1)"});
+    let m = Mechanism {
+        eta: 0.8,
+        omega: 1.0,
+    };
+    let v0 = (2.0f64 * 0.1).sqrt();
+    let exact = ExactOrbit::new(m, 0.0, v0);
+    let mut last = (0.0, 0.0);
+    let (taylor, impacts) = median_of(5, || {
+        let (e, r, _, n) = run(parameters.clone(), initial.clone(), 1e5, "taylor");
+        last = (e, r);
+        n
+    });
+    let (e, r) = exact.state_at(1e5);
+    println!(
+        "  taylor (order 20)   {impacts} impacts in {taylor:.4} s: {:.0} impacts/s, |d eps| {:.1e}, |d eps'| {:.1e}",
+        impacts as f64 / taylor,
+        (last.0 - e).abs(),
+        (last.1 - r).abs()
+    );
+    let builtin = Registry::builtin()
+        .from_value(
+            &json!({"model": "mechanism", "formulation": "strain", "eta": 0.8,
+            "initial": {"energy": 0.1, "phase": "impact"}, "t_end": 1e5}),
+        )
+        .unwrap();
+    let (exact_seconds, exact_impacts) = median_of(5, || {
+        builtin
+            .run(&Control::default(), &mut ())
+            .unwrap()
+            .outcome
+            .events
+    });
+    println!(
+        "  built-in exact      {exact_impacts} impacts in {exact_seconds:.4} s: {:.0} impacts/s ({:.1}x taylor's speed)",
+        exact_impacts as f64 / exact_seconds,
+        taylor / exact_seconds
+    );
+}
