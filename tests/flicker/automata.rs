@@ -114,6 +114,55 @@ fn bouncing_ball_bounces_at_the_closed_form_times_and_piles_up_at_its_zeno_point
     }
 }
 
+/// A sweep over `parameters.e` and `initial.y` (`models/sweeps/
+/// ball_bounces.json`): each point's first bounce at `sqrt(2 y / g)` to 1e-14,
+/// and its run stopped at the accumulation `sqrt(2 y / g) (1 + e) / (1 - e)`
+/// to within the propagator's resolution (see the test above).
+#[test]
+fn a_sweep_over_parameters_and_initial_values_follows_the_closed_form() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("sweep.csv");
+    let result = flicker(&[
+        "sweep",
+        &format!(
+            "{}/models/sweeps/ball_bounces.json",
+            env!("CARGO_MANIFEST_DIR")
+        ),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(
+        result.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&result.stderr)
+    );
+    let mut reader = csv::Reader::from_path(&out).unwrap();
+    let header = reader.headers().unwrap().clone();
+    let column = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let mut rows = 0;
+    for record in reader.records() {
+        let record = record.unwrap();
+        let number = |name: &str| record[column(name)].parse::<f64>().unwrap();
+        let (e, y) = (number("parameters.e"), number("initial.y"));
+        let t1 = (2.0 * y / 9.81).sqrt();
+        assert!((number("first_impact") - t1).abs() < 1e-14, "{record:?}");
+        let zeno = t1 * (1.0 + e) / (1.0 - e);
+        // The propagator takes a rise below 1e-10 of the drop for resting
+        // contact: the bounce speed is then at most sqrt(2 g 1e-10 y), and
+        // the flights still to come last 2 v / (g (1 - e)) in all.
+        let unresolved = 2.0 * (2.0 * 9.81 * 1e-10 * y).sqrt() / (9.81 * (1.0 - e));
+        let stopped = number("t_reached");
+        assert!(
+            stopped <= zeno && zeno - stopped < unresolved,
+            "e {e}, y {y}: {stopped} vs {zeno}"
+        );
+        assert!(record[column("status")].starts_with("zeno"));
+        rows += 1;
+    }
+    assert_eq!(rows, 15);
+}
+
 /// A terminal transition ends the run there, `completed`, at the closed-form
 /// time of the first bounce.
 #[test]
