@@ -216,7 +216,7 @@ pub fn dispatch(cli: Cli, registry: &Registry) -> Result<Code, Failure> {
         }
         Command::Plot {
             what: Some(what), ..
-        } => plot::plot(what),
+        } => plot::plot(what, registry),
         Command::Plot {
             what: None,
             dir: Some(dir),

@@ -1,20 +1,37 @@
-//! `flicker plot phase`: phase portraits of the mechanism, level sets and
-//! simulated trajectories together.
+//! `flicker plot`: phase portraits of the mechanism (level sets and
+//! simulated trajectories together), any two states of a scene's run, and
+//! the pictures of what a run wrote.
 
 use std::path::{Path, PathBuf};
 
 use crate::models::mechanism::Mechanism;
 use crate::plot::phase::{Plane, Portrait};
+use crate::plot::plane::{DEFAULT_SAMPLES, state_plane};
+use crate::runner::Control;
+use crate::scene::Registry;
 
 use crate::cli::exit::{Code, Failure};
 
 /// `flicker plot`'s pictures.
 #[derive(Debug, clap::Subcommand)]
 pub enum PlotCommand {
-    /// A phase portrait of the mechanism (the paper's Figs. 3-9).
+    /// A phase plane: with a scene, any two of its states against each
+    /// other along its run (`--x`, `--y`); with `--eta`, the mechanism's
+    /// portrait (the paper's Figs. 3-9).
     Phase {
+        /// A scene to run and draw (an automaton: any two of its states).
+        scene: Option<PathBuf>,
+        /// The state on the horizontal axis (with a scene).
+        #[arg(long, requires = "scene")]
+        x: Option<String>,
+        /// The state on the vertical axis (with a scene).
+        #[arg(long, requires = "scene")]
+        y: Option<String>,
+        /// Sample times along the run (with a scene).
+        #[arg(long, default_value_t = DEFAULT_SAMPLES, requires = "scene")]
+        samples: usize,
         /// Load ratio F / F_cr.
-        #[arg(long, allow_negative_numbers = true)]
+        #[arg(long, allow_negative_numbers = true, conflicts_with = "scene")]
         eta: Option<f64>,
         /// sqrt(k / m).
         #[arg(long, default_value_t = 1.0)]
@@ -40,17 +57,23 @@ pub fn plot_dir(dir: &Path) -> Result<Code, Failure> {
     Ok(Code::Ok)
 }
 
-/// Run `flicker plot phase`: check the parameters, draw the phase
-/// portrait into its file, and print how well the level sets and the
-/// simulated trajectories agree.
-pub fn plot(command: PlotCommand) -> Result<Code, Failure> {
+/// Run `flicker plot phase`: check the parameters, draw the phase plane
+/// into its file, and say what it shows.
+pub fn plot(command: PlotCommand, registry: &Registry) -> Result<Code, Failure> {
     let PlotCommand::Phase {
+        scene,
+        x,
+        y,
+        samples,
         eta,
         omega,
         plane,
         f1,
         out,
     } = command;
+    if let Some(scene) = scene {
+        return scene_plane(registry, &scene, x, y, samples, &out);
+    }
     let finite = |name: &str, x: f64| {
         if x.is_finite() {
             Ok(x)
@@ -94,5 +117,46 @@ pub fn plot(command: PlotCommand) -> Result<Code, Failure> {
         out.display(),
         portrait.largest_mismatch()
     );
+    Ok(Code::Ok)
+}
+
+/// `flicker plot phase SCENE --x A --y B`: run the scene and draw `B`
+/// against `A`.
+fn scene_plane(
+    registry: &Registry,
+    path: &Path,
+    x: Option<String>,
+    y: Option<String>,
+    samples: usize,
+    out: &Path,
+) -> Result<Code, Failure> {
+    let scene = registry.load(path).map_err(Failure::bad_input)?;
+    let (Some(x), Some(y)) = (x, y) else {
+        return Err(Failure::bad_input(
+            "plot phase SCENE: name the two states to draw with --x and --y",
+        ));
+    };
+    let control = Control {
+        stop: Some(crate::cli::setup::stop_flag()),
+        max_wall_seconds: None,
+    };
+    let (figure, report) = state_plane(&scene, &x, &y, samples, &control)
+        .map_err(|e| Failure::bad_input(format!("{}: {e}", path.display())))?;
+    figure
+        .draw(out)
+        .map_err(|e| Failure::untrusted(format!("{}: {e}", out.display())))?;
+    let o = &report.outcome;
+    say!(
+        "wrote {} ({} {} at t = {} with {} events, method {})",
+        out.display(),
+        scene.model(),
+        o.status.as_str(),
+        o.t_reached,
+        o.events,
+        report.method
+    );
+    if let Some(reason) = &o.reason {
+        say!("  reason: {reason}");
+    }
     Ok(Code::Ok)
 }

@@ -6,14 +6,14 @@ use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
 
-use crate::engine::{Method, Status};
+use crate::engine::Status;
 use crate::log::JsonlWriter;
 use crate::log::field_files;
 use crate::log::summary::{summary, write_atomically};
-use crate::runner::ensemble::{check as check_ensemble, run_ensemble};
+use crate::runner::ensemble::EnsembleRequest;
 use crate::runner::{Control, Report};
 use crate::scene::solver::SolverSpec;
-use crate::scene::{ChainScene, Registry, Scene};
+use crate::scene::{Registry, Scene};
 
 use crate::cli::exit::{Code, Failure};
 use crate::cli::progress::WithProgress;
@@ -50,15 +50,16 @@ pub struct RunArgs {
     ensemble: EnsembleFlags,
 }
 
-/// A chain scene's reproducibility horizon.
+/// A scene's reproducibility horizon.
 #[derive(Debug, clap::Args)]
 pub struct EnsembleFlags {
-    /// Also run K copies with perturbed initial strains (chain scenes, exact
-    /// flow) and report when their unit strains part (the horizon) and how
-    /// far the coarse fields spread, in the summary and ensemble.csv.
+    /// Also run K copies with perturbed initial values (chain scenes with
+    /// the exact flow, automata) and report when they part (the horizon)
+    /// and how far they spread, in the summary and ensemble.csv.
     #[arg(long, value_name = "K")]
     ensemble: Option<usize>,
-    /// Relative perturbation of each unit's initial strain.
+    /// Relative perturbation of each initial value (a chain's unit strains,
+    /// an automaton's states).
     #[arg(long, value_name = "P", default_value_t = 1e-12, requires = "ensemble")]
     perturb: f64,
     /// Seed of the perturbations (the same seed gives the same ensemble).
@@ -122,22 +123,18 @@ pub fn run(args: RunArgs, registry: &Registry) -> Result<Code, Failure> {
             ))
         })?;
     }
-    // Ensembles are the chain's (a tool for one kind: asked for by name).
-    let chain = scene
-        .downcast_ref::<ChainScene>()
-        .filter(|c| matches!(c.method, Method::Auto | Method::Exact));
-    let ensemble_scene = match (chain, ensemble.ensemble) {
-        (_, None) => None,
-        (Some(c), Some(copies)) => {
-            check_ensemble(c, copies, ensemble.perturb)
+    let ensemble = match ensemble.ensemble {
+        None => None,
+        Some(copies) => {
+            let request = EnsembleRequest {
+                copies,
+                perturb: ensemble.perturb,
+                seed: ensemble.seed,
+            };
+            scene
+                .check_ensemble(&request)
                 .map_err(|e| Failure::bad_input(format!("--ensemble: {}", e.reason)))?;
-            Some(c.clone())
-        }
-        _ => {
-            return Err(Failure::bad_input(format!(
-                "--ensemble: {} is not a chain scene run with the exact flow",
-                scene_path.display()
-            )));
+            Some(request)
         }
     };
     let out = out.unwrap_or_else(|| default_out(scene_path));
@@ -200,18 +197,18 @@ pub fn run(args: RunArgs, registry: &Registry) -> Result<Code, Failure> {
     // The copies run only after a run that completed: an interrupted or
     // failed run says so by itself.
     let completed = report.outcome.status == Status::Completed;
-    if let (Some(chain), Some(copies), true) = (&ensemble_scene, ensemble.ensemble, completed) {
+    if let (Some(request), true) = (&ensemble, completed) {
         let path = out.join("ensemble.csv");
-        let found = run_ensemble(chain, copies, ensemble.perturb, ensemble.seed, &control)
-            .and_then(|found| {
-                field_files::write_ensemble(&found, &path)
-                    .map(|()| found)
-                    .map_err(|e| format!("{}: cannot be written: {e}", path.display()))
-            });
+        let found = scene.ensemble(request, &control).and_then(|found| {
+            found
+                .write_csv(&path)
+                .map(|()| found)
+                .map_err(|e| format!("{}: cannot be written: {e}", path.display()))
+        });
         match found {
             Ok(found) => {
                 written.push(path);
-                summary["ensemble"] = field_files::ensemble_summary(&found);
+                summary["ensemble"] = found.summary.clone();
                 horizon = Some(found);
             }
             Err(why) => {
@@ -235,26 +232,9 @@ pub fn run(args: RunArgs, registry: &Registry) -> Result<Code, Failure> {
         let names: Vec<String> = drawn.iter().map(|p| p.display().to_string()).collect();
         say!("  drew {}", names.join(", "));
     }
-    if let Some(e) = horizon {
-        let last = e.spread.last().copied();
-        say!(
-            "  ensemble of {} copies (perturbation {:e}, seed {}): unit strains part by more than 1e-3 {}",
-            e.copies,
-            e.perturb,
-            e.seed,
-            e.horizon.map_or("nowhere before t_end".to_string(), |h| format!(
-                "at t = {h} (to within {:.3e}); unit-level results after that are not reproducible",
-                e.resolution
-            ))
-        );
-        if let Some(s) = last {
-            say!(
-                "  spread at the end: window strain {:.2e}, window velocity {:.2e}, hidden energy {:.2e}, right end {:.2e}",
-                s.window_strain,
-                s.window_velocity,
-                s.hidden_energy,
-                s.right_end
-            );
+    if let Some(found) = horizon {
+        for line in &found.said {
+            say!("  {line}");
         }
     }
     if let Some(why) = ensemble_failed {

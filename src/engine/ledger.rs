@@ -45,6 +45,11 @@ pub(crate) struct Ledger<'o> {
     /// Set once the run has settled a Zeno accumulation and gone on.
     zeno_reason: Option<String>,
     energy_initial: Option<f64>,
+    /// What the energy should be now: the initial energy, moved by each
+    /// reset's change where resets may change it.
+    energy_reference: Option<f64>,
+    /// Whether a reset's change of energy moves the reference.
+    rebase_at_resets: bool,
     energy_scale: f64,
     max_energy_error: Option<f64>,
 }
@@ -65,9 +70,21 @@ impl<'o> Ledger<'o> {
             settles: 0,
             zeno_reason: None,
             energy_initial,
+            energy_reference: energy_initial,
+            rebase_at_resets: false,
             energy_scale,
             max_energy_error: energy_initial.map(|_| 0.0),
         }
+    }
+
+    /// Audit the energy along the flows only: each logged reset's change of
+    /// energy moves the reference (for a model whose resets may change the
+    /// energy, [`HybridModel::resets_keep_energy`]).
+    ///
+    /// [`HybridModel::resets_keep_energy`]: crate::engine::HybridModel::resets_keep_energy
+    pub fn rebase_at_resets(mut self) -> Self {
+        self.rebase_at_resets = true;
+        self
     }
 
     pub fn t_end(&self) -> f64 {
@@ -187,6 +204,15 @@ impl<'o> Ledger<'o> {
         self.events += 1;
         event.seq = self.events;
         self.audit(event.energy_before);
+        if self.rebase_at_resets
+            && let (Some(before), Some(after), Some(reference)) = (
+                event.energy_before,
+                event.energy_after,
+                self.energy_reference.as_mut(),
+            )
+        {
+            *reference += after - before;
+        }
         self.audit(event.energy_after);
         observer
             .on_event(&event)
@@ -196,9 +222,11 @@ impl<'o> Ledger<'o> {
     /// Audit one value of the energy.
     #[inline]
     pub fn audit(&mut self, energy: Option<f64>) {
-        if let (Some(e), Some(e0), Some(max)) =
-            (energy, self.energy_initial, self.max_energy_error.as_mut())
-        {
+        if let (Some(e), Some(e0), Some(max)) = (
+            energy,
+            self.energy_reference,
+            self.max_energy_error.as_mut(),
+        ) {
             *max = max.max((e - e0).abs() / self.energy_scale);
         }
     }

@@ -258,6 +258,14 @@ pub trait HybridModel {
         None
     }
 
+    /// Whether every reset keeps the energy (an elastic impact, a change of
+    /// chart). A model whose resets may change it (a restitution below
+    /// one) says no: its energy is then audited along the flows, each
+    /// reset's change, which the log shows, moving what it is held to.
+    fn resets_keep_energy(&self) -> bool {
+        true
+    }
+
     /// The scale that relative energy errors are measured against, given
     /// the initial energy.
     fn energy_scale(&self, initial_energy: f64) -> f64 {

@@ -95,7 +95,9 @@ pub struct Outcome {
     pub energy_initial: Option<f64>,
     /// The model's energy at the end, if it has one.
     pub energy_final: Option<f64>,
-    /// Largest `|E - E(0)| / scale` seen at any event and at the end.
+    /// Largest `|E - E(0)| / scale` seen at any event and at the end
+    /// (`E(0)` moved by each reset's change where resets may change the
+    /// energy).
     pub max_energy_error: Option<f64>,
     /// The mode the run ended in.
     pub final_mode: Mode,

@@ -33,7 +33,10 @@
 //!   wherever the source computes it (at each event for the whole-state
 //!   path; at logged events and samples for the event-local one, whose
 //!   energy is a sum over the whole model) and at the end; the largest
-//!   relative error is the outcome's `max_energy_error`.
+//!   relative error is the outcome's `max_energy_error`. Where the model's
+//!   resets may change the energy (`HybridModel::resets_keep_energy`), each
+//!   logged reset's change moves what the energy is held to, so the audit
+//!   measures the flows.
 //! - **Counts.** Non-internal events are counted per guard, settlings
 //!   apart; the outcome reports them by guard name.
 //!

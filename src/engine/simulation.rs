@@ -86,6 +86,9 @@ pub fn simulate_sampled<M: HybridModel + ?Sized, O: Observer + ?Sized>(
     let energy_initial = model.energy(mode, &x0);
     let energy_scale = energy_initial.map_or(1.0, |e| model.energy_scale(e));
     let mut ledger = Ledger::new(options, energy_initial, energy_scale);
+    if !model.resets_keep_energy() {
+        ledger = ledger.rebase_at_resets();
+    }
     let mut run = Run::new(model, mode, &x0, options, on_sample);
     let end = match refused {
         Some(reason) => End::failed(reason),

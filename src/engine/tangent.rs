@@ -30,6 +30,22 @@ pub struct Tangents {
     a: Vec<f64>,
     b: Vec<f64>,
     c: Vec<f64>,
+    d: Vec<f64>,
+    e: Vec<f64>,
+}
+
+/// The largest `||tau J||` (row sums) of one piece of a nonlinear step's
+/// tangent.
+const PIECE_SPREAD: f64 = 0.25;
+
+/// The most pieces a step's tangent is cut into.
+const MAX_PIECES: usize = 64;
+
+/// The largest absolute row sum of a row-major `n x n` matrix.
+fn row_norm(n: usize, a: &[f64]) -> f64 {
+    (0..n)
+        .map(|i| (0..n).map(|j| a[i * n + j].abs()).sum::<f64>())
+        .fold(0.0, f64::max)
 }
 
 /// Relative step of the central differences.
@@ -52,6 +68,8 @@ impl Tangents {
             a: vec![0.0; if n <= TRACKED { n * n } else { 0 }],
             b: vec![0.0; if n <= TRACKED { n * n } else { 0 }],
             c: vec![0.0; if n <= TRACKED { n * n } else { 0 }],
+            d: vec![0.0; if n <= TRACKED { n * n } else { 0 }],
+            e: vec![0.0; if n <= TRACKED { n * n } else { 0 }],
         }
     }
 
@@ -136,13 +154,54 @@ impl Tangents {
         } else {
             // The midpoint's Jacobian: a second-order tangent (exp of the
             // Magnus expansion's first term), which is plenty for a bound
-            // and costs half the two Gauss points' differences.
+            // and costs half the two Gauss points' differences. A long step
+            // (Taylor's method takes steps of a sizeable part of a period)
+            // is cut into pieces over which the flow moves the state by at
+            // most PIECE_SPREAD of a unit's linear growth: the Jacobian then
+            // changes little over each, and the product of their
+            // exponentials follows the variational flow (a single midpoint
+            // over a whole swing misjudges its volume change, and the
+            // bound grows with every period).
             at(0.5 * tau, &mut x[..n]);
             self.jacobian(model, mode, &x[..n], &mut first);
-            for (o, j) in x.iter_mut().zip(first.iter()) {
-                *o = tau * j;
+            let spread = tau * row_norm(n, &first);
+            let pieces = if spread.is_finite() {
+                ((spread / PIECE_SPREAD).ceil() as usize).clamp(1, MAX_PIECES)
+            } else {
+                1
+            };
+            if pieces == 1 {
+                for (o, j) in x.iter_mut().zip(first.iter()) {
+                    *o = tau * j;
+                }
+                exp(n, &x, out, &mut first, &mut second);
+            } else {
+                let mut piece = std::mem::take(&mut self.d);
+                let mut product = std::mem::take(&mut self.e);
+                let h = tau / pieces as f64;
+                for k in 0..pieces {
+                    at((k as f64 + 0.5) * h, &mut x[..n]);
+                    self.jacobian(model, mode, &x[..n], &mut first);
+                    for (o, j) in x.iter_mut().zip(first.iter()) {
+                        *o = h * j;
+                    }
+                    exp(n, &x, &mut piece, &mut first, &mut second);
+                    if k == 0 {
+                        out.copy_from_slice(&piece);
+                    } else {
+                        // out = piece * out: the later piece acts last.
+                        for i in 0..n {
+                            for j in 0..n {
+                                product[i * n + j] =
+                                    (0..n).map(|l| piece[i * n + l] * out[l * n + j]).sum();
+                            }
+                        }
+                        out.copy_from_slice(&product);
+                    }
+                }
+                self.d = piece;
+                self.e = product;
             }
-            exp(n, &x, out, &mut first, &mut second);
         }
         self.a = first;
         self.b = second;
@@ -281,9 +340,7 @@ fn exp(n: usize, a: &[f64], out: &mut [f64], term: &mut [f64], next: &mut [f64])
     if n == 2 {
         return exp2(a, out);
     }
-    let norm = (0..n)
-        .map(|i| (0..n).map(|j| a[i * n + j].abs()).sum::<f64>())
-        .fold(0.0, f64::max);
+    let norm = row_norm(n, a);
     if !norm.is_finite() {
         // No exponential to take: the bound that uses it becomes infinite.
         out.fill(f64::NAN);

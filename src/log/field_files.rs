@@ -12,15 +12,14 @@
 //!   [`CLASSICAL_MAX_UNITS`](crate::runner::CLASSICAL_MAX_UNITS) units).
 //! - `trace.csv`: columns `t,energy,momentum,right_end` at the scene's
 //!   sample times, `right_end` being the loaded end's displacement.
-//! - `ensemble.csv` (with `--ensemble`): the spread between perturbed
-//!   copies at each sample time (see [`crate::runner::ensemble`]).
+//! (`ensemble.csv`, with `--ensemble`, is the model's own:
+//! [`crate::runner::ensemble`].)
 
 use std::io;
 use std::path::Path;
 
 use serde_json::{Value, json};
 
-use crate::runner::ensemble::Ensemble;
 use crate::runner::{FieldOutputs, Profile};
 
 /// The contents of `profiles.json`.
@@ -58,65 +57,6 @@ pub fn write_trace(chain: &FieldOutputs, path: &Path) -> io::Result<()> {
     w.write_record(["t", "energy", "momentum", "right_end"])?;
     for row in &chain.trace {
         w.write_record([row.t, row.energy, row.momentum, row.right_end].map(|x| x.to_string()))?;
-    }
-    w.flush()?;
-    drop(w);
-    std::fs::rename(&tmp, path)
-}
-
-/// The ensemble's entry in `summary.json`: copies, perturbation, seed, the
-/// horizon and its resolution, and the spread of each field over time.
-pub fn ensemble_summary(e: &Ensemble) -> Value {
-    let spread: Vec<Value> = e
-        .spread
-        .iter()
-        .map(|s| {
-            json!({
-                "t": s.t,
-                "unit_strain": s.unit_strain,
-                "window_strain": s.window_strain,
-                "window_velocity": s.window_velocity,
-                "hidden_energy": s.hidden_energy,
-                "right_end": s.right_end,
-                "front": s.front,
-            })
-        })
-        .collect();
-    json!({
-        "copies": e.copies,
-        "perturb": e.perturb,
-        "seed": e.seed,
-        "horizon": e.horizon,
-        "horizon_resolution": e.resolution,
-        "spread": spread,
-    })
-}
-
-/// Write `ensemble.csv`: the spreads of [`ensemble_summary`], one row per
-/// sample time (an empty `front` while some copy has none).
-pub fn write_ensemble(e: &Ensemble, path: &Path) -> io::Result<()> {
-    let tmp = path.with_extension("csv.tmp");
-    let mut w = csv::Writer::from_path(&tmp)?;
-    w.write_record([
-        "t",
-        "unit_strain",
-        "window_strain",
-        "window_velocity",
-        "hidden_energy",
-        "right_end",
-        "front",
-    ])?;
-    for s in &e.spread {
-        let front = s.front.map_or(String::new(), |f| f.to_string());
-        w.write_record([
-            s.t.to_string(),
-            s.unit_strain.to_string(),
-            s.window_strain.to_string(),
-            s.window_velocity.to_string(),
-            s.hidden_energy.to_string(),
-            s.right_end.to_string(),
-            front,
-        ])?;
     }
     w.flush()?;
     drop(w);

@@ -1,4 +1,5 @@
-//! Pictures: phase portraits of the mechanism ([`phase`]) and what a run
+//! Pictures: phase portraits of the mechanism ([`phase`]), any two states
+//! of a run against each other ([`plane`]), and what a run
 //! wrote ([`run`], with a chain's or a continuum's own in [`fields`]), drawn
 //! with a bundled font ([`draw`]), so a machine without system fonts draws
 //! text.
@@ -6,6 +7,7 @@
 pub mod draw;
 pub mod fields;
 pub mod phase;
+pub mod plane;
 pub mod run;
 
 use std::sync::Once;

@@ -27,6 +27,21 @@ pub struct Report {
     pub fields: Option<FieldOutputs>,
 }
 
+/// A run with its state sampled along the way: what pictures of any two
+/// states are drawn from ([`SceneModel::sampled`]).
+///
+/// [`SceneModel::sampled`]: crate::scene::SceneModel::sampled
+#[derive(Debug, Clone)]
+pub struct Trajectory {
+    /// The names of the state's components.
+    pub names: Vec<&'static str>,
+    /// `(t, state)` at each sample time the run reached (the state before
+    /// an event at the same time).
+    pub samples: Vec<(f64, Vec<f64>)>,
+    /// The run itself.
+    pub report: Report,
+}
+
 /// What may stop a run from outside the scene.
 #[derive(Debug, Clone, Default)]
 pub struct Control {

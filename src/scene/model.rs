@@ -17,7 +17,8 @@ use serde_json::Value;
 
 use crate::compare::Reference;
 use crate::engine::Observer;
-use crate::runner::{Control, Report};
+use crate::runner::ensemble::{EnsembleReport, EnsembleRequest};
+use crate::runner::{Control, Report, Trajectory};
 use crate::scene::SceneError;
 use crate::scene::fields::{Fields, kind};
 use crate::scene::solver::SolverSpec;
@@ -73,12 +74,55 @@ pub trait SceneModel: fmt::Debug + Send + Sync + 'static {
         None
     }
 
+    /// The run with its state sampled at `times` (increasing, up to
+    /// `t_end`), events reported to `observer` with their states: what
+    /// `flicker plot phase SCENE` draws any two states from. `None` where
+    /// the model offers no samples of its state.
+    fn sampled(
+        &self,
+        control: &Control,
+        times: &[f64],
+        observer: &mut dyn Observer,
+    ) -> Option<Result<Trajectory, SceneError>> {
+        let _ = (control, times, observer);
+        None
+    }
+
+    /// Whether `flicker run --ensemble` can run this scene as `request`
+    /// asks, checked before anything runs.
+    fn check_ensemble(&self, request: &EnsembleRequest) -> Result<(), SceneError> {
+        let _ = request;
+        Err(SceneError::field(
+            "ensemble",
+            format!(
+                "a {} scene has no ensemble of perturbed copies",
+                self.model()
+            ),
+        ))
+    }
+
+    /// Run the perturbed copies of this scene that [`check_ensemble`]
+    /// accepted, and say how far apart they drift; an error says which copy
+    /// stopped and why.
+    ///
+    /// [`check_ensemble`]: SceneModel::check_ensemble
+    fn ensemble(
+        &self,
+        request: &EnsembleRequest,
+        control: &Control,
+    ) -> Result<EnsembleReport, String> {
+        self.check_ensemble(request).map_err(|e| e.reason)?;
+        let _ = control;
+        Err(format!("a {} scene has no ensemble", self.model()))
+    }
+
     /// A copy behind a new box (scenes are cloned per sweep point and per
     /// method compared).
     fn clone_box(&self) -> Box<dyn SceneModel>;
 
     /// The scene as `Any`, for the few tools made for one kind of model
-    /// (a chain's ensemble and advice).
+    /// (`advise` and `compare-models`, which weigh a chain against its
+    /// continua).
     fn as_any(&self) -> &dyn Any;
 }
 
@@ -135,6 +179,10 @@ impl std::ops::DerefMut for Scene {
         &mut *self.0
     }
 }
+
+/// The largest scene file read: 64 MiB (a chain of 10^6 units with its
+/// initial strains and velocities takes about 40 MB).
+pub const MAX_SCENE_BYTES: u64 = 64 << 20;
 
 /// Validates the keys of one kind of scene (all but `"model"`).
 pub type Validator = fn(Fields) -> Result<Scene, SceneError>;
@@ -266,13 +314,25 @@ impl Registry {
         self.from_value(&value)
     }
 
-    /// Read and validate the scene in `path`.
+    /// Read and validate the scene in `path` (at most [`MAX_SCENE_BYTES`]).
     pub fn load(&self, path: &std::path::Path) -> Result<Scene, SceneError> {
-        let text = std::fs::read_to_string(path).map_err(|e| SceneError {
+        use std::io::Read;
+        let refuse = |reason: String| SceneError {
             file: Some(path.to_path_buf()),
             field: None,
-            reason: format!("cannot be read: {e}"),
-        })?;
+            reason,
+        };
+        let file = std::fs::File::open(path).map_err(|e| refuse(format!("cannot be read: {e}")))?;
+        // Read one byte past the limit to tell a file at the limit from a larger one.
+        let mut text = String::new();
+        file.take(MAX_SCENE_BYTES + 1)
+            .read_to_string(&mut text)
+            .map_err(|e| refuse(format!("cannot be read: {e}")))?;
+        if text.len() as u64 > MAX_SCENE_BYTES {
+            return Err(refuse(format!(
+                "is larger than {MAX_SCENE_BYTES} bytes: too large for a scene"
+            )));
+        }
         self.parse(&text).map_err(|e| e.in_path(path))
     }
 }

@@ -10,12 +10,12 @@ use serde_json::{Value, json};
 
 use crate::support::{flicker, read_json};
 
-fn automaton(name: &str) -> String {
+pub fn automaton(name: &str) -> String {
     format!("{}/models/automata/{name}", env!("CARGO_MANIFEST_DIR"))
 }
 
 /// Run `scene` (a path) with `args`, returning the summary and the events.
-fn run(scene: &str, args: &[&str]) -> (Value, Vec<Value>) {
+pub fn run(scene: &str, args: &[&str]) -> (Value, Vec<Value>) {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().to_str().unwrap();
     let mut all = vec!["run", scene, "--out", out, "--quiet"];
@@ -36,14 +36,14 @@ fn run(scene: &str, args: &[&str]) -> (Value, Vec<Value>) {
 }
 
 /// Write `scene` to a file and run it.
-fn run_value(scene: &Value, args: &[&str]) -> (Value, Vec<Value>) {
+pub fn run_value(scene: &Value, args: &[&str]) -> (Value, Vec<Value>) {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("scene.json");
     std::fs::write(&path, scene.to_string()).unwrap();
     run(path.to_str().unwrap(), args)
 }
 
-fn f(v: &Value) -> f64 {
+pub fn f(v: &Value) -> f64 {
     v.as_f64().unwrap()
 }
 

@@ -1,6 +1,7 @@
 //! flicker's integration tests: one binary, one module per behaviour.
 
 mod automata;
+mod automata_models;
 mod bouncing_ball;
 mod chain;
 mod chain_cli;

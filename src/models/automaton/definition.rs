@@ -119,8 +119,9 @@ pub struct Definition {
     pub modes: Vec<ModeDef>,
     /// The mode the run starts in.
     pub initial_mode: usize,
-    /// The monitored energy, if any.
-    pub energy: Option<Source>,
+    /// The monitored energy, if any: one expression per mode, in the order
+    /// of `modes` (the same one for all where the file gives one).
+    pub energy: Option<Vec<Source>>,
 }
 
 impl Definition {
@@ -164,10 +165,10 @@ impl Definition {
                 )
             })
             .collect::<Result<Vec<_>, _>>()?;
-        let energy = f
-            .optional("energy")
-            .map(|v| Source::read(v, &f.path("energy")))
-            .transpose()?;
+        let energy = match f.optional("energy") {
+            None => None,
+            Some(value) => Some(energy(value, &f.path("energy"), &mode_names)?),
+        };
         Ok(Definition {
             parameters,
             states,
@@ -189,7 +190,7 @@ impl Definition {
                     }),
                 )
             })
-            .chain(self.energy.iter())
+            .chain(self.energy.iter().flatten())
     }
 
     /// Whether any expression reads the clock `t` (a forced system).
@@ -207,6 +208,31 @@ fn mentions(ast: &Ast, name: &str) -> bool {
         Ast::Binary(_, a, b) => mentions(a, name) || mentions(b, name),
         Ast::Call(_, args, _) => args.iter().any(|a| mentions(a, name)),
     }
+}
+
+/// The energy: one expression for every mode, or an object giving each
+/// mode its own (a model whose modes are charts in different coordinates).
+fn energy(value: &Value, path: &str, modes: &[&str]) -> Result<Vec<Source>, SceneError> {
+    let Value::Object(map) = value else {
+        let one = Source::read(value, path)?;
+        return Ok(vec![one; modes.len()]);
+    };
+    for key in map.keys() {
+        index_of(key, modes, "mode", &format!("{path}.{key}"))?;
+    }
+    modes
+        .iter()
+        .map(|mode| {
+            let at = format!("{path}.{mode}");
+            let value = map.get(*mode).ok_or_else(|| {
+                SceneError::field(
+                    &at,
+                    "is missing: an energy given per mode needs every mode's".into(),
+                )
+            })?;
+            Source::read(value, &at)
+        })
+        .collect()
 }
 
 fn object<'a>(value: &'a Value, path: &str) -> Result<&'a Map<String, Value>, SceneError> {

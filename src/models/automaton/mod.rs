@@ -35,7 +35,8 @@
 //!   watch recognises resting contact).
 //! - `energy`: an expression the run monitors, reported as the built-in
 //!   models' energy is (across every reset in the log, largest relative
-//!   error in the summary).
+//!   error in the summary); or an object giving every mode its own
+//!   expression, for modes that are charts in different coordinates.
 //! - The keys every scene has: `t_end`, `solver`, `max_events`,
 //!   `description`.
 //! - Expressions: numbers, names (states, parameters, `t` for time, `pi`),
@@ -49,14 +50,21 @@
 //! compiled to tapes ([`Automaton`](model::Automaton), a
 //! [`HybridModel`](crate::engine::HybridModel)), and run as any scene
 //! ([`scene`]). Without a `solver`, a run takes the exact linear propagator
-//! where every flow is affine, Dormand-Prince otherwise, and says which.
-//! `docs/automata.md` explains each bundled automaton.
+//! where every flow is affine, Taylor's method at machine precision
+//! otherwise (Dormand-Prince where a flow or guard uses `abs`, `min` or
+//! `max`, across which series do not hold), and says which.
+//! The same model is built in Rust, without JSON, by
+//! [`AutomatonBuilder`]. `docs/automata.md` explains each bundled
+//! automaton.
 
+pub mod builder;
 pub mod definition;
+pub mod ensemble;
 pub mod expr;
 pub mod model;
 pub mod scene;
 
+pub use builder::{AutomatonBuilder, TransitionBuilder};
 pub use definition::Definition;
 pub use model::Automaton;
 pub use scene::AutomatonScene;

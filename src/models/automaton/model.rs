@@ -3,7 +3,7 @@
 //! file's expressions.
 //!
 //! Each mode's rates are one tape (its subexpressions shared); each guard,
-//! each reset and the energy are tapes of their own. When an expression
+//! each reset and the energy (in each mode) are tapes of their own. When an expression
 //! reads the clock `t`, the state gains a last component `t` with rate 1,
 //! so that the flows stay autonomous as the engine wants them (the log and
 //! the summary show it as a state). What the compiled form reveals is
@@ -31,7 +31,8 @@ pub struct Automaton {
     /// Whether the last state component is the clock.
     clock: bool,
     modes: Vec<CompiledMode>,
-    energy: Option<Tape>,
+    /// The energy's tape in each mode.
+    energy: Option<Vec<Tape>>,
     initial: Vec<f64>,
     initial_mode: Mode,
 }
@@ -169,7 +170,7 @@ impl Automaton {
         let energy = definition
             .energy
             .as_ref()
-            .map(|e| compile(&[e]))
+            .map(|per_mode| per_mode.iter().map(|e| compile(&[e])).collect())
             .transpose()?;
         let mut initial = definition.initial.clone();
         if clock {
@@ -300,8 +301,14 @@ impl HybridModel for Automaton {
         self.is_terminal(mode, guard)
     }
 
-    fn energy(&self, _: Mode, x: &[f64]) -> Option<f64> {
-        self.energy.as_ref().map(|e| e.eval1(x))
+    fn energy(&self, mode: Mode, x: &[f64]) -> Option<f64> {
+        self.energy.as_ref().map(|e| e[mode].eval1(x))
+    }
+
+    /// A file's resets may take energy away (a restitution) or rewrite
+    /// it in other coordinates: its energy is audited along the flows.
+    fn resets_keep_energy(&self) -> bool {
+        false
     }
 
     fn energy_scale(&self, initial_energy: f64) -> f64 {

@@ -3,11 +3,15 @@
 
 use std::sync::Arc;
 
+use crate::compare::Reference;
 use crate::engine::integrator::{methods_for, runs};
-use crate::engine::{HybridModel, Method, Observer, Tolerances, simulate, taylor};
+use crate::engine::{
+    EventTimes, HybridModel, Method, Observer, Sample, Status, Tolerances, simulate_sampled, taylor,
+};
 use crate::models::automaton::definition::Definition;
 use crate::models::automaton::model::Automaton;
-use crate::runner::{Control, Report};
+use crate::runner::ensemble::{EnsembleReport, EnsembleRequest};
+use crate::runner::{Control, Report, Trajectory};
 use crate::scene::fields::Fields;
 use crate::scene::solver::{SolverSpec, check_steps};
 use crate::scene::{Scene, SceneError, SceneModel};
@@ -125,6 +129,43 @@ impl AutomatonScene {
             ),
             Method::Verlet { step } => (self.method, format!("Stormer-Verlet, step {step:e}")),
             Method::Exact => (self.method, "closed form".into()),
+        }
+    }
+}
+
+impl AutomatonScene {
+    /// The run, with the state at each of `times` passed to `on_sample`.
+    fn run_sampled(
+        &self,
+        control: &Control,
+        times: &[f64],
+        on_sample: &mut dyn FnMut(&Sample),
+        observer: &mut dyn Observer,
+    ) -> Report {
+        let (method, description) = self.resolved();
+        let options = control.options(self.t_end, self.max_events, method, self.tolerances);
+        let model = &*self.automaton;
+        let outcome = simulate_sampled(
+            model,
+            model.initial_mode(),
+            model.initial(),
+            &options,
+            times,
+            on_sample,
+            observer,
+        );
+        let final_state = outcome
+            .final_state_names
+            .iter()
+            .copied()
+            .zip(outcome.final_state.iter().copied())
+            .collect();
+        Report {
+            outcome,
+            method: method.name(),
+            description,
+            final_state,
+            fields: None,
         }
     }
 }
@@ -247,29 +288,93 @@ impl SceneModel for AutomatonScene {
     }
 
     fn run(&self, control: &Control, observer: &mut dyn Observer) -> Result<Report, SceneError> {
-        let (method, description) = self.resolved();
-        let options = control.options(self.t_end, self.max_events, method, self.tolerances);
-        let model = &*self.automaton;
-        let outcome = simulate(
-            model,
-            model.initial_mode(),
-            model.initial(),
-            &options,
+        Ok(self.run_sampled(control, &[], &mut |_| {}, observer))
+    }
+
+    fn sampled(
+        &self,
+        control: &Control,
+        times: &[f64],
+        observer: &mut dyn Observer,
+    ) -> Option<Result<Trajectory, SceneError>> {
+        let mut samples = Vec::with_capacity(times.len());
+        let report = self.run_sampled(
+            control,
+            times,
+            &mut |s| samples.push((s.t, s.state.to_vec())),
             observer,
         );
-        let final_state = outcome
-            .final_state_names
-            .iter()
-            .copied()
-            .zip(outcome.final_state.iter().copied())
-            .collect();
-        Ok(Report {
-            outcome,
-            method: method.name(),
-            description,
-            final_state,
-            fields: None,
-        })
+        Some(Ok(Trajectory {
+            names: self.automaton.state_names(0).to_vec(),
+            samples,
+            report,
+        }))
+    }
+
+    fn check_ensemble(&self, request: &EnsembleRequest) -> Result<(), SceneError> {
+        super::ensemble::check(self, request)
+    }
+
+    fn ensemble(
+        &self,
+        request: &EnsembleRequest,
+        control: &Control,
+    ) -> Result<EnsembleReport, String> {
+        super::ensemble::run(self, request, control)
+    }
+
+    /// The exact linear propagator where every mode is affine, else
+    /// Taylor's method at machine precision: the tightest run there is
+    /// (its own stated bounds say how far to trust it). A run that ends at
+    /// a Zeno point has events without end, as a chattering orbit.
+    fn reference(&self) -> Result<Reference, SceneError> {
+        let tightest = Tolerances {
+            rtol: taylor::DEFAULT_TOLERANCE,
+            atol: taylor::DEFAULT_TOLERANCE,
+        };
+        let modes = self.automaton.modes();
+        let (method, kind) = if self.automaton.all_linear() {
+            (Method::Linear, "the exact linear propagator")
+        } else if runs(&*self.automaton, &modes, Method::Taylor(tightest)).is_ok() {
+            (
+                Method::Taylor(tightest),
+                "Taylor's method at machine precision",
+            )
+        } else {
+            return Err(SceneError::field(
+                "modes",
+                "a flow or guard uses abs, min or max, where Taylor series do not hold: \
+                 no reference to measure methods against"
+                    .into(),
+            ));
+        };
+        let mut exact = self.clone();
+        exact.method = method;
+        let mut times = EventTimes::default();
+        let report = exact.run(&Control::default(), &mut times)?;
+        let o = report.outcome;
+        let events = match o.status {
+            Status::Completed => times.0.len() as u64,
+            Status::Zeno => u64::MAX,
+            Status::Failed | Status::Interrupted => {
+                return Err(SceneError::field(
+                    "solver",
+                    format!(
+                        "the reference run ({kind}) {} at t = {}: {}",
+                        o.status.as_str(),
+                        o.t_reached,
+                        o.reason.unwrap_or_default()
+                    ),
+                ));
+            }
+        };
+        let times = times.0;
+        Ok(Reference::new(kind, o.final_state, events, move |k| {
+            usize::try_from(k)
+                .ok()
+                .and_then(|k| times.get(k).copied())
+                .unwrap_or(f64::NAN)
+        }))
     }
 
     fn clone_box(&self) -> Box<dyn SceneModel> {

@@ -31,6 +31,7 @@ use crate::compare::Reference;
 use crate::engine::integrator::methods_for;
 use crate::engine::{Method, Observer, Tolerances};
 use crate::models::chain::Chain;
+use crate::runner::ensemble::{EnsembleReport, EnsembleRequest};
 use crate::runner::{Control, Report};
 use crate::scene::extent;
 use crate::scene::fields::Fields;
@@ -316,6 +317,18 @@ impl SceneModel for ChainScene {
              (its exact and ODE paths are checked against each other in tests/flicker/chain_exact.rs)"
                 .into(),
         ))
+    }
+
+    fn check_ensemble(&self, request: &EnsembleRequest) -> Result<(), SceneError> {
+        super::ensemble::check(self, request)
+    }
+
+    fn ensemble(
+        &self,
+        request: &EnsembleRequest,
+        control: &Control,
+    ) -> Result<EnsembleReport, String> {
+        super::ensemble::run_ensemble(self, request, control).map(|e| super::ensemble::report(&e))
     }
 
     fn clone_box(&self) -> Box<dyn SceneModel> {

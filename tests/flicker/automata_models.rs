@@ -1,0 +1,222 @@
+//! The bundled automata beyond the first three (`models/automata/`): the
+//! mechanism's angle formulation as two charts, Housner's rocking block
+//! and its linearisation, and four units of the chain, each against an
+//! answer that does not come from its own file: the strain mechanism's
+//! closed form written out in `oscillator.rs`, the rocking block's cosh
+//! and sinh solution written out here, and the built-in chain.
+
+use serde_json::{Value, json};
+
+use crate::automata::{automaton, f, run, run_value};
+use crate::oscillator::Unit;
+
+/// The angle formulation as two charts (`mechanism_charts.json`: eta 1.2,
+/// from `theta = acos(1 / 1.5)`, strain 0.5, at rest), by Taylor's method:
+/// every `impact` (theta through zero, crossed in the strain chart) at the
+/// strain model's closed-form time `t1 + k T_imp` and speed
+/// `omega sqrt(2 H0)` to 1e-9 over the first 100, and the energy, written
+/// per chart, kept to 1e-12 relative.
+#[test]
+fn the_angle_formulation_in_two_charts_agrees_with_the_strain_closed_form() {
+    let unit = Unit {
+        eta: 1.2,
+        omega: 1.0,
+    };
+    let start = (0.5, 0.0);
+    let h0 = unit.energy(start.0, start.1);
+    let (t1, period) = (unit.first_closing(start).unwrap(), unit.period_atan2(h0));
+    let (summary, events) = run(&automaton("mechanism_charts.json"), &[]);
+    assert_eq!(summary["status"], "completed", "{summary}");
+    assert_eq!(summary["method"], "taylor");
+    let impacts: Vec<&Value> = events.iter().filter(|e| e["guard"] == "impact").collect();
+    assert!(impacts.len() >= 100, "{} impacts", impacts.len());
+    for (k, e) in impacts.iter().take(100).enumerate() {
+        let t = t1 + k as f64 * period;
+        assert!(
+            (f(&e["t"]) - t).abs() < 1e-9,
+            "impact {k}: {} vs {t}",
+            e["t"]
+        );
+        let speed = unit.impact_speed(h0);
+        assert!(
+            (f(&e["before"]["strain_rate"]) + speed).abs() < 1e-9,
+            "impact {k}: rate {} vs -{speed}",
+            e["before"]["strain_rate"]
+        );
+        // theta changes side at each impact.
+        assert_eq!(f(&e["after"]["side"]), -f(&e["before"]["side"]));
+    }
+    // Between impacts the motion leaves the strain chart for the angle
+    // chart and comes back: the strain chart is entered and left at its
+    // thresholds, strain 0.01 and 0.02.
+    for e in &events {
+        match e["guard"].as_str().unwrap() {
+            "enter_strain_chart" => {
+                assert!((f(&e["after"]["strain"]) - 0.01).abs() < 1e-12, "{e}")
+            }
+            "leave_strain_chart" => {
+                assert!((f(&e["before"]["strain"]) - 0.02).abs() < 1e-12, "{e}")
+            }
+            _ => {}
+        }
+    }
+    assert!(f(&summary["max_energy_error"]) < 1e-12, "{summary}");
+}
+
+/// Housner's block linearised, `theta'' = p^2 (theta - alpha sgn theta)`,
+/// in closed form: from rest at `theta0` the first impact comes at
+/// `cosh(p t1) = alpha / (alpha - theta0)` with speed
+/// `p (alpha - theta0) sinh(p t1)`; leaving `theta = 0` at speed `w`, the
+/// block swings out and back to zero in `(2 / p) atanh(w / (p alpha))`
+/// (the flight is symmetric, and so is the other corner), and each impact
+/// keeps `r = 1 - 1.5 sin^2 alpha` of the speed. Impact times and speeds
+/// `(t_k, w_k)`, for `b`, `h`, `g` and `theta0 = alpha / 2`.
+fn linear_block(g: f64, b: f64, h: f64, impacts: usize) -> Vec<(f64, f64)> {
+    let alpha = (b / h).atan();
+    let p = (3.0 * g / (4.0 * b.hypot(h))).sqrt();
+    let r = 1.0 - 1.5 * alpha.sin().powi(2);
+    let theta0 = 0.5 * alpha;
+    let t1 = (alpha / (alpha - theta0)).acosh() / p;
+    let mut w = p * (alpha - theta0) * (p * t1).sinh();
+    let mut t = t1;
+    let mut out = Vec::new();
+    for _ in 0..impacts {
+        out.push((t, w));
+        w *= r;
+        t += 2.0 / p * (w / (p * alpha)).atanh();
+    }
+    out
+}
+
+/// `rocking_block_linear.json` runs on the exact linear propagator (both
+/// corners are affine) and meets the closed form: every impact time and
+/// speed to 1e-10, corners alternating.
+#[test]
+fn the_linearised_rocking_block_meets_its_cosh_sinh_closed_form() {
+    let (summary, events) = run(&automaton("rocking_block_linear.json"), &[]);
+    assert_eq!(summary["method"], "linear", "{summary}");
+    assert_eq!(summary["status"], "completed", "{summary}");
+    let exact = linear_block(9.81, 0.1, 1.0, events.len());
+    assert!(events.len() >= 10, "{} impacts", events.len());
+    for (k, (e, (t, w))) in events.iter().zip(&exact).enumerate() {
+        assert!(
+            (f(&e["t"]) - t).abs() < 1e-10,
+            "impact {k}: {} vs {t}",
+            e["t"]
+        );
+        assert!(
+            (f(&e["before"]["theta_rate"]).abs() - w).abs() < 1e-10,
+            "impact {k}: speed {} vs {w}",
+            e["before"]["theta_rate"]
+        );
+        let (from, to) = if k % 2 == 0 {
+            ("right", "left")
+        } else {
+            ("left", "right")
+        };
+        assert_eq!(
+            (e["mode_before"].as_str(), e["mode_after"].as_str()),
+            (Some(from), Some(to))
+        );
+    }
+}
+
+/// The nonlinear block (`sin(alpha - theta)`) against the linearised one,
+/// both from `theta0 = alpha / 2`: their equations differ by
+/// `(alpha - theta)^3 / 6 <= alpha^3 / 6` in `theta'' / p^2`, so over the
+/// first impacts their impact speeds (of order `p alpha`) differ by
+/// `O(p alpha^3)`. Checked as a law: at most `p alpha^3`, and halving alpha
+/// divides the largest difference by about 8 (between 6 and 10).
+#[test]
+fn the_rocking_block_approaches_its_linearisation_as_alpha_cubed() {
+    let (g, h) = (9.81_f64, 1.0_f64);
+    let mut differences = Vec::new();
+    for b in [0.2_f64, 0.1, 0.05] {
+        let alpha = (b / h).atan();
+        let p = (3.0 * g / (4.0 * b.hypot(h))).sqrt();
+        let mut scene: Value = serde_json::from_str(
+            &std::fs::read_to_string(automaton("rocking_block.json")).unwrap(),
+        )
+        .unwrap();
+        scene["parameters"]["b"] = json!(b);
+        let (summary, events) = run_value(&scene, &[]);
+        assert_eq!(summary["status"], "completed", "{summary}");
+        let exact = linear_block(g, b, h, 4);
+        assert!(events.len() >= 4, "b {b}: {} impacts", events.len());
+        let largest = events
+            .iter()
+            .zip(&exact)
+            .map(|(e, (_, w))| (f(&e["before"]["theta_rate"]).abs() - w).abs())
+            .fold(0.0, f64::max);
+        assert!(
+            largest < p * alpha.powi(3),
+            "b {b}: {largest} vs {}",
+            p * alpha.powi(3)
+        );
+        // Energy, written per corner, is kept along each swing: every
+        // impact takes away 1 - r^2 of the kinetic energy and nothing else
+        // changes it.
+        let r = 1.0 - 1.5 * alpha.sin().powi(2);
+        let potential = g * b.hypot(h) * alpha.cos();
+        for e in &events {
+            let (before, after) = (f(&e["energy_before"]), f(&e["energy_after"]));
+            let lost = (1.0 - r * r) * (before - potential);
+            assert!((before - after - lost).abs() < 1e-12 * before, "b {b}: {e}");
+        }
+        differences.push(largest);
+    }
+    for pair in differences.windows(2) {
+        let ratio = pair[0] / pair[1];
+        assert!(
+            (6.0..10.0).contains(&ratio),
+            "{differences:?}: ratio {ratio}"
+        );
+    }
+}
+
+/// Four units of the chain written out as an automaton (`chain4.json`: a
+/// Newton's cradle, node 1 into a packed block, then rattling) against the
+/// built-in exact chain from the same start: the same instants of impact
+/// to 1e-9 (the automaton resolves the cradle's simultaneous impacts one
+/// pair at a time by priority, several events at one instant; the chain's
+/// cascade logs one), and the same loaded end and momentum at the end.
+#[test]
+fn four_units_written_out_meet_the_built_in_chain() {
+    let (auto, events) = run(&automaton("chain4.json"), &[]);
+    assert_eq!(auto["status"], "completed", "{auto}");
+    let builtin = json!({
+        "model": "chain", "units": 4, "length": 4.0, "wave_speed": 1.0,
+        "load": {"before": 1.0, "after": 1.0}, "constraint": true,
+        "initial": {"strain": [0.5, 0.0, 0.0, 0.5], "velocity": [1.0, 0.0, 0.0, 0.0]},
+        "t_end": 20.0});
+    let (chain, chain_events) = run_value(&builtin, &[]);
+    assert_eq!(chain["status"], "completed", "{chain}");
+    let mut instants: Vec<f64> = Vec::new();
+    for e in &events {
+        let t = f(&e["t"]);
+        if instants.last().is_none_or(|last| t - last > 1e-9) {
+            instants.push(t);
+        }
+    }
+    let expected: Vec<f64> = chain_events.iter().map(|e| f(&e["t"])).collect();
+    assert!(expected.len() >= 15, "{} impacts", expected.len());
+    assert_eq!(instants.len(), expected.len(), "{instants:?}\n{expected:?}");
+    for (k, (a, b)) in instants.iter().zip(&expected).enumerate() {
+        assert!((a - b).abs() < 1e-9, "instant {k}: {a} vs {b}");
+    }
+    // At t = 0 the cradle passes node 1's speed through units 2 and 3.
+    let at_zero: Vec<&str> = events
+        .iter()
+        .take_while(|e| f(&e["t"]) == 0.0)
+        .map(|e| e["guard"].as_str().unwrap())
+        .collect();
+    assert_eq!(at_zero, ["unit2", "unit3"]);
+    let last = &auto["final_state"];
+    let momentum = ["v1", "v2", "v3", "v4"]
+        .iter()
+        .map(|v| f(&last[v]))
+        .sum::<f64>();
+    assert!((f(&last["y4"]) - f(&chain["final_state"]["right_end"])).abs() < 1e-9);
+    assert!((momentum - f(&chain["final_state"]["momentum"])).abs() < 1e-9);
+    assert!(f(&auto["max_energy_error"]) < 1e-12, "{auto}");
+}
