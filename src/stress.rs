@@ -9,7 +9,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use crate::engine::{EventTimes, Status};
+use crate::engine::{EventTimes, Status, zeno};
 use crate::runner::Control;
 use crate::scene::solver::SolverSpec;
 use crate::scene::{Registry, Scene, SceneError};
@@ -205,9 +205,13 @@ pub fn run_case(
             .zip(&reference.final_state)
             .map(|((_, a), b)| (a - b).abs())
             .fold(0.0, f64::max),
-        time_error: reference.largest_time_error(&times.0),
-        error_bound: o.error_bound,
-        event_time_bound: o.event_time_bound,
+        time_error: reference.largest_time_error(match o.status {
+            Status::Zeno => zeno::resolved(&times.0),
+            _ => &times.0,
+        }),
+        // A reference that is itself a run is off by its own bound too.
+        error_bound: o.error_bound + reference.error_bound,
+        event_time_bound: o.event_time_bound.map(|b| b + reference.event_time_bound),
     };
     Ok(Row {
         case: case.to_string(),

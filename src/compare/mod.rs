@@ -13,7 +13,7 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
-use crate::engine::{EventTimes, Status};
+use crate::engine::{EventTimes, Status, zeno};
 use crate::runner;
 use crate::scene::solver::SolverSpec;
 use crate::scene::{Scene, SceneError};
@@ -156,9 +156,15 @@ fn measure(scene: &Scene, setting: &SolverSpec, reference: &Reference) -> Result
         .zip(&reference.final_state)
         .map(|(a, b)| (a - b).abs())
         .fold(0.0, f64::max);
-    let max_event_time_error = reference.largest_time_error(&times.0);
+    let max_event_time_error = reference.largest_time_error(match o.status {
+        Status::Zeno => zeno::resolved(&times.0),
+        _ => &times.0,
+    });
     let status = match (o.status, &o.reason) {
         (Status::Failed, Some(reason)) => format!("failed: {reason}"),
+        // The run stopped at the accumulation it could no longer resolve;
+        // the exact answer counts on without end.
+        (Status::Zeno, _) if reference.events == u64::MAX => "zeno".into(),
         _ if times.0.len() as u64 != reference.events => format!(
             "events differ: {} against {} in the reference",
             times.0.len(),

@@ -15,6 +15,12 @@ pub struct Reference {
     pub final_state: Vec<f64>,
     /// Events up to the end (saturating for chattering orbits).
     pub events: u64,
+    /// How far the reference's own final state may be from the truth (0
+    /// for a closed form; a run's stated bound where the reference is the
+    /// tightest run there is).
+    pub error_bound: f64,
+    /// The same for its event times.
+    pub event_time_bound: f64,
     /// The time of event number `k` (from 0).
     event_time: Arc<dyn Fn(u64) -> f64 + Send + Sync>,
 }
@@ -32,8 +38,18 @@ impl Reference {
             kind,
             final_state,
             events,
+            error_bound: 0.0,
+            event_time_bound: 0.0,
             event_time: Arc::new(event_time),
         }
+    }
+
+    /// The reference with the bounds its own run stated on its final state
+    /// and its event times.
+    pub fn with_bounds(mut self, error_bound: f64, event_time_bound: f64) -> Self {
+        self.error_bound = error_bound;
+        self.event_time_bound = event_time_bound;
+        self
     }
 
     /// The time of event number `k` (from 0).
@@ -59,6 +75,8 @@ impl fmt::Debug for Reference {
             .field("kind", &self.kind)
             .field("final_state", &self.final_state)
             .field("events", &self.events)
+            .field("error_bound", &self.error_bound)
+            .field("event_time_bound", &self.event_time_bound)
             .finish_non_exhaustive()
     }
 }

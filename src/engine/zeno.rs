@@ -25,6 +25,13 @@ pub fn resolution(t: f64, t_end: f64) -> f64 {
     RESOLUTION * t.abs().max(t_end)
 }
 
+/// The event times of a run that stopped at a Zeno point, without the
+/// last [`REPEATS`]: those are the events the run could no longer resolve
+/// (where it stops among them is its own), and are not compared.
+pub fn resolved(times: &[f64]) -> &[f64] {
+    &times[..times.len().saturating_sub(REPEATS as usize)]
+}
+
 #[derive(Debug, Clone, Copy, Default)]
 struct Track {
     last: Option<Time>,

@@ -48,17 +48,20 @@ fn the_angle_formulation_in_two_charts_agrees_with_the_strain_closed_form() {
     }
     // Between impacts the motion leaves the strain chart for the angle
     // chart and comes back: the strain chart is entered and left at its
-    // thresholds, strain 0.01 and 0.02.
+    // thresholds, strain 0.05 and 0.1, and the energy, written in each
+    // chart's coordinates, is the same on both sides of a change.
     for e in &events {
         match e["guard"].as_str().unwrap() {
             "enter_strain_chart" => {
-                assert!((f(&e["after"]["strain"]) - 0.01).abs() < 1e-12, "{e}")
+                assert!((f(&e["after"]["strain"]) - 0.05).abs() < 1e-12, "{e}")
             }
             "leave_strain_chart" => {
-                assert!((f(&e["before"]["strain"]) - 0.02).abs() < 1e-12, "{e}")
+                assert!((f(&e["before"]["strain"]) - 0.1).abs() < 1e-12, "{e}")
             }
             _ => {}
         }
+        let (before, after) = (f(&e["energy_before"]), f(&e["energy_after"]));
+        assert!((before - after).abs() < 1e-14, "{e}");
     }
     assert!(f(&summary["max_energy_error"]) < 1e-12, "{summary}");
 }

@@ -2,6 +2,7 @@
 
 mod automata;
 mod automata_models;
+mod automata_tools;
 mod bouncing_ball;
 mod chain;
 mod chain_cli;

@@ -113,6 +113,14 @@ impl SvgChart {
         )
     }
 
+    /// The data point the chart draws at the pixel `(x, y)`.
+    pub fn value(&self, (x, y): (f64, f64)) -> (f64, f64) {
+        (
+            (x - self.x_axis.0) / self.x_axis.1,
+            (y - self.y_axis.0) / self.y_axis.1,
+        )
+    }
+
     /// The data values one pixel spans on each axis.
     pub fn pixel_size(&self) -> (f64, f64) {
         (1.0 / self.x_axis.1.abs(), 1.0 / self.y_axis.1.abs())

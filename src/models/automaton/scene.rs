@@ -5,6 +5,7 @@ use std::sync::Arc;
 
 use crate::compare::Reference;
 use crate::engine::integrator::{methods_for, runs};
+use crate::engine::zeno;
 use crate::engine::{
     EventTimes, HybridModel, Method, Observer, Sample, Status, Tolerances, simulate_sampled, taylor,
 };
@@ -325,8 +326,9 @@ impl SceneModel for AutomatonScene {
 
     /// The exact linear propagator where every mode is affine, else
     /// Taylor's method at machine precision: the tightest run there is
-    /// (its own stated bounds say how far to trust it). A run that ends at
-    /// a Zeno point has events without end, as a chattering orbit.
+    /// (its own stated bounds say how far to trust it, and come with it).
+    /// A run that ends at a Zeno point has events without end, as a
+    /// chattering orbit, and no final state to compare.
     fn reference(&self) -> Result<Reference, SceneError> {
         let tightest = Tolerances {
             rtol: taylor::DEFAULT_TOLERANCE,
@@ -353,9 +355,12 @@ impl SceneModel for AutomatonScene {
         let mut times = EventTimes::default();
         let report = exact.run(&Control::default(), &mut times)?;
         let o = report.outcome;
-        let events = match o.status {
-            Status::Completed => times.0.len() as u64,
-            Status::Zeno => u64::MAX,
+        // A run that stops at a Zeno point stops where it can no longer
+        // resolve the events, which differs from method to method: it is
+        // measured by its events, not by where it stopped.
+        let (events, final_state) = match o.status {
+            Status::Completed => (times.0.len() as u64, o.final_state),
+            Status::Zeno => (u64::MAX, Vec::new()),
             Status::Failed | Status::Interrupted => {
                 return Err(SceneError::field(
                     "solver",
@@ -368,13 +373,17 @@ impl SceneModel for AutomatonScene {
                 ));
             }
         };
-        let times = times.0;
-        Ok(Reference::new(kind, o.final_state, events, move |k| {
+        let times = match o.status {
+            Status::Zeno => zeno::resolved(&times.0).to_vec(),
+            _ => times.0,
+        };
+        let reference = Reference::new(kind, final_state, events, move |k| {
             usize::try_from(k)
                 .ok()
                 .and_then(|k| times.get(k).copied())
                 .unwrap_or(f64::NAN)
-        }))
+        });
+        Ok(reference.with_bounds(o.error_bound, o.event_time_bound.unwrap_or(0.0)))
     }
 
     fn clone_box(&self) -> Box<dyn SceneModel> {
