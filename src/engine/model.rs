@@ -290,6 +290,21 @@ pub trait HybridModel {
         Labels::NONE
     }
 
+    /// Whether a guard or a reset may be undefined somewhere (a model read
+    /// from a file, whose expressions may take a square root of a negative
+    /// number): the run then checks every guard where each stretch of flow
+    /// starts and ends, and stops at a value that is not finite.
+    fn may_be_undefined(&self) -> bool {
+        false
+    }
+
+    /// Which guard or reset value is not finite at `x` (the guard's slot,
+    /// before the reset for a reset), in a sentence naming its expression.
+    fn diagnose_guard(&self, mode: Mode, guard: usize, x: &[f64], reset: bool) -> Option<String> {
+        let _ = (mode, guard, x, reset);
+        None
+    }
+
     /// A sentence explaining why a numerical flow may fail at `x`, added to
     /// the engine's own message (e.g. a coordinate singularity).
     fn diagnose(&self, mode: Mode, x: &[f64]) -> Option<String> {

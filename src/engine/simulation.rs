@@ -165,10 +165,14 @@ impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
         self.after.copy_from_slice(&before);
         let jump = model.reset(mode, slot, &mut self.after);
         let recorded = if !all_finite(&before) || !all_finite(&self.after) {
+            let why = model
+                .diagnose_guard(mode, slot, &before, true)
+                .map_or_else(String::new, |why| format!(": {why}"));
             Err(End::failed(format!(
-                "non-finite state at the `{}` event at t = {}: before {:?}, after {:?}",
+                "non-finite state at the `{}` event at t = {} in mode `{}`: before {:?}, after {:?}{why}",
                 guard.name,
                 t.value(),
+                model.mode_name(mode),
                 before,
                 self.after
             )))
@@ -260,7 +264,7 @@ impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
         self.state.copy_from_slice(&x);
         self.before = x;
         self.origin = t;
-        Ok(())
+        self.check_guards()
     }
 }
 
@@ -415,9 +419,35 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
         self.start_segment()
     }
 
+    /// Where guards may be undefined, stop at one that is not finite at
+    /// `(origin, state)`: a crossing cannot be looked for in it.
+    fn check_guards(&self) -> Result<(), End> {
+        let (model, mode) = (self.model, self.mode);
+        if !model.may_be_undefined() {
+            return Ok(());
+        }
+        for (g, guard) in model.guards(mode).iter().enumerate() {
+            let value = model.guard(mode, g, &self.state);
+            if !value.is_finite() {
+                let why = model
+                    .diagnose_guard(mode, g, &self.state, false)
+                    .map_or_else(String::new, |why| format!(": {why}"));
+                return Err(End::failed(format!(
+                    "guard `{}` is {value} at t = {} in mode `{}` (state {:?}){why}",
+                    guard.name,
+                    self.origin.value(),
+                    model.mode_name(mode),
+                    self.state
+                )));
+            }
+        }
+        Ok(())
+    }
+
     /// Predict every guard of the current mode from `(origin, state)`; for an
     /// ODE mode this takes the next integration step.
     fn start_segment(&mut self) -> Result<(), End> {
+        self.check_guards()?;
         self.queue.clear();
         self.step_end = None;
         let (model, mode) = (self.model, self.mode);
@@ -604,8 +634,9 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
         let t = self.origin.value();
         let what = match failure {
             StepFailure::Collapsed { h } => format!(
-                "the {} step size collapsed to {h:.3e} at t = {t} (state {:?})",
+                "the step size of {} collapsed to {h:.3e} at t = {t} in mode `{}` (state {:?})",
                 self.integrator.name(),
+                self.model.mode_name(self.mode),
                 self.state
             ),
             StepFailure::NotApplicable(why) => {
@@ -616,7 +647,8 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
             }
             StepFailure::NonFinite => {
                 format!(
-                    "the right-hand side is not finite at t = {t} (state {:?})",
+                    "the right-hand side is not finite at t = {t} in mode `{}` (state {:?})",
+                    self.model.mode_name(self.mode),
                     self.state
                 )
             }

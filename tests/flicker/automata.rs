@@ -462,3 +462,72 @@ proptest! {
         let _ = flicker::scene::Registry::builtin().from_value(&ball);
     }
 }
+
+/// At run time, a value that is not finite stops the run (`failed`, exit
+/// 3) with the time, the mode and the expression that produced it: a rate
+/// (NaN below `x = 0.5`), a rate that blows up (the step size collapses
+/// near `x = 0.5`), a reset and a guard; whatever the method.
+#[test]
+fn an_undefined_value_at_run_time_stops_the_run_and_names_its_expression() {
+    let scene = |flow_x: &str, guard: &str, reset_v: &str| {
+        json!({"model": "automaton", "states": ["x", "v"], "initial": {"x": 1.0, "v": 0.0},
+               "modes": {"m": {"flow": {"x": flow_x, "v": "-1"},
+                               "transitions": [{"name": "hit", "guard": guard, "direction": "falling",
+                                                "reset": {"v": reset_v}}]}},
+               "t_end": 2.0})
+    };
+    let cases = [
+        (
+            scene("v - sqrt(x - 0.5)", "x + 10", "v"),
+            "`v - sqrt(x - 0.5)`",
+        ),
+        (scene("-1 / (x - 0.5)", "x + 10", "v"), "`-1 / (x - 0.5)`"),
+        (scene("v", "x", "log(x - 1)"), "`log(x - 1)`"),
+        (scene("v", "sqrt(x - 0.5)", "v"), "`sqrt(x - 0.5)`"),
+    ];
+    for (scene, expression) in cases {
+        for method in ["taylor", "dopri5"] {
+            let dir = tempfile::tempdir().unwrap();
+            let path = dir.path().join("scene.json");
+            std::fs::write(&path, scene.to_string()).unwrap();
+            let out = flicker(&[
+                "run",
+                path.to_str().unwrap(),
+                "--out",
+                dir.path().join("o").to_str().unwrap(),
+                "--quiet",
+                "--method",
+                method,
+            ]);
+            let err = String::from_utf8_lossy(&out.stderr);
+            assert_eq!(out.status.code(), Some(3), "{expression} {method}: {err}");
+            for want in [expression, "in mode `m`", " at t = "] {
+                assert!(err.contains(want), "{method}: no {want:?} in {err}");
+            }
+            let summary = read_json(&dir.path().join("o/summary.json"));
+            assert_eq!(summary["status"], "failed");
+        }
+    }
+}
+
+/// A scene file larger than flicker reads (64 MiB) is refused with exit
+/// 2 before it is parsed.
+#[test]
+fn a_scene_file_too_large_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("huge.json");
+    let mut file = std::fs::File::create(&path).unwrap();
+    use std::io::Write;
+    let chunk = vec![b' '; 1 << 20];
+    for _ in 0..65 {
+        file.write_all(&chunk).unwrap();
+    }
+    drop(file);
+    let out = flicker(&["check", path.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("huge.json") && err.contains("too large"),
+        "{err}"
+    );
+}

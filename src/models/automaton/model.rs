@@ -46,6 +46,9 @@ struct CompiledMode {
     rates: Vec<Option<Source>>,
     guards: Vec<Guard>,
     guard_tapes: Vec<Tape>,
+    /// Each transition's guard and reset expressions as written, for
+    /// diagnoses.
+    texts: Vec<(String, Vec<String>)>,
     resets: Vec<Reset>,
     kind: Flow,
     linear: Option<(DMatrix<f64>, DVector<f64>)>,
@@ -113,6 +116,14 @@ impl Automaton {
             let mut guards = Vec::new();
             let mut guard_tapes = Vec::new();
             let mut resets = Vec::new();
+            let texts = mode
+                .transitions
+                .iter()
+                .map(|t| {
+                    let resets = t.reset.iter().map(|(_, s)| s.text.clone()).collect();
+                    (t.guard.text.clone(), resets)
+                })
+                .collect();
             for t in &mode.transitions {
                 let tape = compile(&[&t.guard])?;
                 guards.push(Guard {
@@ -161,6 +172,7 @@ impl Automaton {
                 rates: mode.flow.clone(),
                 guards,
                 guard_tapes,
+                texts,
                 resets,
                 kind: if still { Flow::Frozen } else { Flow::Ode },
                 linear,
@@ -315,20 +327,59 @@ impl HybridModel for Automaton {
         initial_energy.abs().max(f64::MIN_POSITIVE)
     }
 
-    /// Which rate is not finite at `x`, and its expression.
+    /// Which rate is not finite at `x`, and its expression; where all are
+    /// (a step size that collapsed), the steepest.
     fn diagnose(&self, mode: Mode, x: &[f64]) -> Option<String> {
         let m = &self.modes[mode];
         let mut rates = vec![0.0; self.states.len()];
         m.flow.eval_scratch(x, &mut rates);
-        let i = rates.iter().position(|r| !r.is_finite())?;
-        let text = m
-            .rates
-            .get(i)
-            .and_then(|r| r.as_ref())
-            .map_or("0", |s| s.text.as_str());
+        let text = |i: usize| {
+            m.rates
+                .get(i)
+                .and_then(|r| r.as_ref())
+                .map_or("0", |s| s.text.as_str())
+        };
+        if let Some(i) = rates.iter().position(|r| !r.is_finite()) {
+            return Some(format!(
+                "the rate of `{}`, `{}`, is {} there",
+                self.states[i],
+                text(i),
+                rates[i]
+            ));
+        }
+        // All finite: the step collapsed where a rate turns steep (a
+        // square root at zero, a pole): name the steepest.
+        let jac = jacobian(&m.flow, x);
+        let (i, j) = (0..jac.nrows())
+            .flat_map(|i| (0..jac.ncols()).map(move |j| (i, j)))
+            .max_by(|a, b| jac[*a].abs().total_cmp(&jac[*b].abs()))?;
         Some(format!(
-            "in mode `{}` the rate of `{}`, `{text}`, is {} there",
-            m.name, self.states[i], rates[i]
+            "the rate of `{}`, `{}`, changes by {:e} per unit of `{}` there",
+            self.states[i],
+            text(i),
+            jac[(i, j)],
+            self.states[j]
+        ))
+    }
+
+    fn may_be_undefined(&self) -> bool {
+        true
+    }
+
+    /// The guard's expression, or the reset's that is not finite.
+    fn diagnose_guard(&self, mode: Mode, guard: usize, x: &[f64], reset: bool) -> Option<String> {
+        let m = &self.modes[mode];
+        let (guard_text, reset_texts) = &m.texts[guard];
+        if !reset {
+            return Some(format!("its expression is `{guard_text}`"));
+        }
+        let r = &m.resets[guard];
+        let mut new = vec![0.0; r.targets.len()];
+        r.tape.eval_scratch(x, &mut new);
+        let k = new.iter().position(|v| !v.is_finite())?;
+        Some(format!(
+            "the reset of `{}`, `{}`, is {} there",
+            self.states[r.targets[k]], reset_texts[k], new[k]
         ))
     }
 }
