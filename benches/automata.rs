@@ -11,7 +11,14 @@
 //!   H0 0.1, starting at an impact, to t = 10^5: 43,468 impacts) for
 //!   `taylor` and for the built-in exact model, and their ratio.
 //!
-//! heyoka itself is timed beside it by `benches/peers/heyoka_mechanism.py`.
+//! - the angle formulation as two charts (`models/automata/
+//!   mechanism_charts.json`) by DOP853 at `rtol = atol = 1e-10` beside the
+//!   built-in angle model on the same orbit (eta 1.2, from strain 0.5 at
+//!   rest, 100 impacts), medians of 7 runs, and their ratio; and the charts
+//!   by Taylor's method at machine precision.
+//!
+//! heyoka itself is timed beside it by `benches/peers/heyoka_mechanism.py`,
+//! SciPy by `benches/peers/scipy_mechanism.py --automaton`.
 
 use std::time::Instant;
 
@@ -120,5 +127,55 @@ fn main() {
         "  built-in exact      {exact_impacts} impacts in {exact_seconds:.4} s: {:.0} impacts/s ({:.1}x taylor's speed)",
         exact_impacts as f64 / exact_seconds,
         taylor / exact_seconds
+    );
+
+    println!();
+    println!("the angle formulation, 100 impacts (eta 1.2, from strain 0.5 at rest), medians of 7");
+    let t_end = 465.0;
+    let charts_path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/models/automata/mechanism_charts.json"
+    );
+    let charts: Value =
+        serde_json::from_str(&std::fs::read_to_string(charts_path).unwrap()).unwrap();
+    let timed = |scene: Value| {
+        let scene = Registry::builtin().from_value(&scene).unwrap();
+        median_of(7, || {
+            let report = scene.run(&Control::default(), &mut ()).unwrap();
+            assert_eq!(
+                report.outcome.status.as_str(),
+                "completed",
+                "{:?}",
+                report.outcome.reason
+            );
+            report
+                .outcome
+                .events_by_guard
+                .get("impact")
+                .copied()
+                .unwrap_or(0)
+        })
+    };
+    let dop853 = json!({"method": "dop853", "rtol": 1e-10, "atol": 1e-10});
+    let mut automaton = charts.clone();
+    automaton["t_end"] = json!(t_end);
+    automaton["solver"] = dop853.clone();
+    let (auto_seconds, auto_impacts) = timed(automaton);
+    let (builtin_seconds, builtin_impacts) = timed(json!({
+        "model": "mechanism", "formulation": "angle", "eta": 1.2,
+        "initial": {"strain": 0.5, "strain_rate": 0.0}, "t_end": t_end, "solver": dop853}));
+    let mut taylor = charts;
+    taylor["t_end"] = json!(t_end);
+    let (taylor_seconds, taylor_impacts) = timed(taylor);
+    println!(
+        "  built-in angle model, dop853 1e-10   {builtin_impacts} impacts in {builtin_seconds:.4} s"
+    );
+    println!(
+        "  charts automaton, dop853 1e-10       {auto_impacts} impacts in {auto_seconds:.4} s ({:.2}x the built-in model's time)",
+        auto_seconds / builtin_seconds
+    );
+    println!(
+        "  charts automaton, taylor (default)   {taylor_impacts} impacts in {taylor_seconds:.4} s ({:.2}x)",
+        taylor_seconds / builtin_seconds
     );
 }

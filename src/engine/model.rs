@@ -290,6 +290,14 @@ pub trait HybridModel {
         Labels::NONE
     }
 
+    /// The Jacobian of `mode`'s right-hand side at `x` into `jac`
+    /// (row-major `n x n`), where the model knows it exactly; `false`, and
+    /// the engine takes differences, where it does not.
+    fn jacobian(&self, mode: Mode, x: &[f64], jac: &mut [f64]) -> bool {
+        let _ = (mode, x, jac);
+        false
+    }
+
     /// Whether a guard or a reset may be undefined somewhere (a model read
     /// from a file, whose expressions may take a square root of a negative
     /// number): the run then checks every guard where each stretch of flow

@@ -100,6 +100,9 @@ impl Tangents {
         jac: &mut [f64],
     ) {
         let n = self.n;
+        if model.jacobian(mode, x, jac) {
+            return;
+        }
         model.rhs(mode, x, &mut self.down);
         self.x.copy_from_slice(x);
         for j in 0..n {
@@ -340,6 +343,52 @@ fn exp(n: usize, a: &[f64], out: &mut [f64], term: &mut [f64], next: &mut [f64])
     if n == 2 {
         return exp2(a, out);
     }
+    // Components that neither move nor move others (a frozen chart's
+    // states) keep their errors: exp is the identity there, and the rest
+    // is the exponential of the smaller block.
+    let mut active = [0usize; TRACKED];
+    let mut k = 0;
+    for i in 0..n.min(TRACKED) {
+        if (0..n).any(|j| a[i * n + j] != 0.0 || a[j * n + i] != 0.0) {
+            active[k] = i;
+            k += 1;
+        }
+    }
+    if n <= TRACKED && k < n {
+        let mut small = [0.0; TRACKED * TRACKED];
+        for (r, &i) in active[..k].iter().enumerate() {
+            for (c, &j) in active[..k].iter().enumerate() {
+                small[r * k + c] = a[i * n + j];
+            }
+        }
+        let mut result = [0.0; TRACKED * TRACKED];
+        exp_dense(k, &small[..k * k], &mut result[..k * k], term, next);
+        out.fill(0.0);
+        for i in 0..n {
+            out[i * n + i] = 1.0;
+        }
+        for (r, &i) in active[..k].iter().enumerate() {
+            for (c, &j) in active[..k].iter().enumerate() {
+                out[i * n + j] = result[r * k + c];
+            }
+        }
+        return;
+    }
+    exp_dense(n, a, out, term, next)
+}
+
+/// [`exp`] without looking for decoupled components.
+fn exp_dense(n: usize, a: &[f64], out: &mut [f64], term: &mut [f64], next: &mut [f64]) {
+    match n {
+        0 => return,
+        1 => {
+            out[0] = a[0].exp();
+            return;
+        }
+        2 => return exp2(a, out),
+        _ => {}
+    }
+    let (term, next) = (&mut term[..n * n], &mut next[..n * n]);
     let norm = row_norm(n, a);
     if !norm.is_finite() {
         // No exponential to take: the bound that uses it becomes infinite.

@@ -26,7 +26,7 @@
 use crate::engine::adaptive::{StepFailure, Tolerances};
 use crate::engine::locate::StepScan;
 use crate::engine::model::{Direction, HybridModel, Mode};
-use crate::numerics::polynomial::eval;
+use crate::numerics::polynomial::{eval, eval_compensated};
 use crate::numerics::taylor::{eval2, first_fall};
 
 /// The tolerance `taylor` takes unless told: machine epsilon, as heyoka.
@@ -119,10 +119,13 @@ impl Taylor {
         self.h
     }
 
-    /// The state `tau` into the step: each component's series summed.
+    /// The state `tau` into the step: each component's series summed, by
+    /// compensated Horner (the terms of a step of a sizeable part of a
+    /// period cancel, and plain Horner's few ulps per step would add up
+    /// over millions of steps to the phase error the run is after).
     pub fn eval(&self, tau: f64, x: &mut [f64]) {
         for (xi, c) in x.iter_mut().zip(self.series.chunks_exact(self.order + 1)) {
-            *xi = eval(c, tau);
+            *xi = eval_compensated(c, tau);
         }
     }
 

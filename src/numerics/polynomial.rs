@@ -24,6 +24,29 @@ pub fn eval_plain(c: &[f64], s: f64) -> f64 {
     horner(c, s, |acc, s, ck| acc * s + ck)
 }
 
+/// `p(s)` by compensated Horner (Graillat, Langlois and Louvet): each
+/// step's rounding errors, found exactly (a fused multiply-add gives the
+/// product's, Knuth's two-sum the sum's), are summed by a second Horner
+/// pass and added at the end. The result is as accurate as Horner's rule
+/// in twice the working precision, rounded once: what a Taylor step's state
+/// needs, whose terms cancel to a few times less than their sum.
+pub fn eval_compensated(c: &[f64], s: f64) -> f64 {
+    let Some((&last, rest)) = c.split_last() else {
+        return 0.0;
+    };
+    let (mut sum, mut error) = (last, 0.0);
+    for &ck in rest.iter().rev() {
+        let product = sum * s;
+        let product_error = sum.mul_add(s, -product);
+        let next = product + ck;
+        let t = next - product;
+        let sum_error = (product - (next - t)) + (ck - t);
+        error = error * s + (product_error + sum_error);
+        sum = next;
+    }
+    sum + error
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -35,5 +58,23 @@ mod tests {
         assert_eq!(eval(&c, 1.5), 0.875);
         assert_eq!(eval_plain(&c, 1.5), 0.875);
         assert_eq!(eval(&[], 3.0), 0.0);
+        assert_eq!(eval_compensated(&c, 1.5), 0.875);
+        assert_eq!(eval_compensated(&[], 3.0), 0.0);
+    }
+
+    #[test]
+    fn compensated_horner_keeps_what_plain_horner_loses_to_cancellation() {
+        // (s - 1)^7 expanded, near its root: the terms are about 100 and
+        // cancel to about 1e-14; plain Horner loses the result in their
+        // rounding, the compensated one keeps it to a few ulps.
+        let c = [-1.0, 7.0, -21.0, 35.0, -35.0, 21.0, -7.0, 1.0];
+        let s = 1.01;
+        let exact = 0.01_f64.powi(7);
+        let compensated = eval_compensated(&c, s);
+        assert!(
+            (compensated - exact).abs() < 1e-3 * exact,
+            "{compensated} vs {exact}"
+        );
+        assert!((eval_plain(&c, s) - exact).abs() > 1e-2 * exact);
     }
 }

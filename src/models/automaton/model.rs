@@ -19,7 +19,7 @@ use nalgebra::{DMatrix, DVector};
 
 use crate::engine::{Flow, Guard, HybridModel, Jump, Mode};
 use crate::models::automaton::definition::{Definition, Source};
-use crate::models::automaton::expr::derivative::jacobian;
+use crate::models::automaton::expr::derivative::{jacobian, jacobian_into};
 use crate::models::automaton::expr::series::Series;
 use crate::models::automaton::expr::{Ast, Scope, Tape};
 use crate::scene::SceneError;
@@ -263,6 +263,12 @@ impl HybridModel for Automaton {
     }
 
     fn has_rhs(&self, _: Mode) -> bool {
+        true
+    }
+
+    /// Exact, by forward differentiation along the mode's tape.
+    fn jacobian(&self, mode: Mode, x: &[f64], jac: &mut [f64]) -> bool {
+        jacobian_into(&self.modes[mode].flow, x, jac);
         true
     }
 

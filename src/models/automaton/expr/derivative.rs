@@ -4,6 +4,8 @@
 //! For an affine tape the gradients are the coefficients themselves, which
 //! is how the linear propagator gets `A` without differences.
 
+use std::cell::RefCell;
+
 use nalgebra::DMatrix;
 
 use crate::models::automaton::expr::tape::{Fun, Fun2, Op, Reg, Tape};
@@ -11,9 +13,37 @@ use crate::models::automaton::expr::tape::{Fun, Fun2, Op, Reg, Tape};
 /// The Jacobian (outputs x `n` inputs) of `tape` at `x`.
 pub fn jacobian(tape: &Tape, x: &[f64]) -> DMatrix<f64> {
     let n = x.len();
-    let m = tape.ops.len();
-    let mut value = vec![0.0; m];
-    let mut grad = vec![0.0; m * n];
+    let mut out = vec![0.0; tape.outputs.len() * n];
+    jacobian_into(tape, x, &mut out);
+    DMatrix::from_row_slice(tape.outputs.len(), n, &out)
+}
+
+/// The Jacobian of `tape` at `x` into `out`, row-major (outputs x `n`
+/// inputs), in scratch registers: what the engine's error bounds ask for
+/// at every step.
+pub fn jacobian_into(tape: &Tape, x: &[f64], out: &mut [f64]) {
+    SCRATCH.with_borrow_mut(|(value, grad)| {
+        let n = x.len();
+        let m = tape.ops.len();
+        value.resize(m, 0.0);
+        grad.resize(m * n, 0.0);
+        forward(tape, x, value, grad);
+        for (o, &r) in tape.outputs.iter().enumerate() {
+            out[o * n..(o + 1) * n].copy_from_slice(&grad[r as usize * n..(r as usize + 1) * n]);
+        }
+    })
+}
+
+thread_local! {
+    /// Values and gradients of every register (models are shared, read
+    /// only, between the threads of a sweep).
+    static SCRATCH: RefCell<(Vec<f64>, Vec<f64>)> = const { RefCell::new((Vec::new(), Vec::new())) };
+}
+
+/// Every register's value and gradient (`n` inputs each) along `tape` at
+/// `x`.
+fn forward(tape: &Tape, x: &[f64], value: &mut [f64], grad: &mut [f64]) {
+    let n = x.len();
     for (i, &op) in tape.ops.iter().enumerate() {
         value[i] = op.value(&value, x);
         let (done, rest) = grad.split_at_mut(i * n);
@@ -56,9 +86,6 @@ pub fn jacobian(tape: &Tape, x: &[f64]) -> DMatrix<f64> {
             }
         }
     }
-    DMatrix::from_fn(tape.outputs.len(), n, |o, k| {
-        grad[tape.outputs[o] as usize * n + k]
-    })
 }
 
 /// `f'(a)`, given `fa = f(a)`.
