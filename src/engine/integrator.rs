@@ -260,8 +260,9 @@ impl Integrator {
     }
 
     /// Where the method locates a guard's crossing itself, on its own
-    /// series (Taylor's method, see [`Taylor::locate`]): the scan of the
-    /// last step for `guard`; `None` where the dense output is to be
+    /// series (Taylor's method, see [`Taylor::locate`]; the linear
+    /// propagator where the model gives its guards' series): the scan of
+    /// the last step for `guard`; `None` where the dense output is to be
     /// scanned.
     pub fn locate<M: HybridModel + ?Sized>(
         &mut self,
@@ -273,6 +274,7 @@ impl Integrator {
     ) -> Option<Result<StepScan, String>> {
         match self {
             Integrator::Taylor(m) => Some(m.locate(model, mode, guard, check_start, uncertainty)),
+            Integrator::Linear(m) => m.locate(model, mode, guard, check_start, uncertainty),
             _ => None,
         }
     }

@@ -204,12 +204,15 @@ impl<'o> Ledger<'o> {
         self.events += 1;
         event.seq = self.events;
         self.audit(event.energy_before);
+        // A change within the energies' own rounding is no change: summed
+        // over millions of resets it would be a drift of the books alone.
         if self.rebase_at_resets
             && let (Some(before), Some(after), Some(reference)) = (
                 event.energy_before,
                 event.energy_after,
                 self.energy_reference.as_mut(),
             )
+            && (after - before).abs() > 8.0 * f64::EPSILON * before.abs().max(after.abs())
         {
             *reference += after - before;
         }

@@ -1,22 +1,35 @@
 //! The exact propagator of a linear flow `x' = A x + b`.
 //!
-//! With the augmented matrix `M = [[A, b], [0, 0]]`, `exp(M tau)` holds both
-//! `exp(A tau)` and `(integral of exp(A s) ds) b`, so one matrix exponential
-//! (nalgebra's scaled Pade) gives the state at any `tau` to round-off.
-//! Steps are bounded so that `|M| h <= 1/2`: within a step the guard is
-//! smooth enough for the polynomial root isolation of
-//! [`locate`](crate::engine::locate) to bracket every crossing, and each
-//! bracket is refined on the exact propagator itself.
+//! With the augmented matrix `M = [[A, b], [0, 0]]`, the flow from `y` is
+//! `exp(M tau) y = sum_k M^k y tau^k / k!`. Steps are bounded so that
+//! `|M| h <= 1`; over a step the series is then summed to round-off by its
+//! first [`ORDER`] + 1 terms (the rest is below `1 / 25!` of the state), so
+//! each step computes them once, `ORDER` matrix-vector products, and the
+//! state anywhere in the step is that polynomial summed by compensated
+//! Horner: exact to a few ulps, with no matrix exponential.
+//!
+//! Events are found on the same polynomials: where the model gives its
+//! guards' Taylor series along a flow's ([`HybridModel::guard_series`]), by
+//! the certified root search Taylor's method uses (no root in the step
+//! missed); elsewhere (a chain's ODE) by the engine's scan of the state
+//! along the step ([`locate`](crate::engine::locate)), each bracket refined
+//! on the propagator itself.
 
 use std::cell::Cell;
 
 use nalgebra::{DMatrix, DVector};
 
 use crate::engine::adaptive::StepFailure;
+use crate::engine::locate::StepScan;
 use crate::engine::model::{HybridModel, Mode};
+use crate::numerics::polynomial::eval_compensated;
+
+/// The degree of a step's series: with `|M| h <= 1`, the first term left
+/// out is below `1 / 25!` (7e-26) of the state.
+pub const ORDER: usize = 24;
 
 /// The exact propagator's working state: the augmented matrix of the
-/// current mode, and the current step.
+/// current mode, and the current step's series.
 #[derive(Debug, Clone)]
 pub struct Linear {
     /// The mode whose `M` is cached.
@@ -25,21 +38,32 @@ pub struct Linear {
     h_bound: f64,
     h: f64,
     y0: DVector<f64>,
+    /// The step's series, component by component: `series[i * (ORDER + 1)
+    /// + k]` is `(M^k y0)_i / k!`, the layout of
+    /// [`HybridModel::flow_series`].
+    series: Vec<f64>,
+    /// Scratch: one term of the augmented series and the next.
+    term: Vec<f64>,
+    next: Vec<f64>,
+    /// A guard's series along the step.
+    guard: Vec<f64>,
     y1: Vec<f64>,
-    /// `exp(M h / GRID)` for the step length `h` it was made for: event
-    /// location samples the step at multiples of `h / GRID`, so the states
-    /// there come from powers of it, without a matrix exponential each.
-    /// With it, `exp(M h)` itself, which takes the step to its end in one
-    /// product (no rounding piled up over `GRID` products).
-    grid_propagator: Option<(f64, DMatrix<f64>, DMatrix<f64>)>,
-    /// The states at `k h / GRID`, `k = 0..=GRID`, of the current step.
-    grid: Vec<DVector<f64>>,
     /// Propagator evaluations; a `Cell` because evaluation reads `&self`.
     evaluations: Cell<u64>,
 }
 
-/// Points per step whose states are kept (see `Linear::grid`).
-const GRID: usize = 8;
+/// `out = a v` for a square column-major matrix.
+fn mat_vec(a: &DMatrix<f64>, v: &[f64], out: &mut [f64]) {
+    let m = v.len();
+    out[..m].fill(0.0);
+    for (j, &vj) in v.iter().enumerate() {
+        if vj != 0.0 {
+            for (o, aij) in out[..m].iter_mut().zip(a.column(j).iter()) {
+                *o += aij * vj;
+            }
+        }
+    }
+}
 
 impl Linear {
     /// A propagator for states of `dimension` components.
@@ -50,9 +74,11 @@ impl Linear {
             h_bound: f64::INFINITY,
             h: 0.0,
             y0: DVector::zeros(dimension + 1),
+            series: vec![0.0; dimension * (ORDER + 1)],
+            term: vec![0.0; dimension + 1],
+            next: vec![0.0; dimension + 1],
+            guard: vec![0.0; ORDER + 1],
             y1: vec![0.0; dimension],
-            grid_propagator: None,
-            grid: Vec::new(),
             evaluations: Cell::new(0),
         }
     }
@@ -66,7 +92,7 @@ impl Linear {
     }
 
     /// One step from `y0` in `mode`, as long as `h_max` and the bound
-    /// `|M| h <= 1/2` allow; fails if the mode's flow is not linear or the
+    /// `|M| h <= 1` allow; fails if the mode's flow is not linear or the
     /// state stops being finite.
     pub fn step<M: HybridModel + ?Sized>(
         &mut self,
@@ -76,6 +102,7 @@ impl Linear {
         h_max: f64,
         _h_min: f64,
     ) -> Result<(), StepFailure> {
+        let n = y0.len();
         if self.mode != Some(mode) {
             let Some((a, b)) = model.linear(mode) else {
                 return Err(StepFailure::NotApplicable(format!(
@@ -83,7 +110,6 @@ impl Linear {
                     model.mode_name(mode)
                 )));
             };
-            let n = y0.len();
             self.augmented.fill(0.0);
             self.augmented.view_mut((0, 0), (n, n)).copy_from(&a);
             self.augmented.view_mut((0, n), (n, 1)).copy_from(&b);
@@ -96,50 +122,47 @@ impl Linear {
                 .map(|c| c.lp_norm(1))
                 .fold(0.0, f64::max);
             self.h_bound = if norm > 0.0 {
-                0.5 / norm
+                1.0 / norm
             } else {
                 f64::INFINITY
             };
             self.mode = Some(mode);
-            self.grid_propagator = None;
         }
-        self.y0.rows_mut(0, y0.len()).copy_from_slice(y0);
-        self.y0[y0.len()] = 1.0;
+        self.y0.rows_mut(0, n).copy_from_slice(y0);
+        self.y0[n] = 1.0;
         self.h = self.h_bound.min(h_max);
-        if self
-            .grid_propagator
-            .as_ref()
-            .is_none_or(|(h, _, _)| *h != self.h)
-        {
-            let part = (&self.augmented * (self.h / GRID as f64)).exp();
-            let whole = (&self.augmented * self.h).exp();
-            self.evaluations.set(self.evaluations.get() + 2);
-            self.grid_propagator = Some((self.h, part, whole));
-        }
-        if let Some((_, part, whole)) = &self.grid_propagator {
-            self.grid.clear();
-            self.grid.push(self.y0.clone());
-            for k in 1..GRID {
-                let next = part * &self.grid[k - 1];
-                self.grid.push(next);
+        // The series: term k is M^k y0 / k!.
+        let w = ORDER + 1;
+        self.term.copy_from_slice(self.y0.as_slice());
+        for k in 0..w {
+            for i in 0..n {
+                self.series[i * w + k] = self.term[i];
             }
-            self.grid.push(whole * &self.y0);
+            if k < ORDER {
+                mat_vec(&self.augmented, &self.term, &mut self.next);
+                let scale = 1.0 / (k + 1) as f64;
+                for (t, v) in self.term.iter_mut().zip(&self.next) {
+                    *t = v * scale;
+                }
+            }
         }
-        let n = y0.len();
-        self.y1.copy_from_slice(&self.grid[GRID].as_slice()[..n]);
+        self.evaluations.set(self.evaluations.get() + 1);
+        let mut y1 = std::mem::take(&mut self.y1);
+        self.eval(self.h, &mut y1);
+        self.y1 = y1;
         if self.y1.iter().any(|x| !x.is_finite()) {
             return Err(StepFailure::NonFinite);
         }
         Ok(())
     }
 
-    /// The exact state `tau` after the step's start.
+    /// The exact state `tau` after the step's start: the step's series
+    /// inside it, an exponential of its own beyond.
     pub fn eval(&self, tau: f64, x: &mut [f64]) {
-        let k = (tau / self.h * GRID as f64).round();
-        if (0.0..=GRID as f64).contains(&k)
-            && (tau - k * self.h / GRID as f64).abs() <= 4.0 * f64::EPSILON * self.h
-        {
-            x.copy_from_slice(&self.grid[k as usize].as_slice()[..x.len()]);
+        if tau <= self.h * (1.0 + 4.0 * f64::EPSILON) {
+            for (xi, c) in x.iter_mut().zip(self.series.chunks_exact(ORDER + 1)) {
+                *xi = eval_compensated(c, tau);
+            }
             return;
         }
         let propagator = (&self.augmented * tau).exp();
@@ -148,7 +171,33 @@ impl Linear {
         self.evaluations.set(self.evaluations.get() + 1);
     }
 
-    /// Propagator evaluations so far: the matrix exponentials taken.
+    /// Where the model gives its guards' series: the first crossing of
+    /// `guard` in the step on its series, as Taylor's method finds it (see
+    /// [`crate::engine::taylor`]); `None` where the step is to be scanned.
+    pub fn locate<M: HybridModel + ?Sized>(
+        &mut self,
+        model: &M,
+        mode: Mode,
+        guard: usize,
+        check_start: bool,
+        uncertainty: f64,
+    ) -> Option<Result<StepScan, String>> {
+        if !model.has_series(mode) {
+            return None;
+        }
+        model.guard_series(mode, guard, &self.series, ORDER, &mut self.guard);
+        Some(crate::engine::taylor::locate_on_series(
+            model,
+            mode,
+            guard,
+            &mut self.guard,
+            self.h,
+            check_start,
+            uncertainty,
+        ))
+    }
+
+    /// Propagator evaluations so far: the series and exponentials taken.
     pub fn evaluations(&self) -> u64 {
         self.evaluations.get()
     }

@@ -26,7 +26,7 @@
 use crate::engine::adaptive::{StepFailure, Tolerances};
 use crate::engine::locate::StepScan;
 use crate::engine::model::{Direction, HybridModel, Mode};
-use crate::numerics::polynomial::{eval, eval_compensated};
+use crate::numerics::polynomial::eval_compensated;
 use crate::numerics::taylor::{eval2, first_fall};
 
 /// The tolerance `taylor` takes unless told: machine epsilon, as heyoka.
@@ -162,35 +162,58 @@ impl Taylor {
         let p = self.order;
         model.guard_series(mode, guard, &self.series, p, &mut self.guard);
         self.evaluations += 1;
-        if !self.guard.iter().all(|c| c.is_finite()) {
-            return Err(format!(
-                "the series of guard `{}` is not finite",
-                model.guards(mode)[guard].name
-            ));
-        }
-        let h = self.h;
-        let (first, margin) = match model.guards(mode)[guard].direction {
-            Direction::Falling => falls(&self.guard, h, check_start, uncertainty)?,
-            Direction::Rising => {
-                self.guard.iter_mut().for_each(|c| *c = -*c);
-                falls(&self.guard, h, check_start, uncertainty)?
-            }
-            Direction::Either => {
-                let (a, ma) = falls(&self.guard, h, check_start, uncertainty)?;
-                self.guard.iter_mut().for_each(|c| *c = -*c);
-                let (b, mb) = falls(&self.guard, h, check_start, uncertainty)?;
-                let first = match (a, b) {
-                    (Some(a), Some(b)) => Some(a.min(b)),
-                    (a, b) => a.or(b),
-                };
-                (first, ma.min(mb))
-            }
-        };
-        Ok(StepScan {
-            crossing: first.map(|tau| (tau / h).min(1.0)),
-            margin,
-        })
+        locate_on_series(
+            model,
+            mode,
+            guard,
+            &mut self.guard,
+            self.h,
+            check_start,
+            uncertainty,
+        )
     }
+}
+
+/// The first crossing of `guard` in its direction on a step of length `h`
+/// along which the guard's series is `series` (negated in place where the
+/// guard rises), as a fraction of the step, and how clearly the step
+/// decides (see [`Taylor::locate`]).
+pub(crate) fn locate_on_series<M: HybridModel + ?Sized>(
+    model: &M,
+    mode: Mode,
+    guard: usize,
+    series: &mut [f64],
+    h: f64,
+    check_start: bool,
+    uncertainty: f64,
+) -> Result<StepScan, String> {
+    if !series.iter().all(|c| c.is_finite()) {
+        return Err(format!(
+            "the series of guard `{}` is not finite",
+            model.guards(mode)[guard].name
+        ));
+    }
+    let (first, margin) = match model.guards(mode)[guard].direction {
+        Direction::Falling => falls(series, h, check_start, uncertainty)?,
+        Direction::Rising => {
+            series.iter_mut().for_each(|c| *c = -*c);
+            falls(series, h, check_start, uncertainty)?
+        }
+        Direction::Either => {
+            let (a, ma) = falls(series, h, check_start, uncertainty)?;
+            series.iter_mut().for_each(|c| *c = -*c);
+            let (b, mb) = falls(series, h, check_start, uncertainty)?;
+            let first = match (a, b) {
+                (Some(a), Some(b)) => Some(a.min(b)),
+                (a, b) => a.or(b),
+            };
+            (first, ma.min(mb))
+        }
+    };
+    Ok(StepScan {
+        crossing: first.map(|tau| (tau / h).min(1.0)),
+        margin,
+    })
 }
 
 /// The order for `tolerances`: `ceil(-ln(eps) / 2) + 1`, `eps = min(rtol,

@@ -57,9 +57,9 @@ pub fn f(v: &Value) -> f64 {
 /// linear propagator: the flight is affine) and with DOP853.
 ///
 /// How close to `t*` a run gets is the method's resolution: the propagator
-/// takes bounces whose rise is below 1e-10 of a step's guard values for
-/// resting contact (62 bounces, 4.4e-6 short of `t*`); DOP853 follows them
-/// to a dip within its error (120 bounces, 1e-11 short).
+/// follows the bounces on their series until they come closer than the
+/// run can time (122 bounces, 7e-12 short of `t*`); DOP853 follows them to
+/// a dip within its error (120 bounces, 1e-11 short).
 #[test]
 fn bouncing_ball_bounces_at_the_closed_form_times_and_piles_up_at_its_zeno_point() {
     let (g, e, h) = (9.81_f64, 0.8_f64, 1.0_f64);
@@ -148,8 +148,8 @@ fn a_sweep_over_parameters_and_initial_values_follows_the_closed_form() {
         let t1 = (2.0 * y / 9.81).sqrt();
         assert!((number("first_impact") - t1).abs() < 1e-14, "{record:?}");
         let zeno = t1 * (1.0 + e) / (1.0 - e);
-        // The propagator takes a rise below 1e-10 of the drop for resting
-        // contact: the bounce speed is then at most sqrt(2 g 1e-10 y), and
+        // A bounce rising less than 1e-10 of the drop is below what any
+        // method here resolves: its speed is at most sqrt(2 g 1e-10 y), and
         // the flights still to come last 2 v / (g (1 - e)) in all.
         let unresolved = 2.0 * (2.0 * 9.81 * 1e-10 * y).sqrt() / (9.81 * (1.0 - e));
         let stopped = number("t_reached");
@@ -157,7 +157,15 @@ fn a_sweep_over_parameters_and_initial_values_follows_the_closed_form() {
             stopped <= zeno && zeno - stopped < unresolved,
             "e {e}, y {y}: {stopped} vs {zeno}"
         );
-        assert!(record[column("status")].starts_with("zeno"));
+        // At the accumulation the run either recognises it, or (the
+        // slowest losses, e = 0.9, followed to bounces of 1e-10) stops
+        // where its error no longer tells the bounces apart: never past it.
+        let status = &record[column("status")];
+        assert!(
+            status.starts_with("zeno")
+                || status.contains("leaves the events' order and count uncertain"),
+            "{status}"
+        );
         rows += 1;
     }
     assert_eq!(rows, 15);

@@ -49,7 +49,10 @@ fn the_angle_formulation_in_two_charts_agrees_with_the_strain_closed_form() {
         } else {
             ("strain_negative", "strain_positive")
         };
-        assert_eq!((e["mode_before"].as_str(), e["mode_after"].as_str()), (Some(sides.0), Some(sides.1)));
+        assert_eq!(
+            (e["mode_before"].as_str(), e["mode_after"].as_str()),
+            (Some(sides.0), Some(sides.1))
+        );
     }
     // Between impacts the motion leaves the strain chart for the angle
     // chart and comes back: the strain chart is entered and left at its
