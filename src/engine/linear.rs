@@ -35,6 +35,8 @@ pub struct Linear {
     /// The mode whose `M` is cached.
     mode: Option<Mode>,
     augmented: DMatrix<f64>,
+    /// The same, row by row, for the series' products.
+    rows: Vec<f64>,
     h_bound: f64,
     h: f64,
     y0: DVector<f64>,
@@ -52,16 +54,11 @@ pub struct Linear {
     evaluations: Cell<u64>,
 }
 
-/// `out = a v` for a square column-major matrix.
-fn mat_vec(a: &DMatrix<f64>, v: &[f64], out: &mut [f64]) {
+/// `out = a v` for a square matrix `a` laid out row by row.
+fn mat_vec(a: &[f64], v: &[f64], out: &mut [f64]) {
     let m = v.len();
-    out[..m].fill(0.0);
-    for (j, &vj) in v.iter().enumerate() {
-        if vj != 0.0 {
-            for (o, aij) in out[..m].iter_mut().zip(a.column(j).iter()) {
-                *o += aij * vj;
-            }
-        }
+    for (o, row) in out[..m].iter_mut().zip(a.chunks_exact(m)) {
+        *o = row.iter().zip(v).map(|(x, y)| x * y).sum();
     }
 }
 
@@ -71,6 +68,7 @@ impl Linear {
         Linear {
             mode: None,
             augmented: DMatrix::zeros(dimension + 1, dimension + 1),
+            rows: vec![0.0; (dimension + 1) * (dimension + 1)],
             h_bound: f64::INFINITY,
             h: 0.0,
             y0: DVector::zeros(dimension + 1),
@@ -126,6 +124,12 @@ impl Linear {
             } else {
                 f64::INFINITY
             };
+            let m = n + 1;
+            for i in 0..m {
+                for j in 0..m {
+                    self.rows[i * m + j] = self.augmented[(i, j)];
+                }
+            }
             self.mode = Some(mode);
         }
         self.y0.rows_mut(0, n).copy_from_slice(y0);
@@ -139,7 +143,7 @@ impl Linear {
                 self.series[i * w + k] = self.term[i];
             }
             if k < ORDER {
-                mat_vec(&self.augmented, &self.term, &mut self.next);
+                mat_vec(&self.rows, &self.term, &mut self.next);
                 let scale = 1.0 / (k + 1) as f64;
                 for (t, v) in self.term.iter_mut().zip(&self.next) {
                     *t = v * scale;
