@@ -14,13 +14,14 @@
 
 use std::path::PathBuf;
 
+use crate::compare_models::Release;
 use crate::compare_models::{
     Track, chain_track, continuum_track, distance, release, without_homogenized,
 };
 use crate::engine::Status;
 use crate::models::continuum::Variant;
 use crate::runner::Control;
-use crate::scene::{ChainScene, Registry};
+use crate::scene::Registry;
 
 use crate::cli::exit::{Code, Failure};
 
@@ -46,18 +47,26 @@ pub struct AdviseArgs {
 /// which to run. Returns [`Code::Untrusted`] if a run stopped early.
 pub fn advise(args: AdviseArgs, registry: &Registry) -> Result<Code, Failure> {
     let scene = registry.load(&args.scene).map_err(Failure::bad_input)?;
-    let Some(chain) = scene.downcast_ref::<ChainScene>() else {
-        return Err(Failure::bad_input(format!(
+    let not_a_chain = || {
+        Failure::bad_input(format!(
             "{}: advise weighs a chain scene against its continua; this is not a chain scene",
             args.scene.display()
-        )));
+        ))
+    };
+    let units = match scene.release() {
+        Some(Ok(Release {
+            units: Some(units), ..
+        })) => units,
+        _ => return Err(not_a_chain()),
     };
     if !(args.tolerance.is_finite() && args.tolerance > 0.0) {
         return Err(Failure::bad_input("--tolerance: a number > 0"));
     }
-    let mut release = release(&scene).map_err(|e| Failure::bad_input(e.in_path(&args.scene)))?;
+    let mut release = release(&scene)
+        .map_err(|e| Failure::bad_input(e.in_path(&args.scene)))?
+        .string;
     release.samples = SAMPLES;
-    let probe = chain.units.min(PROBE_UNITS);
+    let probe = units.min(PROBE_UNITS);
     // One after another, so that each is timed alone.
     let control = Control::default();
     let mut runs = vec![
@@ -81,18 +90,18 @@ pub fn advise(args: AdviseArgs, registry: &Registry) -> Result<Code, Failure> {
         return Ok(Code::Untrusted);
     }
     let reference = &tracks[0];
-    let scale = (chain.units as f64 / probe as f64).powi(2);
+    let scale = (units as f64 / probe as f64).powi(2);
     let chain_seconds = reference.wall_seconds * scale;
     say!(
         "{}: chain of {} units; probed with the chain at N = {probe} ({:.3} s, {} impacts){}",
         args.scene.display(),
-        chain.units,
+        units,
         reference.wall_seconds,
         reference.events,
         if scale > 1.0 {
             format!(
                 "; at N = {} it would take about {chain_seconds:.1} s (x N^2)",
-                chain.units
+                units
             )
         } else {
             String::new()

@@ -55,7 +55,9 @@ pub fn compare_models(args: CompareModelsArgs, registry: &Registry) -> Result<Co
         out,
     } = args;
     let scene = registry.load(&path).map_err(Failure::bad_input)?;
-    let mut release = release_of(&scene).map_err(|e| Failure::bad_input(e.in_path(&path)))?;
+    let mut release = release_of(&scene)
+        .map_err(|e| Failure::bad_input(e.in_path(&path)))?
+        .string;
     let most = crate::models::continuum::scene::MAX_FINITE_VOLUMES;
     if !(2..=most).contains(&cells) {
         return Err(Failure::bad_input(format!("--cells: from 2 to {most}")));

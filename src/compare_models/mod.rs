@@ -20,9 +20,9 @@ use rayon::prelude::*;
 use crate::engine::{LocalModel, Method, Options, Status, Tolerances, simulate_local};
 use crate::models::chain::coarse::{Coarse, WINDOW_WIDTH};
 use crate::models::chain::{Chain, TaylorChain};
-use crate::models::continuum::{Piece, StringModel, Variant};
+use crate::models::continuum::{StringModel, Variant};
 use crate::runner::{self, Control};
-use crate::scene::{ChainScene, ContinuumScene, Scene, SceneError};
+use crate::scene::{ContinuumScene, Scene, SceneError};
 use crate::time::Time;
 
 /// Fewest windows behind the front for a plateau to be measured.
@@ -35,55 +35,36 @@ pub const DEFAULT_CELLS: usize = 200;
 /// paper's string of length 2.
 pub const CENTRES: usize = 101;
 
-/// The release a chain or continuum scene describes, as a continuum scene
-/// (the chain's string without its units), its homogenized string on
-/// [`DEFAULT_CELLS`]. Scenes with an `initial` profile are refused: the
-/// models would not start alike.
-pub fn release(scene: &Scene) -> Result<ContinuumScene, SceneError> {
-    let refuse = || {
-        SceneError::field(
-            "initial",
-            "the models are compared from the release of a uniform string at rest; leave `initial` out".into(),
-        )
-    };
-    // A tool made for these two kinds: it asks for them by name.
-    let (c, uniform) = if let Some(c) = scene.downcast_ref::<ContinuumScene>() {
-        (c.clone(), c.cells.len() == 1)
-    } else if let Some(c) = scene.downcast_ref::<ChainScene>() {
-        let rest = c.load_before - 1.0;
-        let uniform = c.strain.iter().all(|e| *e == rest) && c.velocity.iter().all(|v| *v == 0.0);
-        let string = ContinuumScene {
-            variant: Variant::Paper,
-            length: c.length,
-            wave_speed: c.wave_speed,
-            load_before: c.load_before,
-            load_after: c.load_after,
-            constraint: c.constraint,
-            t_end: c.t_end,
-            snapshots: c.snapshots.clone(),
-            samples: c.samples,
-            resolution: DEFAULT_CELLS,
-            cells: vec![Piece {
-                strain: rest,
-                velocity: 0.0,
-            }],
-            max_events: c.max_events,
-            description: None,
-        };
-        (string, uniform)
-    } else {
-        return Err(SceneError::field(
+/// What a chain or continuum scene says of the release it describes
+/// ([`SceneModel::release`](crate::scene::SceneModel::release)).
+#[derive(Debug, Clone)]
+pub struct Release {
+    /// The release as a continuum scene (a chain's string without its
+    /// units), its homogenized string on [`DEFAULT_CELLS`].
+    pub string: ContinuumScene,
+    /// The chain's units, for a chain scene.
+    pub units: Option<usize>,
+    /// Whether the string starts uniform and at rest.
+    pub uniform: bool,
+}
+
+/// The release a scene describes, as a continuum scene: asked of the
+/// scene's model. Scenes with an `initial` profile are refused: the models
+/// would not start alike.
+pub fn release(scene: &Scene) -> Result<Release, SceneError> {
+    let release = scene.release().unwrap_or_else(|| {
+        Err(SceneError::field(
             "model",
             "compares a chain with its continuum: give a chain or continuum scene".into(),
+        ))
+    })?;
+    if !release.uniform || release.string.cells[0].velocity != 0.0 {
+        return Err(SceneError::field(
+            "initial",
+            "the models are compared from the release of a uniform string at rest; leave `initial` out".into(),
         ));
-    };
-    if !uniform || c.cells[0].velocity != 0.0 {
-        return Err(refuse());
     }
-    Ok(ContinuumScene {
-        resolution: DEFAULT_CELLS,
-        ..c
-    })
+    Ok(release)
 }
 
 /// The strain the string starts at, against which the front is found.

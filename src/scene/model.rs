@@ -16,6 +16,7 @@ use std::fmt;
 use serde_json::Value;
 
 use crate::compare::Reference;
+use crate::compare_models::Release;
 use crate::engine::Observer;
 use crate::runner::ensemble::{EnsembleReport, EnsembleRequest};
 use crate::runner::{Control, Report, Trajectory};
@@ -88,6 +89,13 @@ pub trait SceneModel: fmt::Debug + Send + Sync + 'static {
         None
     }
 
+    /// The release of a string this scene describes, as a continuum scene
+    /// (a chain's with its units): what `compare-models` and `advise` weigh
+    /// chains and continua on. `None` where the model describes no string.
+    fn release(&self) -> Option<Result<Release, SceneError>> {
+        None
+    }
+
     /// Whether `flicker run --ensemble` can run this scene as `request`
     /// asks, checked before anything runs.
     fn check_ensemble(&self, request: &EnsembleRequest) -> Result<(), SceneError> {
@@ -120,9 +128,8 @@ pub trait SceneModel: fmt::Debug + Send + Sync + 'static {
     /// method compared).
     fn clone_box(&self) -> Box<dyn SceneModel>;
 
-    /// The scene as `Any`, for the few tools made for one kind of model
-    /// (`advise` and `compare-models`, which weigh a chain against its
-    /// continua).
+    /// The scene as `Any`, for a program's own tools made for one kind of
+    /// model.
     fn as_any(&self) -> &dyn Any;
 }
 

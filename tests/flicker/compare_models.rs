@@ -14,7 +14,7 @@ use crate::support::{flicker, models, read_json};
 
 fn release(name: &str) -> ContinuumScene {
     let scene = scene::load(std::path::Path::new(&models(name))).unwrap();
-    release_of(&scene).unwrap()
+    release_of(&scene).unwrap().string
 }
 
 #[test]

@@ -138,7 +138,7 @@ fn against_the_traction_free_chain_it_meets_the_figures_the_issue_sets() {
     use flicker::compare_models::{Model, distance, release, run_all};
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("models/continuum_release_free_end.json");
-    let mut release = release(&scene::load(&path).unwrap()).unwrap();
+    let mut release = release(&scene::load(&path).unwrap()).unwrap().string;
     release.t_end = 0.7;
     release.snapshots = vec![0.3];
     release.samples = 57;

@@ -45,9 +45,9 @@
 //!   max pow hypot`. Time may appear anywhere (forced systems): the state
 //!   then carries the clock `t` as its last component.
 //!
-//! The file is read into a [`Definition`](definition::Definition) (names
+//! The file is read into a [`Definition`] (names
 //! checked, expressions parsed, errors with a caret under the character),
-//! compiled to tapes ([`Automaton`](model::Automaton), a
+//! compiled to tapes ([`Automaton`], a
 //! [`HybridModel`](crate::engine::HybridModel)), and run as any scene
 //! ([`scene`]). Without a `solver`, a run takes the exact linear propagator
 //! where every flow is affine, Taylor's method at machine precision

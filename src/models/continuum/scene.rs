@@ -27,6 +27,7 @@
 use serde_json::Value;
 
 use crate::compare::Reference;
+use crate::compare_models::{DEFAULT_CELLS, Release};
 use crate::engine::{Method, Observer};
 use crate::models::continuum::{Continuum, Piece, Variant};
 use crate::runner::{Control, Report};
@@ -351,6 +352,18 @@ impl SceneModel for ContinuumScene {
              exact front tracking only (`flicker compare-models` compares it with the chain)"
                 .into(),
         ))
+    }
+
+    /// Itself, on the comparison's cells.
+    fn release(&self) -> Option<Result<Release, SceneError>> {
+        Some(Ok(Release {
+            string: ContinuumScene {
+                resolution: DEFAULT_CELLS,
+                ..self.clone()
+            },
+            units: None,
+            uniform: self.cells.len() == 1,
+        }))
     }
 
     fn clone_box(&self) -> Box<dyn SceneModel> {

@@ -1,5 +1,5 @@
 //! The expressions of an automaton file: parsed to a syntax tree
-//! ([`parse`]), compiled to a register tape ([`tape`]) that is evaluated,
+//! ([`mod@parse`]), compiled to a register tape ([`tape`]) that is evaluated,
 //! differentiated and expanded in Taylor series without walking text.
 
 pub mod derivative;
