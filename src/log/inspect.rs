@@ -163,7 +163,12 @@ mod tests {
             guard: guard.into(),
             energy_before: Some(1.0),
             energy_after: Some(1.0 + jump),
+            mode_before: "m".into(),
+            mode_after: "m".into(),
+            before: Default::default(),
+            after: Default::default(),
             unit: None,
+            rel_velocity: None,
             x: None,
         }
     }

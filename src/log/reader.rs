@@ -20,12 +20,57 @@ pub struct LoggedEvent {
     pub energy_before: Option<f64>,
     /// The model's energy just after the reset, if it has one.
     pub energy_after: Option<f64>,
+    /// The mode before the reset.
+    #[serde(default)]
+    pub mode_before: String,
+    /// The mode after the reset.
+    #[serde(default)]
+    pub mode_after: String,
+    /// The state before the reset, by name, in the log's order.
+    #[serde(default)]
+    pub before: NamedState,
+    /// The state after the reset.
+    #[serde(default)]
+    pub after: NamedState,
     /// A chain's unit.
     #[serde(default)]
     pub unit: Option<u64>,
+    /// A chain's closing speed.
+    #[serde(default)]
+    pub rel_velocity: Option<f64>,
     /// Where along a continuum.
     #[serde(default)]
     pub x: Option<f64>,
+}
+
+/// A logged state: its components by name, in the order the log wrote
+/// them (a JSON object read without sorting its keys).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct NamedState(pub Vec<(String, f64)>);
+
+impl<'de> Deserialize<'de> for NamedState {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct Components;
+        impl<'de> serde::de::Visitor<'de> for Components {
+            type Value = NamedState;
+
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("an object of state components")
+            }
+
+            fn visit_map<A: serde::de::MapAccess<'de>>(
+                self,
+                mut map: A,
+            ) -> Result<NamedState, A::Error> {
+                let mut components = Vec::new();
+                while let Some((name, value)) = map.next_entry::<String, f64>()? {
+                    components.push((name, value));
+                }
+                Ok(NamedState(components))
+            }
+        }
+        deserializer.deserialize_map(Components)
+    }
 }
 
 /// A log that could not be read: which file, which line, why.

@@ -306,3 +306,45 @@ fn the_builder_makes_the_same_automaton_as_the_file() {
     assert_eq!(error.field.as_deref(), Some("modes.flight.flow.y"));
     assert!(error.reason.contains("`vv`"), "{}", error.reason);
 }
+
+/// `flicker events --csv` of an automaton's log: each state before and
+/// after each event, so that the bounces read off as the reset says, the
+/// height kept and the speed turned up by `e = 0.8`.
+#[test]
+fn the_event_table_of_an_automaton_has_its_states_before_and_after() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("run");
+    let run = flicker(&[
+        "run",
+        &automaton("bouncing_ball.json"),
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert_eq!(run.status.code(), Some(0));
+    let table = flicker(&[
+        "events",
+        out.join("events.jsonl").to_str().unwrap(),
+        "--csv",
+    ]);
+    assert_eq!(table.status.code(), Some(0));
+    let mut reader = csv::Reader::from_reader(table.stdout.as_slice());
+    let header: Vec<String> = reader.headers().unwrap().iter().map(String::from).collect();
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let (y0, v0, y1, v1) = (
+        col("before.y"),
+        col("before.v"),
+        col("after.y"),
+        col("after.v"),
+    );
+    let mut rows = 0;
+    for record in reader.records() {
+        let r = record.unwrap();
+        let x = |i: usize| r[i].parse::<f64>().unwrap();
+        assert_eq!(&r[col("mode_before")], "flight");
+        assert_eq!(x(y1), x(y0));
+        assert_eq!(x(v1), -0.8 * x(v0));
+        rows += 1;
+    }
+    assert!(rows > 30, "{rows} bounces");
+}

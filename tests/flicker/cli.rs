@@ -520,14 +520,30 @@ fn events_exports_csv_with_one_row_per_kept_event() {
     let mut reader = csv::Reader::from_reader(csv_out.stdout.as_slice());
     assert_eq!(
         reader.headers().unwrap(),
-        vec!["seq", "t", "guard", "energy_before", "energy_after"]
+        vec![
+            "seq",
+            "t",
+            "guard",
+            "mode_before",
+            "mode_after",
+            "energy_before",
+            "energy_after",
+            "before.strain",
+            "before.strain_rate",
+            "after.strain",
+            "after.strain_rate"
+        ]
     );
     let rows: Vec<csv::StringRecord> = reader.records().map(|r| r.unwrap()).collect();
     assert_eq!(rows.len(), lines);
+    let number = |r: &csv::StringRecord, i: usize| r[i].parse::<f64>().unwrap();
     for (k, r) in rows.iter().enumerate() {
         assert_eq!(r[0].parse::<usize>().unwrap(), k + 1);
-        let jump = r[4].parse::<f64>().unwrap() - r[3].parse::<f64>().unwrap();
+        let jump = number(r, 6) - number(r, 5);
         assert!(jump.abs() < 1e-15);
+        // The elastic reset: the strain on zero, its rate flipped.
+        assert_eq!(number(r, 9), 0.0);
+        assert_eq!(number(r, 10), -number(r, 8));
     }
     let both = flicker(&["events", log.to_str().unwrap(), "--csv", "--summary"]);
     assert_eq!(both.status.code(), Some(2));
