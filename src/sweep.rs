@@ -105,6 +105,12 @@ pub struct Row {
     pub t_reached: f64,
 }
 
+/// Whether `value` is a sweep (an object with `scene` and `grid`) rather
+/// than a scene.
+pub fn is_sweep(value: &Value) -> bool {
+    value.get("grid").is_some() && value.get("scene").is_some()
+}
+
 /// Read and validate a sweep file, whose scenes are of the models
 /// `registry` knows.
 pub fn load(path: &Path, registry: &Registry) -> Result<Sweep, SceneError> {
@@ -361,6 +367,31 @@ impl Sweep {
             energy_error: o.max_energy_error,
             t_reached: o.t_reached,
         }
+    }
+
+    /// What `flicker check` says of the sweep, a line each: `label` (the
+    /// file), how many scenes of which model, then each axis.
+    pub fn check_lines(&self, label: &str) -> Vec<String> {
+        let model = self
+            .base
+            .get("model")
+            .and_then(|m| m.as_str())
+            .unwrap_or("?");
+        let mut said = vec![format!(
+            "{label}: a valid sweep of {} {model} scenes (run it with `flicker sweep`)",
+            self.points()
+        )];
+        for axis in &self.axes {
+            let (first, last) = (axis.values.first(), axis.values.last());
+            said.push(format!(
+                "  {}: {} values from {} to {}",
+                axis.key,
+                axis.values.len(),
+                first.map_or("-".into(), |v| v.to_string()),
+                last.map_or("-".into(), |v| v.to_string())
+            ));
+        }
+        said
     }
 
     /// The CSV header: `point`, the axis keys, then the results.

@@ -3,9 +3,8 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::compare::{Plan, Row, TOLERANCES, chart, compare as run_compare, write_csv};
-use crate::scene::solver::METHODS;
-use crate::scene::{Registry, Scene};
+use crate::compare::{Plan, Row, chart, compare as run_compare, write_csv};
+use crate::scene::Registry;
 
 use crate::cli::exit::{Code, Failure};
 
@@ -22,35 +21,15 @@ pub fn compare(
     out: Option<PathBuf>,
 ) -> Result<Code, Failure> {
     let scene = registry.load(scene_path).map_err(Failure::bad_input)?;
-    let methods = methods.unwrap_or_else(|| applicable(&scene));
-    if let Some(bad) = methods.iter().find(|m| !METHODS.contains(&m.as_str())) {
-        return Err(Failure::bad_input(format!(
-            "--methods: unknown method {bad:?} (known: {})",
-            METHODS.join(", ")
-        )));
-    }
-    for (flag, values) in [("--tolerances", &tolerances), ("--steps", &steps)] {
-        if values
-            .iter()
-            .flatten()
-            .any(|x| !(x.is_finite() && *x > 0.0))
-        {
-            return Err(Failure::bad_input(format!(
-                "{flag}: every value must be a finite number > 0"
-            )));
-        }
-    }
+    let plan = Plan::new(&scene, methods, tolerances, steps).map_err(|e| {
+        Failure::bad_input(format!("--{}: {}", e.field.unwrap_or_default(), e.reason))
+    })?;
     let out = out.unwrap_or_else(|| {
         let stem = scene_path
             .file_stem()
             .map_or_else(|| "scene".into(), |s| s.to_string_lossy().into_owned());
         Path::new("out").join(format!("{stem}-compare"))
     });
-    let plan = Plan {
-        methods,
-        tolerances: tolerances.unwrap_or_else(|| TOLERANCES.to_vec()),
-        steps,
-    };
     eprintln!(
         "{:<8} {:>9} {:>9} {:>10} {:>10} {:>9} {:>10}  status",
         "method", "tol", "step", "seconds", "evals", "events", "error"
@@ -75,11 +54,6 @@ pub fn compare(
     let names: Vec<String> = written.iter().map(|p| p.display().to_string()).collect();
     say!("wrote {}", names.join(", "));
     Ok(Code::Ok)
-}
-
-/// The methods a scene's model can run.
-fn applicable(scene: &Scene) -> Vec<String> {
-    scene.methods().into_iter().map(str::to_string).collect()
 }
 
 fn line(row: &Row) -> String {

@@ -15,7 +15,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::engine::{EventTimes, Status, zeno};
 use crate::runner;
-use crate::scene::solver::SolverSpec;
+use crate::scene::solver::{METHODS, SolverSpec};
 use crate::scene::{Scene, SceneError};
 pub use reference::Reference;
 
@@ -71,6 +71,46 @@ pub struct Plan {
     pub tolerances: Vec<f64>,
     /// Fixed steps; `None` picks fractions of the scene's period.
     pub steps: Option<Vec<f64>>,
+}
+
+impl Plan {
+    /// The plan made of `flicker compare`'s flags for `scene`: `methods`
+    /// (default: every method its model can run), `tolerances` (default
+    /// [`TOLERANCES`]), `steps` (default: fractions of its time scale);
+    /// refused, naming `methods`, `tolerances` or `steps`, where a method is
+    /// unknown or a value is not a finite number > 0.
+    pub fn new(
+        scene: &Scene,
+        methods: Option<Vec<String>>,
+        tolerances: Option<Vec<f64>>,
+        steps: Option<Vec<f64>>,
+    ) -> Result<Plan, SceneError> {
+        let methods =
+            methods.unwrap_or_else(|| scene.methods().into_iter().map(str::to_string).collect());
+        if let Some(bad) = methods.iter().find(|m| !METHODS.contains(&m.as_str())) {
+            return Err(SceneError::field(
+                "methods",
+                format!("unknown method {bad:?} (known: {})", METHODS.join(", ")),
+            ));
+        }
+        for (key, values) in [("tolerances", &tolerances), ("steps", &steps)] {
+            if values
+                .iter()
+                .flatten()
+                .any(|x| !(x.is_finite() && *x > 0.0))
+            {
+                return Err(SceneError::field(
+                    key,
+                    "every value must be a finite number > 0".into(),
+                ));
+            }
+        }
+        Ok(Plan {
+            methods,
+            tolerances: tolerances.unwrap_or_else(|| TOLERANCES.to_vec()),
+            steps,
+        })
+    }
 }
 
 /// Run every method of `plan` on `scene` and measure it against the reference.

@@ -19,6 +19,7 @@
 //! | `x` | continua only: where the event happened (the wall at `-length / 2`, the loaded end at `+length / 2`) |
 //!
 //! A chain or continuum run also writes `profiles.json` and `trace.csv` ([`field_files`]).
+//! The same events held in memory as arrays: [`columns`].
 //!
 //! ```json
 //! {"seq":1,"t":2.2142,"guard":"impact","mode_before":"flight","mode_after":"flight","energy_before":0.025,"energy_after":0.025,"before":{"strain":0.0,"strain_rate":-0.2236},"after":{"strain":0.0,"strain_rate":0.2236}}
@@ -30,6 +31,7 @@
 //! `t_reached`, `energy_initial`, `energy_final`, `max_energy_error`,
 //! `final_state`, `zeno`, `method` and `wall_seconds`; see [`summary`].
 
+pub mod columns;
 pub mod field_files;
 pub mod inspect;
 pub mod reader;

@@ -159,6 +159,20 @@ impl Scene {
         self.0.set_t_end(t_end)
     }
 
+    /// What `flicker check` says of the scene, a line each: `label` (the
+    /// file), that it is valid and of which model, then what its model
+    /// describes.
+    pub fn check_lines(&self, label: &str) -> Vec<String> {
+        let mut lines = self.describe().into_iter();
+        let mut said = vec![format!(
+            "{label}: a valid {} scene ({})",
+            self.model(),
+            lines.next().unwrap_or_default()
+        )];
+        said.extend(lines.map(|line| format!("  {line}")));
+        said
+    }
+
     /// Override the solver with what the command line gave (the fields it
     /// sets replace the scene's), checking it.
     pub fn override_solver(&mut self, flags: &SolverSpec) -> Result<(), SceneError> {

@@ -1,0 +1,221 @@
+"""flicker: an event-driven engine for hybrid systems, from Python.
+
+Smooth flows between events, guards that fire when a function of the state
+crosses zero, resets that jump the state: impacting mechanisms, chains of
+them, their continuum limits, and any hybrid automaton written in JSON. The
+engine is flicker's own (Rust); this package runs its scenes and hands the
+results over as NumPy arrays.
+
+    >>> import flicker
+    >>> run = flicker.run("models/automata/bouncing_ball.json")
+    >>> run.summary["status"]
+    'zeno'
+    >>> run.events["t"][:3]          # bounce times, float64
+    >>> run.events["before"][:, 1]   # the speed before each bounce
+
+A scene is a path, a JSON string or a dict, in the format `flicker run`
+reads (see the repository's README and docs/automata.md). A scene flicker
+refuses raises `SceneError` (a `ValueError`); a run that cannot be trusted
+returns, with `summary["status"] == "failed"` and the reason in
+`summary["reason"]`, as the command line does. Runs release the GIL (runs
+in several threads use several cores), and Ctrl-C stops a run within a
+second, leaving `status == "interrupted"`.
+"""
+
+import json
+import os
+from typing import Any, Dict, List, Optional, Sequence, Union
+
+import numpy as np
+
+from . import _flicker
+from ._flicker import SceneError
+
+__all__ = ["Run", "SceneError", "check", "compare", "run", "sweep"]
+
+Scene = Union[str, "os.PathLike[str]", Dict[str, Any]]
+
+
+def _source(scene: Scene):
+    """(text, path) for the native module: a dict or a JSON string is text,
+    anything else a path."""
+    if isinstance(scene, dict):
+        return json.dumps(scene), None
+    if isinstance(scene, os.PathLike):
+        return None, os.fspath(scene)
+    if isinstance(scene, str):
+        if scene.lstrip().startswith("{"):
+            return scene, None
+        return None, scene
+    raise TypeError(
+        f"scene must be a path, a JSON string or a dict, not {type(scene).__name__}"
+    )
+
+
+class Run:
+    """A finished run.
+
+    Attributes:
+        summary: the dict `summary.json` holds (`status`, `reason`,
+            `events`, `final_state`, `method`, `max_energy_error`, ...).
+        events: a dict of NumPy arrays, one per field of the event log:
+            `t` (float64), `seq` (uint64), `guard`, `mode_before`,
+            `mode_after` (str), `before` and `after` (float64, shape
+            `(n, len(state_names))`, NaN where an event's mode has no such
+            state), `energy_before`, `energy_after` (float64, NaN without an
+            energy), and the labels the model gives (`unit` as int64,
+            `rel_velocity`, `x`) where it has them. None if the run was
+            asked for no events.
+        state_names: the columns of `before` and `after`.
+        trace: for chains and continua, a dict of float64 arrays `t`,
+            `energy`, `momentum`, `right_end` at the scene's sample times;
+            else None.
+        profiles: for chains and continua, a list of dicts (`t`, and arrays
+            `x`, `strain`, `displacement`, `velocity`) at the snapshot
+            times; else None.
+        fields: everything a chain or continuum reports (the two above, the
+            classical string beside them, the momentum), or None.
+    """
+
+    def __init__(self, raw: Dict[str, Any]):
+        self.summary: Dict[str, Any] = json.loads(raw["summary"])
+        self.fields: Optional[Dict[str, Any]] = raw["fields"]
+        self.trace = self.fields["trace"] if self.fields else None
+        self.profiles = self.fields["profiles"] if self.fields else None
+        columns = raw["events"]
+        if columns is None:
+            self.events = None
+            self.state_names: List[str] = []
+            return
+        names = np.asarray(columns["names"] or [""], dtype=str)
+        self.state_names = list(columns["state_names"])
+        events = {
+            "seq": columns["seq"],
+            "t": columns["t"],
+            "guard": names[columns["guard"]],
+            "mode_before": names[columns["mode_before"]],
+            "mode_after": names[columns["mode_after"]],
+            "energy_before": columns["energy_before"],
+            "energy_after": columns["energy_after"],
+            "before": columns["before"],
+            "after": columns["after"],
+        }
+        for name, values, counts in columns["labels"]:
+            whole = counts and not np.isnan(values).any()
+            events[name] = values.astype(np.int64) if whole else values
+        self.events: Optional[Dict[str, np.ndarray]] = events
+
+    @property
+    def status(self) -> str:
+        """The run's status: `completed`, `zeno`, `failed` or `interrupted`."""
+        return self.summary["status"]
+
+    def to_pandas(self):
+        """The events as a pandas DataFrame: one row per event, one column
+        per field, `before.NAME` and `after.NAME` for each state. Needs
+        pandas."""
+        import pandas as pd
+
+        if self.events is None:
+            raise ValueError("this run kept no events (run it with events=True)")
+        data = {}
+        for key, values in self.events.items():
+            if key in ("before", "after"):
+                for k, name in enumerate(self.state_names):
+                    data[f"{key}.{name}"] = values[:, k]
+            else:
+                data[key] = values
+        return pd.DataFrame(data)
+
+    def __repr__(self) -> str:
+        s = self.summary
+        return (
+            f"<flicker.Run {s['model']} {s['status']} at t = {s['t_reached']} "
+            f"of {s['t_end']}, {s['events']} events, method {s['method']}>"
+        )
+
+
+def run(
+    scene: Scene,
+    *,
+    t_end: Optional[float] = None,
+    method: Optional[str] = None,
+    rtol: Optional[float] = None,
+    atol: Optional[float] = None,
+    step: Optional[float] = None,
+    log: Optional[Union[str, "os.PathLike[str]"]] = None,
+    events: bool = True,
+) -> Run:
+    """Run a scene and return its `Run`.
+
+    Args:
+        scene: a path to a scene file, a JSON string, or a dict.
+        t_end: the simulated time to stop at, replacing the scene's.
+        method: `exact`, `linear`, `taylor`, `dopri5`, `dop853` or
+            `verlet`, replacing the scene's (default: the cheapest exact
+            description of the model).
+        rtol, atol: tolerances (`dopri5`, `dop853`, `taylor`).
+        step: the fixed step (`verlet`).
+        log: a file to stream the event log to (JSON Lines, as
+            `flicker run` writes `events.jsonl`); none is written otherwise.
+        events: keep the events as arrays (`Run.events`).
+
+    Raises:
+        SceneError: the scene or an argument is refused; `field` and
+            `reason` say where and why.
+    """
+    text, path = _source(scene)
+    raw = _flicker.run(
+        text,
+        path,
+        t_end=t_end,
+        method=method,
+        rtol=rtol,
+        atol=atol,
+        step=step,
+        log=None if log is None else os.fspath(log),
+        events=events,
+    )
+    return Run(raw)
+
+
+def check(scene: Scene) -> List[str]:
+    """What `flicker check` says of a scene or a sweep, a line each: that it
+    is valid, its model, and what the model describes (for an automaton:
+    its modes, guards and the method it would run). Raises `SceneError`
+    where it is not valid."""
+    text, path = _source(scene)
+    return _flicker.check(text, path)
+
+
+def compare(
+    scene: Scene,
+    *,
+    methods: Optional[Sequence[str]] = None,
+    tolerances: Optional[Sequence[float]] = None,
+    steps: Optional[Sequence[float]] = None,
+) -> Dict[str, Any]:
+    """`flicker compare`: every method (default: all the scene's model
+    runs) over the tolerances or steps, each measured against the exact
+    answer. Returns `{"reference": what the answer is, "rows": columns}`,
+    the columns of `compare.csv` (`method`, `status` as lists of str; the
+    rest float64 arrays, NaN where a value does not apply)."""
+    text, path = _source(scene)
+    return _flicker.compare(
+        text,
+        path,
+        methods=None if methods is None else list(methods),
+        tolerances=None if tolerances is None else [float(t) for t in tolerances],
+        steps=None if steps is None else [float(h) for h in steps],
+    )
+
+
+def sweep(sweep_file: Scene, *, threads: Optional[int] = None) -> Dict[str, Any]:
+    """`flicker sweep`: every point of a sweep (a path, a JSON string or a
+    dict with `scene` and `grid`), in parallel on `threads` threads
+    (default: one per core). Returns a dict of columns, as `flicker sweep`
+    writes them: `point`, each axis, `status` (list of str), `events`,
+    `first_impact`, `impact_period`, `exact_period`, `period_error`,
+    `energy_error`, `t_reached` (NaN where a value is missing)."""
+    text, path = _source(sweep_file)
+    return _flicker.sweep(text, path, threads=threads)

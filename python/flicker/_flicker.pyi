@@ -1,0 +1,35 @@
+"""Type stubs of flicker's native module (python/src/lib.rs): the functions
+the package's own `run`, `check`, `compare` and `sweep` call."""
+
+from typing import Any, Dict, List, Optional
+
+class SceneError(ValueError):
+    """A scene (or an argument) flicker refuses: `str(e)` is the command
+    line's line, `field` the dotted key at fault (or None), `reason` what
+    is wrong."""
+
+    field: Optional[str]
+    reason: str
+
+def run(
+    text: Optional[str] = None,
+    path: Optional[str] = None,
+    t_end: Optional[float] = None,
+    method: Optional[str] = None,
+    rtol: Optional[float] = None,
+    atol: Optional[float] = None,
+    step: Optional[float] = None,
+    log: Optional[str] = None,
+    events: bool = True,
+) -> Dict[str, Any]: ...
+def check(text: Optional[str] = None, path: Optional[str] = None) -> List[str]: ...
+def compare(
+    text: Optional[str] = None,
+    path: Optional[str] = None,
+    methods: Optional[List[str]] = None,
+    tolerances: Optional[List[float]] = None,
+    steps: Optional[List[float]] = None,
+) -> Dict[str, Any]: ...
+def sweep(
+    text: Optional[str] = None, path: Optional[str] = None, threads: Optional[int] = None
+) -> Dict[str, Any]: ...

@@ -1,0 +1,214 @@
+//! The native half of the Python package `flicker` (`flicker._flicker`):
+//! scenes read and run by the engine, the events handed to NumPy as
+//! arrays, and the tools `check`, `compare` and `sweep`. The Python half
+//! (`python/flicker/__init__.py`) shapes what these return into the
+//! package's `Run` and dicts of columns; the engine crate knows nothing of
+//! Python.
+//!
+//! A run releases the GIL, so runs in several Python threads use several
+//! cores. It goes on in a thread of its own while the calling thread, every
+//! [`POLL`], takes the GIL back to look for a signal: Ctrl-C (in a terminal
+//! or a notebook) sets the run's stop flag, and the run returns, status
+//! `interrupted`, within a fraction of a second.
+
+mod convert;
+mod tools;
+
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::Path;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Duration;
+
+use pyo3::create_exception;
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use flicker::engine::{EventRecord, Observer};
+use flicker::log::JsonlWriter;
+use flicker::log::columns::EventColumns;
+use flicker::log::summary::summary;
+use flicker::runner::Control;
+use flicker::scene::solver::SolverSpec;
+use flicker::scene::{Registry, Scene, SceneError as EngineSceneError};
+
+create_exception!(
+    _flicker,
+    SceneError,
+    PyValueError,
+    "A scene (or an override) that flicker refuses: the message is the command line's, `field` the dotted key at fault (or None), `reason` what is wrong."
+);
+
+/// How often the calling thread looks for a signal while a run goes on.
+const POLL: Duration = Duration::from_millis(50);
+
+/// The Python exception for an engine's refusal, with its parts.
+fn scene_error(py: Python<'_>, e: &EngineSceneError) -> PyErr {
+    let err = SceneError::new_err(format!("flicker: {e}"));
+    let value = err.value(py);
+    let _ = value.setattr("field", e.field.clone());
+    let _ = value.setattr("reason", e.reason.clone());
+    err
+}
+
+/// A refusal of an override (a keyword argument), as the command line
+/// refuses its flag.
+fn override_error(py: Python<'_>, field: &str, reason: String) -> PyErr {
+    scene_error(py, &EngineSceneError::field(field, reason))
+}
+
+/// The scene given as JSON text or as a file, and the label its messages
+/// and summary name it by.
+fn load(py: Python<'_>, text: Option<&str>, path: Option<&str>) -> PyResult<(Scene, String)> {
+    let registry = Registry::builtin();
+    match (path, text) {
+        (Some(path), _) => registry
+            .load(Path::new(path))
+            .map(|scene| (scene, path.to_string()))
+            .map_err(|e| scene_error(py, &e)),
+        (None, Some(text)) => registry
+            .parse(text)
+            .map(|scene| (scene, "<scene>".to_string()))
+            .map_err(|e| scene_error(py, &e)),
+        (None, None) => Err(override_error(
+            py,
+            "scene",
+            "give a path, a JSON string or a dict".into(),
+        )),
+    }
+}
+
+/// The run's observers: the columns, and the log on disk where asked.
+struct Keep {
+    columns: Option<EventColumns>,
+    log: Option<JsonlWriter<BufWriter<File>>>,
+}
+
+impl Observer for Keep {
+    fn on_event(&mut self, event: &EventRecord) -> std::io::Result<()> {
+        if let Some(columns) = &mut self.columns {
+            columns.on_event(event)?;
+        }
+        if let Some(log) = &mut self.log {
+            log.on_event(event)?;
+        }
+        Ok(())
+    }
+
+    fn wants_details(&self) -> bool {
+        self.columns.is_some() || self.log.is_some()
+    }
+}
+
+/// Run a scene; see `flicker.run` for what the arguments mean. Returns a
+/// dict: `summary` (the JSON text of `summary.json`), `events` (columns,
+/// see `convert::events`), `fields` (a chain's or continuum's trace and
+/// profiles, or None).
+#[pyfunction]
+#[pyo3(signature = (text=None, path=None, t_end=None, method=None, rtol=None, atol=None, step=None, log=None, events=true))]
+#[allow(clippy::too_many_arguments)]
+fn run<'py>(
+    py: Python<'py>,
+    text: Option<&str>,
+    path: Option<&str>,
+    t_end: Option<f64>,
+    method: Option<String>,
+    rtol: Option<f64>,
+    atol: Option<f64>,
+    step: Option<f64>,
+    log: Option<&str>,
+    events: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let (mut scene, label) = load(py, text, path)?;
+    if let Some(t) = t_end {
+        scene
+            .set_t_end(t)
+            .map_err(|e| override_error(py, "t_end", e.reason))?;
+    }
+    let solver = SolverSpec {
+        method,
+        rtol,
+        atol,
+        step,
+    };
+    if solver != SolverSpec::default() {
+        scene
+            .override_solver(&solver)
+            .map_err(|e| override_error(py, "method/rtol/atol/step", e.to_string()))?;
+    }
+    let writer = match log {
+        None => None,
+        Some(file) => Some(JsonlWriter::new(BufWriter::new(
+            File::create(file).map_err(|e| {
+                override_error(py, "log", format!("{file}: cannot be created: {e}"))
+            })?,
+        ))),
+    };
+    let mut keep = Keep {
+        columns: events.then(EventColumns::default),
+        log: writer,
+    };
+    let stop = Arc::new(AtomicBool::new(false));
+    let control = Control {
+        stop: Some(stop.clone()),
+        max_wall_seconds: None,
+    };
+    let report = py.detach(|| {
+        std::thread::scope(|s| {
+            let worker = s.spawn(|| scene.run(&control, &mut keep));
+            while !worker.is_finished() {
+                std::thread::park_timeout(POLL);
+                // A pending Ctrl-C raises here: it becomes the run's stop.
+                if Python::attach(|py| py.check_signals()).is_err() {
+                    stop.store(true, Ordering::Relaxed);
+                }
+            }
+            worker.join()
+        })
+    });
+    let report = match report {
+        Ok(result) => result.map_err(|e| scene_error(py, &e))?,
+        Err(_) => {
+            return Err(pyo3::exceptions::PyRuntimeError::new_err(
+                "flicker: the run panicked (a bug: please report the scene)",
+            ));
+        }
+    };
+    let mut report = report;
+    if let Some(writer) = &mut keep.log
+        && let Err(e) = writer.flush()
+    {
+        report.outcome.status = flicker::engine::Status::Failed;
+        report.outcome.reason = Some(format!("could not write the event log: {e}"));
+    }
+    let summary = summary(
+        &report,
+        scene.model(),
+        Path::new(&label),
+        log.map(Path::new),
+    );
+    let out = PyDict::new(py);
+    out.set_item("summary", summary.to_string())?;
+    match keep.columns {
+        Some(mut columns) => out.set_item("events", convert::events(py, &mut columns)?)?,
+        None => out.set_item("events", py.None())?,
+    }
+    match &report.fields {
+        Some(fields) => out.set_item("fields", convert::fields(py, fields)?)?,
+        None => out.set_item("fields", py.None())?,
+    }
+    Ok(out)
+}
+
+/// The native module.
+#[pymodule]
+fn _flicker(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("SceneError", m.py().get_type::<SceneError>())?;
+    m.add_function(wrap_pyfunction!(run, m)?)?;
+    m.add_function(wrap_pyfunction!(tools::check, m)?)?;
+    m.add_function(wrap_pyfunction!(tools::compare, m)?)?;
+    m.add_function(wrap_pyfunction!(tools::sweep, m)?)?;
+    Ok(())
+}

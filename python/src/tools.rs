@@ -1,0 +1,185 @@
+//! `check`, `compare` and `sweep` as the command line runs them, their
+//! results as lists and NumPy columns instead of printed lines and CSV
+//! files. Long ones release the GIL.
+
+use std::path::{Path, PathBuf};
+
+use numpy::IntoPyArray;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+use serde_json::Value;
+
+use flicker::compare::{Plan, compare as run_compare};
+use flicker::scene::Registry;
+use flicker::sweep::{Row as SweepRow, Shard, Sweep, is_sweep, parse_text};
+
+use crate::{load, override_error, scene_error};
+
+/// The sweep given as JSON text or a file, if it is one (an object with
+/// `scene` and `grid`); its `scene` path is read beside the file, or from
+/// the working folder.
+fn as_sweep(py: Python<'_>, text: Option<&str>, path: Option<&str>) -> PyResult<Option<Sweep>> {
+    let (text, folder) = match (path, text) {
+        (Some(path), _) => match std::fs::read_to_string(path) {
+            Ok(text) => (
+                text,
+                Path::new(path)
+                    .parent()
+                    .map(Path::to_path_buf)
+                    .unwrap_or_default(),
+            ),
+            // Unreadable: the scene's own error says so.
+            Err(_) => return Ok(None),
+        },
+        (None, Some(text)) => (text.to_string(), PathBuf::new()),
+        (None, None) => return Ok(None),
+    };
+    match serde_json::from_str::<Value>(&text) {
+        Ok(value) if is_sweep(&value) => {
+            let parsed = parse_text(&text, &folder, &Registry::builtin());
+            let parsed = match path {
+                Some(p) => parsed.map_err(|e| e.in_path(Path::new(p))),
+                None => parsed,
+            };
+            parsed.map(Some).map_err(|e| scene_error(py, &e))
+        }
+        _ => Ok(None),
+    }
+}
+
+/// What `flicker check` prints of a scene or a sweep, a line each.
+#[pyfunction]
+#[pyo3(signature = (text=None, path=None))]
+pub fn check(py: Python<'_>, text: Option<&str>, path: Option<&str>) -> PyResult<Vec<String>> {
+    let label = path.unwrap_or("<scene>");
+    if let Some(sweep) = as_sweep(py, text, path)? {
+        return Ok(sweep.check_lines(label));
+    }
+    let (scene, label) = load(py, text, path)?;
+    Ok(scene.check_lines(&label))
+}
+
+/// `flicker compare`: each method of the plan against the exact answer.
+/// Returns `{"reference": kind, "rows": {column: values}}`, the columns of
+/// `compare.csv` (NaN where a value is missing; `method` and `status` as
+/// lists of str).
+#[pyfunction]
+#[pyo3(signature = (text=None, path=None, methods=None, tolerances=None, steps=None))]
+pub fn compare<'py>(
+    py: Python<'py>,
+    text: Option<&str>,
+    path: Option<&str>,
+    methods: Option<Vec<String>>,
+    tolerances: Option<Vec<f64>>,
+    steps: Option<Vec<f64>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let (scene, _) = load(py, text, path)?;
+    let plan = Plan::new(&scene, methods, tolerances, steps)
+        .map_err(|e| override_error(py, e.field.as_deref().unwrap_or("methods"), e.reason))?;
+    let compared = py.detach(|| run_compare(&scene, &plan, &mut |_| {}));
+    let (reference, rows) = compared.map_err(|e| scene_error(py, &e))?;
+    let out = PyDict::new(py);
+    out.set_item("reference", reference.kind)?;
+    let columns = PyDict::new(py);
+    let nan = |x: Option<f64>| x.unwrap_or(f64::NAN);
+    columns.set_item(
+        "method",
+        PyList::new(py, rows.iter().map(|r| r.method.clone()))?,
+    )?;
+    columns.set_item(
+        "status",
+        PyList::new(py, rows.iter().map(|r| r.status.clone()))?,
+    )?;
+    let numbers: [(&str, fn(&flicker::compare::Row) -> Option<f64>); 10] = [
+        ("tolerance", |r| r.tolerance),
+        ("step", |r| r.step),
+        ("wall_seconds", |r| Some(r.wall_seconds)),
+        ("flow_evals", |r| Some(r.flow_evals as f64)),
+        ("events", |r| Some(r.events as f64)),
+        ("final_error", |r| Some(r.final_error)),
+        ("max_event_time_error", |r| r.max_event_time_error),
+        ("energy_error", |r| r.energy_error),
+        ("error_bound", |r| Some(r.error_bound)),
+        ("event_time_bound", |r| r.event_time_bound),
+    ];
+    for (key, value) in numbers {
+        let column: Vec<f64> = rows.iter().map(|r| nan(value(r))).collect();
+        columns.set_item(key, column.into_pyarray(py))?;
+    }
+    out.set_item("rows", columns)?;
+    Ok(out)
+}
+
+/// `flicker sweep`: every point of the sweep, on `threads` threads
+/// (default: one per core). Returns a dict of columns: `point` and each
+/// axis, then `status` (a list of str) and the results (NaN where a value
+/// is missing), as `flicker sweep` writes them.
+#[pyfunction]
+#[pyo3(signature = (text=None, path=None, threads=None))]
+pub fn sweep<'py>(
+    py: Python<'py>,
+    text: Option<&str>,
+    path: Option<&str>,
+    threads: Option<usize>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let Some(spec) = as_sweep(py, text, path)? else {
+        // Not a sweep: say why as a file that is not one would.
+        return Err(match load(py, text, path) {
+            Err(e) => e,
+            Ok(_) => override_error(
+                py,
+                "grid",
+                "a sweep is an object with `scene` and `grid`; this is a scene".into(),
+            ),
+        });
+    };
+    let pool = rayon_pool(threads).map_err(|e| override_error(py, "threads", e))?;
+    let rows = py.detach(|| pool.install(|| spec.run(Shard::WHOLE)));
+    let out = PyDict::new(py);
+    let header = spec.header();
+    let axes = &header[1..1 + spec.axes.len()];
+    out.set_item(
+        "point",
+        rows.iter()
+            .map(|r| r.point as u64)
+            .collect::<Vec<u64>>()
+            .into_pyarray(py),
+    )?;
+    for (k, key) in axes.iter().enumerate() {
+        let column: Vec<f64> = rows.iter().map(|r| r.values[k]).collect();
+        out.set_item(key, column.into_pyarray(py))?;
+    }
+    out.set_item(
+        "status",
+        PyList::new(py, rows.iter().map(|r| r.status.clone()))?,
+    )?;
+    out.set_item(
+        "events",
+        rows.iter()
+            .map(|r| r.events)
+            .collect::<Vec<u64>>()
+            .into_pyarray(py),
+    )?;
+    let nan = |x: Option<f64>| x.unwrap_or(f64::NAN);
+    let numbers: [(&str, fn(&SweepRow) -> Option<f64>); 6] = [
+        ("first_impact", |r| r.first_impact),
+        ("impact_period", |r| r.impact_period),
+        ("exact_period", |r| r.exact_period),
+        ("period_error", |r| r.period_error),
+        ("energy_error", |r| r.energy_error),
+        ("t_reached", |r| Some(r.t_reached)),
+    ];
+    for (key, value) in numbers {
+        let column: Vec<f64> = rows.iter().map(|r| nan(value(r))).collect();
+        out.set_item(key, column.into_pyarray(py))?;
+    }
+    Ok(out)
+}
+
+/// A pool of `threads` threads (default: one per core).
+fn rayon_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, String> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.unwrap_or(0))
+        .build()
+        .map_err(|e| e.to_string())
+}

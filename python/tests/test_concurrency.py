@@ -1,0 +1,52 @@
+"""Runs release the GIL: runs in Python threads give the results they give
+one after another; and Ctrl-C (SIGINT) stops a long run within a second,
+returning it with status `interrupted` instead of raising."""
+
+import json
+import os
+import signal
+import threading
+import time
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+
+import flicker
+from conftest import MODELS
+
+SCENES = [
+    MODELS / "mechanism_impacting.json",
+    MODELS / "automata" / "impact_oscillator.json",
+    MODELS / "automata" / "rocking_block.json",
+    MODELS / "chain_cradle.json",
+]
+
+
+def test_runs_in_threads_give_the_results_of_runs_one_after_another():
+    alone = [flicker.run(s) for s in SCENES * 2]
+    with ThreadPoolExecutor(4) as pool:
+        together = list(pool.map(flicker.run, SCENES * 2))
+    for a, b in zip(alone, together):
+        assert a.summary["final_state"] == b.summary["final_state"]
+        assert np.array_equal(a.events["t"], b.events["t"])
+        assert np.array_equal(a.events["after"], b.events["after"])
+
+
+def test_ctrl_c_stops_a_long_run_within_a_second():
+    scene = json.loads((MODELS / "mechanism_impacting.json").read_text())
+    scene["t_end"] = 1e12
+    scene["max_events"] = 10**15
+    sent = []
+
+    def interrupt():
+        time.sleep(0.5)
+        sent.append(time.perf_counter())
+        os.kill(os.getpid(), signal.SIGINT)
+
+    threading.Thread(target=interrupt, daemon=True).start()
+    run = flicker.run(scene, events=False)
+    returned = time.perf_counter()
+    assert sent, "the run ended before the signal"
+    assert run.status == "interrupted", run.summary
+    assert returned - sent[0] < 1.0
+    assert 0 < run.summary["t_reached"] < 1e12

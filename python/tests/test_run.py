@@ -1,0 +1,118 @@
+"""flicker.run against the command line on the same scenes: the same
+events, bit for bit, and the same summary; the arrays' dtypes and shapes;
+and one run checked against physics written out here."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+import flicker
+from conftest import MODELS, read_log
+
+SCENES = [
+    "mechanism_impacting.json",
+    "mechanism_angle.json",
+    "chain_cradle.json",
+    "continuum_release_paper.json",
+    "automata/bouncing_ball.json",
+    "automata/impact_oscillator.json",
+    "automata/mechanism_charts.json",
+]
+
+
+@pytest.mark.parametrize("name", SCENES)
+def test_the_same_scene_gives_the_same_events_as_the_command_line(name, cli, tmp_path):
+    done, out = cli("run", MODELS / name, "--out", tmp_path / "cli", "--quiet")
+    assert done.returncode in (0, 3), done.stderr
+    logged = read_log(tmp_path / "cli" / "events.jsonl")
+    summary = json.loads((tmp_path / "cli" / "summary.json").read_text())
+    run = flicker.run(MODELS / name)
+    ev = run.events
+    assert len(ev["t"]) == len(logged) > 0
+    for k, line in enumerate(logged):
+        assert ev["seq"][k] == line["seq"]
+        assert ev["t"][k] == line["t"]
+        assert ev["guard"][k] == line["guard"]
+        assert ev["mode_before"][k] == line["mode_before"]
+        assert ev["mode_after"][k] == line["mode_after"]
+        for side in ("before", "after"):
+            for name_, value in line[side].items():
+                column = run.state_names.index(name_)
+                assert ev[side][k, column] == value
+        for label in ("unit", "rel_velocity", "x"):
+            if label in line:
+                assert ev[label][k] == line[label]
+    # The summary as summary.json holds it, but for what names the run.
+    for key in ("scene", "log", "wall_seconds"):
+        summary.pop(key)
+        run.summary.pop(key)
+    assert run.summary == summary
+
+
+def test_arrays_have_their_dtypes_and_shapes():
+    run = flicker.run(MODELS / "automata" / "impact_oscillator.json")
+    ev = run.events
+    n = len(ev["t"])
+    assert n > 20
+    assert ev["t"].dtype == np.float64 and ev["seq"].dtype == np.uint64
+    for key in ("guard", "mode_before", "mode_after"):
+        assert ev[key].dtype.kind == "U" and ev[key].shape == (n,)
+    # The forced oscillator carries the clock as a state.
+    assert run.state_names == ["x", "v", "t"]
+    assert ev["before"].shape == ev["after"].shape == (n, 3)
+    assert ev["before"].dtype == np.float64
+    # No energy in this file: NaN, not zero.
+    assert np.isnan(ev["energy_before"]).all()
+    chain = flicker.run(MODELS / "chain_cradle.json")
+    assert chain.events["before"].shape == (len(chain.events["t"]), 0)
+    assert chain.events["unit"].dtype == np.int64
+    assert chain.trace["t"].dtype == np.float64
+    assert len(chain.profiles) == 3 and chain.profiles[0]["strain"].shape == (5,)
+
+
+def test_bounces_from_python_meet_the_closed_form():
+    g, e, h = 9.81, 0.8, 1.0
+    run = flicker.run(MODELS / "automata" / "bouncing_ball.json")
+    t = run.events["t"]
+    v = run.events["before"][:, run.state_names.index("v")]
+    falling = v < 0
+    t1 = math.sqrt(2 * h / g)
+    expected = t1 + 2 * t1 * e * (1 - e ** np.arange(falling.sum())) / (1 - e)
+    assert np.max(np.abs(t[falling] - expected)) < 1e-13
+
+
+def test_overrides_and_a_log_on_disk(cli, tmp_path):
+    log = tmp_path / "events.jsonl"
+    run = flicker.run(MODELS / "mechanism_impacting.json", t_end=50, method="dop853", rtol=1e-10, atol=1e-10, log=log)
+    assert run.summary["method"] == "dop853" and run.summary["t_end"] == 50
+    done, _ = cli(
+        "run", MODELS / "mechanism_impacting.json", "--out", tmp_path / "cli", "--quiet",
+        "--t-end", "50", "--method", "dop853", "--rtol", "1e-10", "--atol", "1e-10",
+    )
+    assert done.returncode == 0
+    assert log.read_bytes() == (tmp_path / "cli" / "events.jsonl").read_bytes()
+    assert run.summary["log"] == str(log)
+    quiet = flicker.run(MODELS / "mechanism_impacting.json", events=False)
+    assert quiet.events is None and quiet.summary["events"] == 234
+
+
+def test_a_dict_and_a_json_string_are_scenes():
+    scene = json.loads((MODELS / "automata" / "bouncing_ball.json").read_text())
+    from_dict = flicker.run(scene)
+    from_text = flicker.run(json.dumps(scene))
+    from_path = flicker.run(str(MODELS / "automata" / "bouncing_ball.json"))
+    assert np.array_equal(from_dict.events["t"], from_path.events["t"])
+    assert np.array_equal(from_text.events["before"], from_path.events["before"])
+    assert from_dict.summary["scene"] == "<scene>"
+
+
+def test_to_pandas_has_a_row_per_event_and_a_column_per_state():
+    pd = pytest.importorskip("pandas")
+    run = flicker.run(MODELS / "automata" / "bouncing_ball.json")
+    frame = run.to_pandas()
+    assert isinstance(frame, pd.DataFrame)
+    assert len(frame) == len(run.events["t"])
+    assert {"t", "guard", "before.y", "before.v", "after.v"} <= set(frame.columns)
+    assert np.allclose(frame["after.v"], -0.8 * frame["before.v"], rtol=1e-15, atol=0)
