@@ -155,10 +155,20 @@ fn run<'py>(
         stop: Some(stop.clone()),
         max_wall_seconds: None,
     };
+    let done = AtomicBool::new(false);
     let report = py.detach(|| {
         std::thread::scope(|s| {
-            let worker = s.spawn(|| scene.run(&control, &mut keep));
-            while !worker.is_finished() {
+            // The worker says it is done and wakes the caller (a wake-up
+            // given before the caller waits is kept for it).
+            let caller = std::thread::current();
+            let (scene, control, keep, finished) = (&scene, &control, &mut keep, &done);
+            let worker = s.spawn(move || {
+                let report = scene.run(control, keep);
+                finished.store(true, Ordering::Release);
+                caller.unpark();
+                report
+            });
+            while !done.load(Ordering::Acquire) {
                 std::thread::park_timeout(POLL);
                 // A pending Ctrl-C raises here: it becomes the run's stop.
                 if Python::attach(|py| py.check_signals()).is_err() {
