@@ -168,7 +168,8 @@ fn run<'py>(
                 caller.unpark();
                 report
             });
-            while !done.load(Ordering::Acquire) {
+            // A worker that panicked never says it is done, but is finished.
+            while !done.load(Ordering::Acquire) && !worker.is_finished() {
                 std::thread::park_timeout(POLL);
                 // A pending Ctrl-C raises here: it becomes the run's stop.
                 if Python::attach(|py| py.check_signals()).is_err() {
