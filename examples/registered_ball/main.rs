@@ -121,6 +121,7 @@ impl SceneModel for BallScene {
             description: "free flight in closed form, exact landing times".into(),
             final_state,
             fields: None,
+            sensitivities: None,
         })
     }
     fn clone_box(&self) -> Box<dyn SceneModel> {

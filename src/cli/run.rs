@@ -48,6 +48,12 @@ pub struct RunArgs {
     solver: SolverFlags,
     #[command(flatten)]
     ensemble: EnsembleFlags,
+    /// Also carry the derivatives of the state and of every event time
+    /// along these directions (comma-separated: a parameter's name, or
+    /// initial.STATE), into the summary's `sensitivities` and each event's
+    /// states (automata).
+    #[arg(long, value_name = "LIST", value_delimiter = ',')]
+    sensitivities: Option<Vec<String>>,
 }
 
 /// A scene's reproducibility horizon.
@@ -99,6 +105,7 @@ pub fn run(args: RunArgs, registry: &Registry) -> Result<Code, Failure> {
         plot,
         solver,
         ensemble,
+        sensitivities,
     } = args;
     let scene_path = scene_path.as_path();
     let log_events = !no_events;
@@ -122,6 +129,11 @@ pub fn run(args: RunArgs, registry: &Registry) -> Result<Code, Failure> {
                 e.in_path(scene_path)
             ))
         })?;
+    }
+    if let Some(directions) = &sensitivities {
+        scene
+            .set_sensitivities(directions)
+            .map_err(|e| Failure::bad_input(format!("--sensitivities: {}", e.reason)))?;
     }
     let ensemble = match ensemble.ensemble {
         None => None,

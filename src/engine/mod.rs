@@ -15,6 +15,7 @@ pub mod linear;
 pub mod local;
 pub mod locate;
 pub mod model;
+pub mod names;
 pub mod observer;
 pub mod queue;
 pub mod run;
@@ -22,6 +23,7 @@ mod run_loop;
 pub mod simulation;
 pub mod tangent;
 pub mod taylor;
+pub mod variational;
 pub mod verlet;
 pub mod zeno;
 

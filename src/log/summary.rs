@@ -10,7 +10,10 @@
 //! where not tracked), `wall_seconds`, `log` (path of the event log or
 //! null); for chains, `momentum` (total, at the end) and
 //! `momentum_balance_error` (against the end load's and the wall's
-//! impulses, relative; exact path only), null for other models.
+//! impulses, relative; exact path only), null for other models; with
+//! `--sensitivities`, `sensitivities`: for each direction, the derivatives
+//! of the final state (`final_state`, by name) and of the last event's time
+//! (`last_event_time`).
 
 use std::io;
 use std::path::Path;
@@ -27,7 +30,7 @@ pub fn summary(report: &Report, model: &str, scene: &Path, log: Option<&Path>) -
         .iter()
         .map(|(name, x)| (name.to_string(), json!(x)))
         .collect();
-    json!({
+    let mut value = json!({
         "status": o.status.as_str(),
         "reason": o.reason,
         "model": model,
@@ -51,7 +54,11 @@ pub fn summary(report: &Report, model: &str, scene: &Path, log: Option<&Path>) -
         "log": log.map(|p| p.display().to_string()),
         "momentum": report.fields.as_ref().map(|c| c.momentum),
         "momentum_balance_error": report.fields.as_ref().and_then(|c| c.momentum_balance_error),
-    })
+    });
+    if let Some(sensitivities) = &report.sensitivities {
+        value["sensitivities"] = sensitivities.clone();
+    }
+    value
 }
 
 /// Write `value` to `path` through a temporary file and a rename, so a

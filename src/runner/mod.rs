@@ -25,6 +25,10 @@ pub struct Report {
     pub final_state: Vec<(&'static str, f64)>,
     /// What a model with extent adds: momentum, profiles, the trace.
     pub fields: Option<FieldOutputs>,
+    /// The derivatives of the final state and of the last event's time
+    /// along each direction asked for (`flicker run --sensitivities`), as
+    /// the summary's `sensitivities` entry.
+    pub sensitivities: Option<serde_json::Value>,
 }
 
 /// A run with its state sampled along the way: what pictures of any two

@@ -57,6 +57,21 @@ pub trait SceneModel: fmt::Debug + Send + Sync + 'static {
     /// Run the scene under `control`, reporting events to `observer`.
     fn run(&self, control: &Control, observer: &mut dyn Observer) -> Result<Report, SceneError>;
 
+    /// Have this scene's runs carry the derivatives of their state and of
+    /// every event time along `directions` (`NAME`, a parameter, or
+    /// `initial.NAME`, a state's initial value): `flicker run
+    /// --sensitivities`. Checked now; a model that gives none says so.
+    fn set_sensitivities(&mut self, directions: &[String]) -> Result<(), SceneError> {
+        let _ = directions;
+        Err(SceneError::field(
+            "sensitivities",
+            format!(
+                "a {} scene gives no sensitivities (automata do: write the model as one)",
+                self.model()
+            ),
+        ))
+    }
+
     /// The exact answer numerical methods are measured against
     /// (`flicker compare`, `flicker stress`), where the model has one.
     fn reference(&self) -> Result<Reference, SceneError> {

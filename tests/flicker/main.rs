@@ -28,6 +28,7 @@ mod registry;
 mod reproducible;
 mod scenes;
 mod schemas;
+mod sensitivities;
 mod stress;
 mod support;
 mod sweep;

@@ -115,6 +115,8 @@ pub struct Definition {
     pub states: Vec<String>,
     /// The initial value of each state.
     pub initial: Vec<f64>,
+    /// The expression each initial value came from.
+    pub initial_sources: Vec<Source>,
     /// The modes.
     pub modes: Vec<ModeDef>,
     /// The mode the run starts in.
@@ -130,7 +132,7 @@ impl Definition {
     pub fn read(f: &mut Fields) -> Result<Definition, SceneError> {
         let parameters = parameters(f)?;
         let states = states(f, &parameters)?;
-        let initial = initial(f, &states, &parameters)?;
+        let (initial, initial_sources) = initial(f, &states, &parameters)?.into_iter().unzip();
         let modes_value = f.required("modes")?;
         let modes_map = object(modes_value, &f.path("modes"))?;
         if modes_map.is_empty() || modes_map.len() > MAX_ITEMS {
@@ -173,6 +175,7 @@ impl Definition {
             parameters,
             states,
             initial,
+            initial_sources,
             modes,
             initial_mode,
             energy,
@@ -191,6 +194,56 @@ impl Definition {
                 )
             })
             .chain(self.energy.iter().flatten())
+    }
+
+    /// The same automaton with the parameters `names` turned into states
+    /// that never change (appended, in that order, to the states), so that
+    /// what depends on them can be differentiated as on any state; and,
+    /// for each, the derivative of every initial value with respect to it
+    /// (an initial value may be an expression of the parameters). An
+    /// unknown name is refused with the nearest.
+    pub fn with_parameters_as_states(
+        &self,
+        names: &[String],
+    ) -> Result<(Definition, Vec<Vec<f64>>), SceneError> {
+        use crate::models::automaton::expr::derivative::jacobian;
+        use crate::models::automaton::expr::{Scope, Tape};
+        let known: Vec<&str> = self.parameters.iter().map(|(p, _)| p.as_str()).collect();
+        let mut promoted = self.clone();
+        let mut slopes = Vec::new();
+        for name in names {
+            let k = index_of(name, &known, "parameter", "sensitivities")?;
+            let (_, value) = self.parameters[k].clone();
+            // d x0 / d p: the initial values' expressions with p as their input.
+            let scope = Scope {
+                inputs: vec![name.clone()],
+                constants: self
+                    .parameters
+                    .iter()
+                    .filter(|(p, _)| p != name)
+                    .cloned()
+                    .collect(),
+            };
+            let mut slope = Vec::new();
+            for source in &self.initial_sources {
+                let tape = Tape::compile(&[&source.ast], &scope)
+                    .map_err(|e| source.error(e.at, &e.message))?;
+                slope.push(jacobian(&tape, &[value])[(0, 0)]);
+            }
+            slopes.push(slope);
+            promoted.parameters.retain(|(p, _)| p != name);
+            promoted.states.push(name.clone());
+            promoted.initial.push(value);
+            promoted.initial_sources.push(Source {
+                text: value.to_string(),
+                path: format!("parameters.{name}"),
+                ast: Ast::Number(value),
+            });
+            for mode in &mut promoted.modes {
+                mode.flow.push(None);
+            }
+        }
+        Ok((promoted, slopes))
     }
 
     /// Whether any expression reads the clock `t` (a forced system).
@@ -342,13 +395,13 @@ fn states(f: &mut Fields, parameters: &[(String, f64)]) -> Result<Vec<String>, S
     Ok(states)
 }
 
-/// The initial value of each state: numbers or expressions of the
-/// parameters.
+/// The initial value of each state, and its expression: numbers or
+/// expressions of the parameters.
 fn initial(
     f: &mut Fields,
     states: &[String],
     parameters: &[(String, f64)],
-) -> Result<Vec<f64>, SceneError> {
+) -> Result<Vec<(f64, Source)>, SceneError> {
     use crate::models::automaton::expr::{Scope, Tape};
     let path = f.path("initial");
     let map = object(f.required("initial")?, &path)?;
@@ -377,7 +430,7 @@ fn initial(
                 source.error(e.at, &message)
             })?;
             match tape.constant() {
-                Some(c) if c[0].is_finite() => Ok(c[0]),
+                Some(c) if c[0].is_finite() => Ok((c[0], source)),
                 _ => Err(SceneError::field(
                     &at,
                     format!("`{}` is not a finite number", source.text),

@@ -63,6 +63,7 @@ pub mod ensemble;
 pub mod expr;
 pub mod model;
 pub mod scene;
+pub mod sensitivities;
 
 pub use builder::{AutomatonBuilder, TransitionBuilder};
 pub use definition::Definition;

@@ -12,11 +12,10 @@
 //! shape `[q; v]` with `q' = v` and `v'` free of `v` is second order.
 
 use std::cell::RefCell;
-use std::collections::HashSet;
-use std::sync::{Mutex, OnceLock};
 
 use nalgebra::{DMatrix, DVector};
 
+use crate::engine::names::intern;
 use crate::engine::{Flow, Guard, HybridModel, Jump, Mode};
 use crate::models::automaton::definition::{Definition, Source};
 use crate::models::automaton::expr::derivative::{jacobian, jacobian_into};
@@ -394,23 +393,4 @@ thread_local! {
     /// Scratch for Taylor series (models are shared, read only, between
     /// the threads of a sweep).
     static SERIES: RefCell<Series> = RefCell::new(Series::default());
-}
-
-/// A name that lives as long as the program: the engine's logs take
-/// `&'static str`. Each distinct name is stored once, however many scenes
-/// use it.
-fn intern(name: &str) -> &'static str {
-    static NAMES: OnceLock<Mutex<HashSet<&'static str>>> = OnceLock::new();
-    let mut names = NAMES
-        .get_or_init(Default::default)
-        .lock()
-        .unwrap_or_else(|poisoned| poisoned.into_inner());
-    match names.get(name) {
-        Some(known) => known,
-        None => {
-            let leaked: &'static str = Box::leak(name.to_string().into_boxed_str());
-            names.insert(leaked);
-            leaked
-        }
-    }
 }

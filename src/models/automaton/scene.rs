@@ -39,6 +39,9 @@ pub struct AutomatonScene {
     pub max_events: u64,
     /// Free text.
     pub description: Option<String>,
+    /// Directions of the derivatives runs carry (`--sensitivities`; none
+    /// by default).
+    pub sensitivities: Vec<String>,
 }
 
 /// Validate the keys of an automaton scene.
@@ -57,6 +60,7 @@ pub fn scene(mut f: Fields) -> Result<Scene, SceneError> {
         tolerances: Tolerances::default(),
         max_events,
         description,
+        sensitivities: Vec::new(),
     };
     let solver = match f.optional("solver") {
         Some(value) => SolverSpec::from_json(value)?,
@@ -135,14 +139,28 @@ impl AutomatonScene {
 }
 
 impl AutomatonScene {
-    /// The run, with the state at each of `times` passed to `on_sample`.
+    /// The run (with the derivatives asked for, if any), with the state at
+    /// each of `times` passed to `on_sample`.
     fn run_sampled(
         &self,
         control: &Control,
         times: &[f64],
         on_sample: &mut dyn FnMut(&Sample),
         observer: &mut dyn Observer,
-    ) -> Report {
+    ) -> Result<Report, SceneError> {
+        if !self.sensitivities.is_empty() {
+            return super::sensitivities::run(
+                &self.definition,
+                &self.sensitivities,
+                self.method,
+                self.tolerances,
+                (self.t_end, self.max_events),
+                control,
+                times,
+                on_sample,
+                observer,
+            );
+        }
         let (method, description) = self.resolved();
         let options = control.options(self.t_end, self.max_events, method, self.tolerances);
         let model = &*self.automaton;
@@ -161,13 +179,14 @@ impl AutomatonScene {
             .copied()
             .zip(outcome.final_state.iter().copied())
             .collect();
-        Report {
+        Ok(Report {
             outcome,
             method: method.name(),
             description,
             final_state,
             fields: None,
-        }
+            sensitivities: None,
+        })
     }
 }
 
@@ -289,7 +308,13 @@ impl SceneModel for AutomatonScene {
     }
 
     fn run(&self, control: &Control, observer: &mut dyn Observer) -> Result<Report, SceneError> {
-        Ok(self.run_sampled(control, &[], &mut |_| {}, observer))
+        self.run_sampled(control, &[], &mut |_| {}, observer)
+    }
+
+    fn set_sensitivities(&mut self, directions: &[String]) -> Result<(), SceneError> {
+        super::sensitivities::check(&self.definition, directions)?;
+        self.sensitivities = directions.to_vec();
+        Ok(())
     }
 
     fn sampled(
@@ -305,6 +330,10 @@ impl SceneModel for AutomatonScene {
             &mut |s| samples.push((s.t, s.state.to_vec())),
             observer,
         );
+        let report = match report {
+            Ok(report) => report,
+            Err(e) => return Some(Err(e)),
+        };
         Some(Ok(Trajectory {
             names: self.automaton.state_names(0).to_vec(),
             samples,

@@ -269,5 +269,6 @@ fn report(
             ("right_end", fields.right_end),
         ],
         fields: Some(fields),
+        sensitivities: None,
     }
 }

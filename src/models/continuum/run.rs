@@ -47,6 +47,7 @@ pub(crate) fn run(
             ("right_end", fields.right_end),
         ],
         fields: Some(fields),
+        sensitivities: None,
     })
 }
 

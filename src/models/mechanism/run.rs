@@ -58,6 +58,7 @@ pub(crate) fn run(
                 description,
                 final_state,
                 fields: None,
+                sensitivities: None,
             })
         }
         Formulation::Angle(charts) => {
@@ -91,6 +92,7 @@ pub(crate) fn run(
                 description,
                 final_state: vec![("strain", e), ("strain_rate", r)],
                 fields: None,
+                sensitivities: None,
             })
         }
     }
