@@ -67,6 +67,7 @@ pub mod engine;
 pub mod log;
 pub mod models;
 pub mod numerics;
+pub mod orbit;
 pub mod plot;
 pub mod runner;
 pub mod scene;

@@ -28,6 +28,7 @@ pub mod compare;
 pub mod compare_models;
 pub mod events;
 pub mod exit;
+pub mod orbit;
 pub mod plot;
 pub mod progress;
 pub mod run;
@@ -137,6 +138,9 @@ enum Command {
         /// The scene file (JSON).
         scene: PathBuf,
     },
+    /// Find a periodic orbit through a Poincare section (Newton shooting)
+    /// and its stability; writes DIR/orbit.json.
+    Orbit(orbit::OrbitArgs),
     /// Print the JSON Schema of scene files, for every model this program
     /// knows (schemas/scene.schema.json is its output for the built-in ones).
     Schema,
@@ -156,7 +160,8 @@ enum Command {
         /// Print a summary (JSON) instead of the events.
         #[arg(long, conflicts_with = "csv")]
         summary: bool,
-        /// Print the events as CSV (seq, t, guard, energy_before, energy_after).
+        /// Print the events as CSV (seq, t, guard, modes, energies, labels,
+        /// and each state before and after).
         #[arg(long)]
         csv: bool,
     },
@@ -190,6 +195,7 @@ pub fn dispatch(cli: Cli, registry: &Registry) -> Result<Code, Failure> {
             out,
         } => compare::compare(registry, &scene, methods, tolerances, steps, out),
         Command::CompareModels(args) => compare_models::compare_models(args, registry),
+        Command::Orbit(args) => orbit::orbit(args, registry),
         Command::Advise(args) => advise::advise(args, registry),
         Command::Stress {
             dir,

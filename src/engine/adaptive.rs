@@ -42,6 +42,14 @@ pub enum StepFailure {
         /// The step size asked for.
         h: f64,
     },
+    /// A guard's series converges over no step above `h_min` (Taylor's
+    /// method): the guard turns steep here (a square root at zero).
+    GuardCollapsed {
+        /// The step size the guard allows.
+        h: f64,
+        /// The guard.
+        guard: usize,
+    },
     /// The right-hand side returned a non-finite value.
     NonFinite,
     /// The method cannot integrate this mode (said why).

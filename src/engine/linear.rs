@@ -47,7 +47,10 @@ pub struct Linear {
     /// Scratch: one term of the augmented series and the next.
     term: Vec<f64>,
     next: Vec<f64>,
-    /// A guard's series along the step.
+    /// Each guard's series along the step, one after another (where the
+    /// model gives them).
+    guards: Vec<f64>,
+    /// A guard's series, scratch for its search.
     guard: Vec<f64>,
     y1: Vec<f64>,
     /// Propagator evaluations; a `Cell` because evaluation reads `&self`.
@@ -75,6 +78,7 @@ impl Linear {
             series: vec![0.0; dimension * (ORDER + 1)],
             term: vec![0.0; dimension + 1],
             next: vec![0.0; dimension + 1],
+            guards: Vec::new(),
             guard: vec![0.0; ORDER + 1],
             y1: vec![0.0; dimension],
             evaluations: Cell::new(0),
@@ -151,6 +155,9 @@ impl Linear {
             }
         }
         self.evaluations.set(self.evaluations.get() + 1);
+        if model.has_series(mode) {
+            self.fit_guards(model, mode);
+        }
         let mut y1 = std::mem::take(&mut self.y1);
         self.eval(self.h, &mut y1);
         self.y1 = y1;
@@ -158,6 +165,32 @@ impl Linear {
             return Err(StepFailure::NonFinite);
         }
         Ok(())
+    }
+
+    /// Each guard's series along the step (kept for [`Linear::locate`]),
+    /// and the step shortened until every one of them is summed to
+    /// round-off by its terms: the state's series converge over `|M| h <=
+    /// 1`, but a guard may read the clock through a sine of any frequency.
+    fn fit_guards<M: HybridModel + ?Sized>(&mut self, model: &M, mode: Mode) {
+        let w = ORDER + 1;
+        let guards = model.guards(mode).len();
+        self.guards.resize(guards * w, 0.0);
+        let size = self.y0.iter().fold(1.0_f64, |m, v| m.max(v.abs()));
+        for g in 0..guards {
+            let c = &mut self.guards[g * w..(g + 1) * w];
+            model.guard_series(mode, g, &self.series, ORDER, c);
+            let scale = c.iter().fold(size, |m, v| m.max(v.abs()));
+            // The last two terms at the step's length far below round-off
+            // (1e-20 of the guard's size: as far as the state's own, whose
+            // last term is at most 1 / 24!).
+            while self.h > 0.0
+                && (c[ORDER - 1].abs() * self.h.powi(ORDER as i32 - 1)
+                    + c[ORDER].abs() * self.h.powi(ORDER as i32))
+                    > 1e-20 * scale
+            {
+                self.h *= 0.5;
+            }
+        }
     }
 
     /// The exact state `tau` after the step's start: the step's series
@@ -189,7 +222,9 @@ impl Linear {
         if !model.has_series(mode) {
             return None;
         }
-        model.guard_series(mode, guard, &self.series, ORDER, &mut self.guard);
+        let w = ORDER + 1;
+        self.guard
+            .copy_from_slice(&self.guards[guard * w..(guard + 1) * w]);
         Some(crate::engine::taylor::locate_on_series(
             model,
             mode,

@@ -298,6 +298,21 @@ pub trait HybridModel {
         false
     }
 
+    /// The gradient of `guard` at `x` in `mode` into `out`, where the
+    /// model knows it exactly; `false` (differences are taken) where not.
+    fn guard_gradient(&self, mode: Mode, guard: usize, x: &[f64], out: &mut [f64]) -> bool {
+        let _ = (mode, guard, x, out);
+        false
+    }
+
+    /// The Jacobian of `guard`'s reset at `x` in `mode` into `out`
+    /// (row-major `n x n`), where the model knows it exactly; `false`
+    /// where not.
+    fn reset_jacobian(&self, mode: Mode, guard: usize, x: &[f64], out: &mut [f64]) -> bool {
+        let _ = (mode, guard, x, out);
+        false
+    }
+
     /// Whether a guard or a reset may be undefined somewhere (a model read
     /// from a file, whose expressions may take a square root of a negative
     /// number): the run then checks every guard where each stretch of flow

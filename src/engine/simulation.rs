@@ -639,6 +639,20 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
                 self.model.mode_name(self.mode),
                 self.state
             ),
+            StepFailure::GuardCollapsed { h, guard } => {
+                let why = self
+                    .model
+                    .diagnose_guard(self.mode, guard, &self.state, false)
+                    .map_or_else(String::new, |why| format!(": {why}"));
+                return End::failed(format!(
+                    "the step size of {} collapsed to {h:.3e} at t = {t} in mode `{}` (state {:?}): \
+                     guard `{}` turns steep there{why}",
+                    self.integrator.name(),
+                    self.model.mode_name(self.mode),
+                    self.state,
+                    self.model.guards(self.mode)[guard].name
+                ));
+            }
             StepFailure::NotApplicable(why) => {
                 format!(
                     "method `{}` cannot run this model: {why}",

@@ -39,7 +39,10 @@ pub struct Taylor {
     order: usize,
     /// `series[i * (order + 1) + k]`: coefficient `k` of component `i`.
     series: Vec<f64>,
-    /// A guard's series, scratch.
+    /// Each guard's series along the current step, one after another
+    /// (`order + 1` each), computed with the step.
+    guards: Vec<f64>,
+    /// A guard's series, scratch for its search.
     guard: Vec<f64>,
     h: f64,
     local_error: f64,
@@ -55,6 +58,7 @@ impl Taylor {
             tolerances,
             order,
             series: vec![0.0; dimension * (order + 1)],
+            guards: Vec::new(),
             guard: vec![0.0; order + 1],
             h: 0.0,
             local_error: 0.0,
@@ -103,10 +107,37 @@ impl Taylor {
                 (scale / n).powf(1.0 / k as f64)
             }
         };
-        let rho = radius(p - 1).min(radius(p));
+        let mut rho = radius(p - 1).min(radius(p));
+        let mut limited_by = None;
+        // A guard's series must converge over the step too: a flow whose
+        // series ends (a polynomial, a clock) says nothing of a guard that
+        // reads the clock through a sine. Each guard's radius, measured
+        // alike, may shorten the step.
+        let guards = model.guards(mode).len();
+        self.guards.resize(guards * w, 0.0);
+        for g in 0..guards {
+            let c = &mut self.guards[g * w..(g + 1) * w];
+            model.guard_series(mode, g, &self.series, p, c);
+            self.evaluations += 1;
+            let guard_radius = |k: usize| {
+                let n = c[k].abs();
+                if n == 0.0 {
+                    f64::INFINITY
+                } else {
+                    (scale / n).powf(1.0 / k as f64)
+                }
+            };
+            let guard_rho = guard_radius(p - 1).min(guard_radius(p));
+            if guard_rho < rho {
+                (rho, limited_by) = (guard_rho, Some(g));
+            }
+        }
         let h = (rho / std::f64::consts::E.powi(2) * (-0.7 / (p - 1) as f64).exp()).min(h_max);
         if !(h >= h_min) {
-            return Err(StepFailure::Collapsed { h });
+            return Err(match limited_by {
+                Some(guard) => StepFailure::GuardCollapsed { h, guard },
+                None => StepFailure::Collapsed { h },
+            });
         }
         self.h = h;
         // The last term kept, the size of the first left out.
@@ -159,9 +190,9 @@ impl Taylor {
         check_start: bool,
         uncertainty: f64,
     ) -> Result<StepScan, String> {
-        let p = self.order;
-        model.guard_series(mode, guard, &self.series, p, &mut self.guard);
-        self.evaluations += 1;
+        let w = self.order + 1;
+        self.guard
+            .copy_from_slice(&self.guards[guard * w..(guard + 1) * w]);
         locate_on_series(
             model,
             mode,

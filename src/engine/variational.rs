@@ -190,24 +190,35 @@ impl<M: HybridModel + ?Sized> HybridModel for Variational<'_, M> {
     fn reset(&self, mode: Mode, guard: usize, x: &mut [f64]) -> Jump {
         let (n, m) = (self.n, self.m);
         let before = x[..n].to_vec();
-        // The guard's gradient and the reset's Jacobian, by central
-        // differences (exact for affine guards and resets, to round-off).
+        // The guard's gradient and the reset's Jacobian: the model's exact
+        // ones where it gives them, else central differences (exact for
+        // affine guards and resets, to round-off; about 1e-10 otherwise).
         let mut gradient = vec![0.0; n];
         let mut reset = vec![0.0; n * n];
-        let (mut up, mut down) = (before.clone(), before.clone());
-        for k in 0..n {
-            let h = step_for(before[k]);
-            up.copy_from_slice(&before);
-            up[k] += h;
-            down.copy_from_slice(&before);
-            down[k] -= h;
-            gradient[k] = (self.model.guard(mode, guard, &up)
-                - self.model.guard(mode, guard, &down))
-                / (2.0 * h);
-            self.model.reset(mode, guard, &mut up);
-            self.model.reset(mode, guard, &mut down);
-            for i in 0..n {
-                reset[i * n + k] = (up[i] - down[i]) / (2.0 * h);
+        let exact_gradient = self
+            .model
+            .guard_gradient(mode, guard, &before, &mut gradient);
+        let exact_reset = self.model.reset_jacobian(mode, guard, &before, &mut reset);
+        if !(exact_gradient && exact_reset) {
+            let (mut up, mut down) = (before.clone(), before.clone());
+            for k in 0..n {
+                let h = step_for(before[k]);
+                up.copy_from_slice(&before);
+                up[k] += h;
+                down.copy_from_slice(&before);
+                down[k] -= h;
+                if !exact_gradient {
+                    gradient[k] = (self.model.guard(mode, guard, &up)
+                        - self.model.guard(mode, guard, &down))
+                        / (2.0 * h);
+                }
+                if !exact_reset {
+                    self.model.reset(mode, guard, &mut up);
+                    self.model.reset(mode, guard, &mut down);
+                    for i in 0..n {
+                        reset[i * n + k] = (up[i] - down[i]) / (2.0 * h);
+                    }
+                }
             }
         }
         let jump = self.model.reset(mode, guard, &mut x[..n]);

@@ -18,6 +18,7 @@ use serde_json::Value;
 use crate::compare::Reference;
 use crate::compare_models::Release;
 use crate::engine::Observer;
+use crate::orbit::{Orbit, OrbitRequest};
 use crate::runner::ensemble::{EnsembleReport, EnsembleRequest};
 use crate::runner::{Control, Report, Trajectory};
 use crate::scene::SceneError;
@@ -67,6 +68,20 @@ pub trait SceneModel: fmt::Debug + Send + Sync + 'static {
             "sensitivities",
             format!(
                 "a {} scene gives no sensitivities (automata do: write the model as one)",
+                self.model()
+            ),
+        ))
+    }
+
+    /// The periodic orbit `request` asks for (`flicker orbit`), found by
+    /// Newton shooting through a Poincare section. Default: the model
+    /// offers no search.
+    fn orbit(&self, request: &OrbitRequest) -> Result<Orbit, SceneError> {
+        let _ = request;
+        Err(SceneError::field(
+            "section",
+            format!(
+                "a {} scene has no periodic-orbit search (automata do: write the model as one)",
                 self.model()
             ),
         ))

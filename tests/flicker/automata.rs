@@ -237,7 +237,7 @@ fn mechanism_automaton_agrees_with_the_built_in_exact_model() {
 /// `x'' + 2 zeta x' + x = cos(w t)` between impacts, from `(x0, v0)` at
 /// `t0`: the particular solution `X cos(w t) + Y sin(w t)` plus the damped
 /// homogeneous one fitted to the start.
-fn forced_oscillator(zeta: f64, w: f64, t0: f64, x0: f64, v0: f64, t: f64) -> (f64, f64) {
+pub fn forced_oscillator(zeta: f64, w: f64, t0: f64, x0: f64, v0: f64, t: f64) -> (f64, f64) {
     let d = (1.0 - w * w).powi(2) + (2.0 * zeta * w).powi(2);
     let (px, py) = ((1.0 - w * w) / d, 2.0 * zeta * w / d);
     let p = |t: f64| px * (w * t).cos() + py * (w * t).sin();

@@ -22,6 +22,7 @@ mod homogenized;
 mod invariants;
 mod mechanism_angle;
 mod mechanism_strain;
+mod orbits;
 mod oscillator;
 mod phase;
 mod registry;

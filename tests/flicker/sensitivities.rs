@@ -117,9 +117,8 @@ fn forced_oscillator_sensitivities_equal_central_differences() {
 /// move with eta), the impacts come every `T = (2 / omega) atan2(sqrt(2
 /// H0), 1 - eta)`: each impact time's derivative grows by `dT/d eta = (2 /
 /// omega) sqrt(2 H0) / (2 H0 + (1 - eta)^2)` per impact, which the log's
-/// `dt/deta` shows to 1e-8 (each reset's Jacobian and the guard's gradient
-/// are central differences, good to about 1e-11, and the derivatives they
-/// carry grow as `k dT/d eta`).
+/// `dt/deta` shows to 1e-11 (the automaton's Jacobians are exact; the
+/// derivatives grow as `k dT/d eta`, and their rounding with them).
 #[test]
 fn impact_times_move_with_eta_as_the_closed_form_period_does() {
     let (eta, omega, h0) = (1.2_f64, 1.0_f64, 0.025_f64);

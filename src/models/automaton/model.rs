@@ -271,6 +271,32 @@ impl HybridModel for Automaton {
         true
     }
 
+    /// Exact, by forward differentiation along the guard's tape.
+    fn guard_gradient(&self, mode: Mode, guard: usize, x: &[f64], out: &mut [f64]) -> bool {
+        jacobian_into(&self.modes[mode].guard_tapes[guard], x, out);
+        true
+    }
+
+    /// Exact: the identity on the states the reset leaves alone, its
+    /// tape's derivatives on the others.
+    fn reset_jacobian(&self, mode: Mode, guard: usize, x: &[f64], out: &mut [f64]) -> bool {
+        let n = x.len();
+        let reset = &self.modes[mode].resets[guard];
+        out.fill(0.0);
+        for i in 0..n {
+            out[i * n + i] = 1.0;
+        }
+        if reset.targets.is_empty() {
+            return true;
+        }
+        let mut rows = vec![0.0; reset.targets.len() * n];
+        jacobian_into(&reset.tape, x, &mut rows);
+        for (k, &i) in reset.targets.iter().enumerate() {
+            out[i * n..(i + 1) * n].copy_from_slice(&rows[k * n..(k + 1) * n]);
+        }
+        true
+    }
+
     fn second_order(&self, mode: Mode) -> bool {
         self.modes[mode].second_order
     }

@@ -11,6 +11,7 @@ use crate::engine::{
 };
 use crate::models::automaton::definition::Definition;
 use crate::models::automaton::model::Automaton;
+use crate::orbit::{Orbit, OrbitRequest};
 use crate::runner::ensemble::{EnsembleReport, EnsembleRequest};
 use crate::runner::{Control, Report, Trajectory};
 use crate::scene::fields::Fields;
@@ -309,6 +310,11 @@ impl SceneModel for AutomatonScene {
 
     fn run(&self, control: &Control, observer: &mut dyn Observer) -> Result<Report, SceneError> {
         self.run_sampled(control, &[], &mut |_| {}, observer)
+    }
+
+    /// Every return of the section map within the scene's `t_end`.
+    fn orbit(&self, request: &OrbitRequest) -> Result<Orbit, SceneError> {
+        crate::orbit::search(&self.automaton, request, self.t_end)
     }
 
     fn set_sensitivities(&mut self, directions: &[String]) -> Result<(), SceneError> {

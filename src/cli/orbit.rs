@@ -1,0 +1,143 @@
+//! `flicker orbit`: a periodic orbit of a scene through a Poincare section,
+//! by Newton shooting, written to `DIR/orbit.json`.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use serde_json::{Value, json};
+
+use crate::log::summary::write_atomically;
+use crate::orbit::{Orbit, OrbitRequest};
+use crate::scene::Registry;
+
+use crate::cli::exit::{Code, Failure};
+
+/// `flicker orbit`'s arguments.
+#[derive(Debug, clap::Args)]
+pub struct OrbitArgs {
+    /// The scene file (an automaton).
+    scene: PathBuf,
+    /// The transition whose events are the section (an impact).
+    #[arg(long, value_name = "GUARD")]
+    section: String,
+    /// Section events per period.
+    #[arg(long, value_name = "K", default_value_t = 1)]
+    events: usize,
+    /// Run this long first and start from the next section event (let a
+    /// transient die out).
+    #[arg(long, value_name = "T", default_value_t = 0.0)]
+    settle: f64,
+    /// The forcing's period, for an automaton that reads the clock: the
+    /// orbit's period is a whole number of them.
+    #[arg(long = "forcing-period", value_name = "T")]
+    forcing_period: Option<f64>,
+    // The `<scene name>` below is clap's placeholder, not an HTML tag.
+    #[allow(rustdoc::invalid_html_tags)]
+    /// Output directory (default: out/<scene name>-orbit).
+    #[arg(long, value_name = "DIR")]
+    out: Option<PathBuf>,
+}
+
+/// The contents of `orbit.json`.
+pub fn orbit_json(orbit: &Orbit, scene: &Path, section: &str, wall: f64) -> Value {
+    let state: serde_json::Map<String, Value> = orbit
+        .section_state
+        .iter()
+        .map(|(n, x)| (n.to_string(), json!(x)))
+        .collect();
+    let multipliers: Vec<Value> = orbit
+        .multipliers
+        .iter()
+        .map(|(re, im)| json!([re, im]))
+        .collect();
+    json!({
+        "status": orbit.status,
+        "converged": orbit.converged,
+        "scene": scene.display().to_string(),
+        "section": section,
+        "period": orbit.period,
+        "events_per_period": orbit.events_per_period,
+        "mode": orbit.mode,
+        "section_state": state,
+        "multipliers": multipliers,
+        "stable": orbit.stable,
+        "residual": orbit.residual,
+        "iterations": orbit.iterations,
+        "newton_residuals": orbit.residuals,
+        "wall_seconds": wall,
+    })
+}
+
+/// Run `flicker orbit`: search, write `orbit.json`, say what was found.
+/// A search that does not converge exits 3, saying why.
+pub fn orbit(args: OrbitArgs, registry: &Registry) -> Result<Code, Failure> {
+    let scene = registry.load(&args.scene).map_err(Failure::bad_input)?;
+    let request = OrbitRequest {
+        guard: args.section.clone(),
+        events: args.events,
+        settle: args.settle,
+        forcing_period: args.forcing_period,
+    };
+    let out = args.out.unwrap_or_else(|| {
+        let stem = args
+            .scene
+            .file_stem()
+            .map_or_else(|| "scene".into(), |s| s.to_string_lossy().into_owned());
+        Path::new("out").join(format!("{stem}-orbit"))
+    });
+    let started = Instant::now();
+    let orbit = scene.orbit(&request).map_err(|e| {
+        Failure::bad_input(format!(
+            "--{}: {}",
+            e.field.clone().unwrap_or_default().replace('_', "-"),
+            e.reason
+        ))
+    })?;
+    let wall = started.elapsed().as_secs_f64();
+    crate::cli::setup::output_folder(&out)?;
+    let path = out.join("orbit.json");
+    write_atomically(&path, &orbit_json(&orbit, &args.scene, &args.section, wall))
+        .map_err(|e| Failure::untrusted(format!("{}: cannot be written: {e}", path.display())))?;
+    if !orbit.converged {
+        say!("no orbit: {}", orbit.status);
+        say!("  wrote {}", path.display());
+        eprintln!("flicker: no orbit: {}", orbit.status);
+        return Ok(Code::Untrusted);
+    }
+    let state: Vec<String> = orbit
+        .section_state
+        .iter()
+        .map(|(n, x)| format!("{n} = {x:e}"))
+        .collect();
+    say!(
+        "a periodic orbit of {} `{}` events: period {:e}, {} Newton iterations, residual {:.1e}",
+        orbit.events_per_period,
+        args.section,
+        orbit.period,
+        orbit.iterations,
+        orbit.residual
+    );
+    say!(
+        "  at the section, in mode `{}`: {}",
+        orbit.mode,
+        state.join(", ")
+    );
+    let multipliers: Vec<String> = orbit
+        .multipliers
+        .iter()
+        .map(|(re, im)| {
+            if *im == 0.0 {
+                format!("{re:.6e}")
+            } else {
+                format!("{re:.6e}{im:+.6e}i")
+            }
+        })
+        .collect();
+    say!(
+        "  multipliers {} ({})",
+        multipliers.join(", "),
+        if orbit.stable { "stable" } else { "unstable" }
+    );
+    say!("  wrote {}", path.display());
+    Ok(Code::Ok)
+}

@@ -1,0 +1,131 @@
+//! Periodic orbits of automata: found by Newton shooting through a
+//! Poincare section ([`shooting`]), from the section map and its Jacobian
+//! ([`section`]: saltation matrices included).
+//!
+//! The section is the events of one guard (an impact); `K` of them make a
+//! period. For an automaton that reads the clock (a forced system), the
+//! period must be a whole number of the forcing's period, which the search
+//! is told. `flicker orbit` writes what it finds.
+
+pub mod section;
+pub mod shooting;
+
+use crate::engine::{HybridModel, Mode, Options, Status, simulate};
+use crate::models::automaton::Automaton;
+use crate::scene::SceneError;
+pub use section::Section;
+pub use shooting::{Orbit, OrbitRequest, Unknowns};
+
+/// Check `request` against `model` (the guard exists, at least one event
+/// per period, a forcing period exactly where the clock is read).
+pub fn check(model: &Automaton, request: &OrbitRequest) -> Result<(), SceneError> {
+    let known: Vec<&str> = model
+        .modes()
+        .into_iter()
+        .flat_map(|m| model.guards(m).iter().map(|g| g.name))
+        .collect();
+    if !known.contains(&request.guard.as_str()) {
+        return Err(SceneError::field(
+            "section",
+            format!(
+                "no transition is called `{}` (transitions: {})",
+                request.guard,
+                known.join(", ")
+            ),
+        ));
+    }
+    if request.events == 0 {
+        return Err(SceneError::field(
+            "events",
+            "at least one section event per period".into(),
+        ));
+    }
+    if !(request.settle.is_finite() && request.settle >= 0.0) {
+        return Err(SceneError::field("settle", "a time >= 0".into()));
+    }
+    match (model.has_clock(), request.forcing_period) {
+        (true, None) => Err(SceneError::field(
+            "forcing_period",
+            "the automaton reads the clock t: give the forcing's period (--forcing-period), of which the orbit's is a whole number".into(),
+        )),
+        (false, Some(_)) => Err(SceneError::field(
+            "forcing_period",
+            "the automaton does not read the clock: an autonomous orbit has no forcing period".into(),
+        )),
+        (_, Some(p)) if !(p.is_finite() && p > 0.0) => Err(SceneError::field(
+            "forcing_period",
+            format!("a time > 0 (got {p})"),
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// Where the search starts: the state just after the first section event
+/// from `x0` in `mode`, once `settle` has passed.
+pub fn start(
+    section: &Section,
+    mode: Mode,
+    x0: &[f64],
+    settle: f64,
+) -> Result<(Mode, Vec<f64>), String> {
+    let (mut mode, mut x) = (mode, x0.to_vec());
+    if settle > 0.0 {
+        let outcome = simulate(section.model, mode, &x, &Options::until(settle), &mut ());
+        if outcome.status != Status::Completed {
+            return Err(format!(
+                "the transient stopped at t = {}: {}",
+                outcome.t_reached,
+                outcome.reason.unwrap_or_default()
+            ));
+        }
+        (mode, x) = (outcome.final_mode, outcome.final_state);
+    }
+    let first = Section {
+        events: 1,
+        ..*section
+    };
+    let (_, mode, x) = first.plain(mode, &x)?;
+    Ok((mode, x))
+}
+
+/// The periodic orbit of `model` (from its initial state, after
+/// `request.settle`) through the section `request` names; every return
+/// within `t_max`.
+pub fn search(model: &Automaton, request: &OrbitRequest, t_max: f64) -> Result<Orbit, SceneError> {
+    check(model, request)?;
+    let section = Section {
+        model,
+        guard: &request.guard,
+        events: request.events,
+        t_max,
+    };
+    let n = model.dimension();
+    let unknowns = Unknowns {
+        free: (0..n).collect(),
+        clock: request.forcing_period.map(|p| (n - 1, p)),
+    };
+    let (mode, x) = match start(
+        &section,
+        model.initial_mode(),
+        model.initial(),
+        request.settle,
+    ) {
+        Ok(start) => start,
+        Err(why) => {
+            return Ok(Orbit {
+                converged: false,
+                status: format!("no start on the section: {why}"),
+                period: f64::NAN,
+                events_per_period: request.events,
+                mode: model.mode_name(model.initial_mode()),
+                section_state: Vec::new(),
+                multipliers: Vec::new(),
+                stable: false,
+                residual: f64::NAN,
+                iterations: 0,
+                residuals: Vec::new(),
+            });
+        }
+    };
+    Ok(shooting::shoot(&section, &unknowns, mode, x))
+}

@@ -1,0 +1,265 @@
+//! Newton shooting for a periodic orbit through a Poincare section: the
+//! state `x` just after a section event with `P(x) = x` (plus whole
+//! forcing periods on the clock, for a forced system), `P` the section map
+//! of [`Section`].
+//!
+//! Each iteration solves `(DP - I) dx = -(P(x) - x)` on the free
+//! components by least squares (SVD): a conservative system's orbits come
+//! in families, along which `DP - I` is singular, and the step then keeps
+//! to the other directions. An orbit is returned only verified: its
+//! residual recomputed by a plain run (no derivatives) from the state found.
+
+use nalgebra::{DMatrix, DVector};
+
+use crate::engine::{HybridModel, Mode};
+use crate::orbit::section::{Return, Section};
+
+/// Newton iterations at most.
+pub const MAX_ITERATIONS: usize = 30;
+
+/// Where Newton stops: the residual below this fraction of the state's
+/// size.
+pub const TOLERANCE: f64 = 1e-12;
+
+/// What a search asks: the section guard, the events per period, a
+/// transient to let die out first, and the period of a forcing (for an
+/// automaton that reads the clock).
+#[derive(Debug, Clone, PartialEq)]
+pub struct OrbitRequest {
+    /// The guard whose events are the section.
+    pub guard: String,
+    /// Section events per period.
+    pub events: usize,
+    /// Time run before the search starts from the next section event.
+    pub settle: f64,
+    /// The forcing's period, where the automaton reads the clock: the
+    /// orbit's period is a whole number of them.
+    pub forcing_period: Option<f64>,
+}
+
+/// A periodic orbit found (or why not).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Orbit {
+    /// Whether Newton converged and the plain run confirmed it.
+    pub converged: bool,
+    /// `converged`, or why not.
+    pub status: String,
+    /// The period.
+    pub period: f64,
+    /// Section events per period.
+    pub events_per_period: usize,
+    /// The mode just after the section event.
+    pub mode: &'static str,
+    /// The state just after the section event, by name.
+    pub section_state: Vec<(&'static str, f64)>,
+    /// The monodromy matrix's eigenvalues, `(re, im)`, saltation matrices
+    /// included: first the trivial 1 of the flow's direction (or of the
+    /// clock), then the others by decreasing modulus.
+    pub multipliers: Vec<(f64, f64)>,
+    /// Whether every multiplier but the trivial one lies within the unit
+    /// circle (to 1e-9).
+    pub stable: bool,
+    /// `|P(x) - x|` (on the free components) recomputed by a plain run.
+    pub residual: f64,
+    /// Newton iterations taken.
+    pub iterations: usize,
+    /// The residual at each iteration.
+    pub residuals: Vec<f64>,
+}
+
+/// The search's unknowns and what closes the orbit.
+#[derive(Debug, Clone)]
+pub struct Unknowns {
+    /// The components Newton moves (not the parameters held as states).
+    pub free: Vec<usize>,
+    /// The clock's component, and the forcing period its time closes on.
+    pub clock: Option<(usize, f64)>,
+}
+
+impl Unknowns {
+    /// `P(x) - x` on the free components, the clock closing on the
+    /// nearest whole number (at least one) of forcing periods.
+    pub fn residual(&self, x: &[f64], back: &[f64], elapsed: f64) -> DVector<f64> {
+        DVector::from_iterator(
+            self.free.len(),
+            self.free.iter().map(|&i| {
+                let shift = match self.clock {
+                    Some((c, period)) if c == i => (elapsed / period).round().max(1.0) * period,
+                    _ => 0.0,
+                };
+                back[i] - x[i] - shift
+            }),
+        )
+    }
+
+    /// `DP - I` on the free components.
+    pub fn newton_matrix(&self, r: &Return) -> DMatrix<f64> {
+        let k = self.free.len();
+        DMatrix::from_fn(k, k, |a, b| {
+            r.jacobian[(self.free[a], self.free[b])] - if a == b { 1.0 } else { 0.0 }
+        })
+    }
+}
+
+/// The largest component of `v`, relative to the state's size.
+fn size(v: &DVector<f64>, x: &[f64]) -> f64 {
+    let scale = x.iter().fold(1.0_f64, |m, v| m.max(v.abs()));
+    v.amax() / scale
+}
+
+/// `a x = b` by least squares: directions `a` barely moves are left alone.
+pub fn least_squares(a: &DMatrix<f64>, b: &DVector<f64>) -> Option<DVector<f64>> {
+    let svd = a.clone().svd(true, true);
+    let largest = svd.singular_values.max();
+    svd.solve(b, 1e-10 * largest.max(f64::MIN_POSITIVE)).ok()
+}
+
+/// The orbit's multipliers on the free components, and whether it is
+/// stable (all within the unit circle but the trivial one).
+///
+/// The monodromy matrix `M` has the trivial multiplier 1 along the flow
+/// (or the clock), exactly; where the orbit is conservative a second 1
+/// makes `M` a Jordan block, whose computed eigenvalues split by the
+/// square root of its rounding (1e-8). The section map's Jacobian `DP = M
+/// + f+ dtau^T` has the same eigenvalues but 0 in place of the trivial
+/// one (`DP f = 0`): its eigenvalues, the one nearest 0 replaced by an
+/// exact 1, are the multipliers, to round-off.
+pub fn multipliers(r: &Return, unknowns: &Unknowns) -> (Vec<(f64, f64)>, bool) {
+    let k = unknowns.free.len();
+    let jacobian = DMatrix::from_fn(k, k, |a, b| {
+        r.jacobian[(unknowns.free[a], unknowns.free[b])]
+    });
+    let mut eigen: Vec<(f64, f64)> = jacobian
+        .complex_eigenvalues()
+        .iter()
+        .map(|z| (z.re, z.im))
+        .collect();
+    let trivial = eigen
+        .iter()
+        .enumerate()
+        .min_by(|a, b| (a.1.0.hypot(a.1.1)).total_cmp(&b.1.0.hypot(b.1.1)))
+        .map(|(i, _)| i);
+    if let Some(i) = trivial {
+        eigen.remove(i);
+    }
+    let stable = eigen.iter().all(|z| z.0.hypot(z.1) <= 1.0 + 1e-9);
+    eigen.sort_by(|a, b| (b.0.hypot(b.1)).total_cmp(&a.0.hypot(a.1)));
+    eigen.insert(0, (1.0, 0.0));
+    (eigen, stable)
+}
+
+/// Newton from `x` (just after a section event, in `mode`).
+pub fn shoot(section: &Section, unknowns: &Unknowns, mode: Mode, x: Vec<f64>) -> Orbit {
+    let names = section.model.state_names(mode);
+    let mut x = x;
+    let mut residuals = Vec::new();
+    let failed = |status: String, residuals: Vec<f64>, x: &[f64]| Orbit {
+        converged: false,
+        status,
+        period: f64::NAN,
+        events_per_period: section.events,
+        mode: section.model.mode_name(mode),
+        section_state: names.iter().copied().zip(x.iter().copied()).collect(),
+        multipliers: Vec::new(),
+        stable: false,
+        residual: f64::NAN,
+        iterations: residuals.len(),
+        residuals,
+    };
+    for _ in 0..MAX_ITERATIONS {
+        let back = match section.map(mode, &x) {
+            Ok(back) => back,
+            Err(why) => return failed(format!("the section map failed: {why}"), residuals, &x),
+        };
+        if back.mode != mode {
+            return failed(
+                format!(
+                    "the run returns to the section in mode `{}`, not `{}`: not an orbit of {} events",
+                    section.model.mode_name(back.mode),
+                    section.model.mode_name(mode),
+                    section.events
+                ),
+                residuals,
+                &x,
+            );
+        }
+        let r = unknowns.residual(&x, &back.state, back.elapsed);
+        let norm = size(&r, &x);
+        residuals.push(norm);
+        if norm <= TOLERANCE {
+            return verified(section, unknowns, mode, &x, &back, residuals);
+        }
+        let a = unknowns.newton_matrix(&back);
+        let Some(step) = least_squares(&a, &(-&r)) else {
+            return failed(
+                "a singular Jacobian: the Newton step is undefined".into(),
+                residuals,
+                &x,
+            );
+        };
+        for (k, &i) in unknowns.free.iter().enumerate() {
+            x[i] += step[k];
+        }
+        if !x.iter().all(|v| v.is_finite()) {
+            return failed(
+                "the Newton step left the finite numbers".into(),
+                residuals,
+                &x,
+            );
+        }
+    }
+    let last = residuals.last().copied().unwrap_or(f64::NAN);
+    failed(
+        format!(
+            "no orbit near the start: the residual is still {last:.2e} after {MAX_ITERATIONS} Newton iterations"
+        ),
+        residuals,
+        &x,
+    )
+}
+
+/// The orbit at `x`, which Newton accepted: its period and multipliers
+/// from `back`, its residual recomputed by a plain run.
+fn verified(
+    section: &Section,
+    unknowns: &Unknowns,
+    mode: Mode,
+    x: &[f64],
+    back: &Return,
+    residuals: Vec<f64>,
+) -> Orbit {
+    let names = section.model.state_names(mode);
+    let (multipliers, stable) = multipliers(back, unknowns);
+    let plain = section.plain(mode, x);
+    let (converged, status, residual) = match plain {
+        Ok((elapsed, _, state)) => {
+            let r = unknowns.residual(x, &state, elapsed);
+            let residual = size(&r, x);
+            if residual <= 1e3 * TOLERANCE {
+                (true, "converged".to_string(), residual)
+            } else {
+                (
+                    false,
+                    format!(
+                        "not verified: a plain run from the orbit found misses it by {residual:.2e}"
+                    ),
+                    residual,
+                )
+            }
+        }
+        Err(why) => (false, format!("not verified: {why}"), f64::NAN),
+    };
+    Orbit {
+        converged,
+        status,
+        period: back.elapsed,
+        events_per_period: section.events,
+        mode: section.model.mode_name(mode),
+        section_state: names.iter().copied().zip(x.iter().copied()).collect(),
+        multipliers,
+        stable,
+        residual,
+        iterations: residuals.len() - 1,
+        residuals,
+    }
+}
