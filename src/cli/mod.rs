@@ -26,6 +26,7 @@ pub mod advise;
 pub mod check;
 pub mod compare;
 pub mod compare_models;
+pub mod continuation;
 pub mod events;
 pub mod exit;
 pub mod orbit;
@@ -141,6 +142,9 @@ enum Command {
     /// Find a periodic orbit through a Poincare section (Newton shooting)
     /// and its stability; writes DIR/orbit.json.
     Orbit(orbit::OrbitArgs),
+    /// Follow a periodic orbit in a parameter (pseudo-arclength), label its
+    /// bifurcations; writes DIR/continuation.csv and DIR/bifurcation.svg.
+    Continue(continuation::ContinueArgs),
     /// Print the JSON Schema of scene files, for every model this program
     /// knows (schemas/scene.schema.json is its output for the built-in ones).
     Schema,
@@ -196,6 +200,7 @@ pub fn dispatch(cli: Cli, registry: &Registry) -> Result<Code, Failure> {
         } => compare::compare(registry, &scene, methods, tolerances, steps, out),
         Command::CompareModels(args) => compare_models::compare_models(args, registry),
         Command::Orbit(args) => orbit::orbit(args, registry),
+        Command::Continue(args) => continuation::continue_orbit(args, registry),
         Command::Advise(args) => advise::advise(args, registry),
         Command::Stress {
             dir,

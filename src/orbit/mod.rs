@@ -1,17 +1,21 @@
 //! Periodic orbits of automata: found by Newton shooting through a
 //! Poincare section ([`shooting`]), from the section map and its Jacobian
-//! ([`section`]: saltation matrices included).
+//! ([`section`]: saltation matrices included), and followed in a parameter
+//! ([`continuation`]), drawn over the brute-force diagram ([`diagram`]).
 //!
 //! The section is the events of one guard (an impact); `K` of them make a
 //! period. For an automaton that reads the clock (a forced system), the
 //! period must be a whole number of the forcing's period, which the search
-//! is told. `flicker orbit` writes what it finds.
+//! is told. `flicker orbit` and `flicker continue` write what these
+//! find.
 
+pub mod continuation;
+pub mod diagram;
 pub mod section;
 pub mod shooting;
 
 use crate::engine::{HybridModel, Mode, Options, Status, simulate};
-use crate::models::automaton::Automaton;
+use crate::models::automaton::{Automaton, Definition};
 use crate::scene::SceneError;
 pub use section::Section;
 pub use shooting::{Orbit, OrbitRequest, Unknowns};
@@ -128,4 +132,85 @@ pub fn search(model: &Automaton, request: &OrbitRequest, t_max: f64) -> Result<O
         }
     };
     Ok(shooting::shoot(&section, &unknowns, mode, x))
+}
+
+/// A followed branch, the names of the state's components, and the
+/// parameter's component among them.
+pub type ContinuedBranch = (continuation::Branch, Vec<&'static str>, usize);
+
+/// A branch of orbits followed in the parameter `parameter` of
+/// `definition` to `to` (at most `points` orbits, the longest step
+/// `max_step` of the way), from the orbit found as `request` asks; every
+/// return within `t_max`.
+pub fn follow(
+    definition: &Definition,
+    request: &OrbitRequest,
+    parameter: &str,
+    to: f64,
+    (points, max_step): (usize, f64),
+    t_max: f64,
+) -> Result<ContinuedBranch, SceneError> {
+    if !(max_step.is_finite() && max_step > 0.0 && max_step <= 1.0) {
+        return Err(SceneError::field(
+            "max_step",
+            format!("a fraction in (0, 1] (got {max_step})"),
+        ));
+    }
+    if !to.is_finite() {
+        return Err(SceneError::field(
+            "to",
+            format!("a finite number (got {to})"),
+        ));
+    }
+    let (promoted, _) = definition.with_parameters_as_states(&[parameter.to_string()])?;
+    let model = Automaton::compile(&promoted)?;
+    check(&model, request)?;
+    let n = model.dimension();
+    let p = definition.states.len();
+    let section = Section {
+        model: &model,
+        guard: &request.guard,
+        events: request.events,
+        t_max,
+    };
+    let unknowns = Unknowns {
+        free: (0..n).filter(|&i| i != p).collect(),
+        clock: request.forcing_period.map(|period| (n - 1, period)),
+    };
+    let names = model.state_names(0).to_vec();
+    let (mode, x) = match start(
+        &section,
+        model.initial_mode(),
+        model.initial(),
+        request.settle,
+    ) {
+        Ok(start) => start,
+        Err(why) => {
+            let branch = continuation::Branch {
+                points: Vec::new(),
+                ended: format!("no start on the section: {why}"),
+            };
+            return Ok((branch, names, p));
+        }
+    };
+    let orbit = shooting::shoot(&section, &unknowns, mode, x.clone());
+    if !orbit.converged {
+        let branch = continuation::Branch {
+            points: Vec::new(),
+            ended: format!("no orbit at the start: {}", orbit.status),
+        };
+        return Ok((branch, names, p));
+    }
+    let x: Vec<f64> = orbit.section_state.iter().map(|(_, v)| *v).collect();
+    let plan = continuation::Plan {
+        parameter: p,
+        to,
+        points,
+        step: (0.2 * max_step, max_step),
+    };
+    Ok((
+        continuation::follow(&section, &unknowns, mode, x, &plan),
+        names,
+        p,
+    ))
 }

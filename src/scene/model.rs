@@ -18,7 +18,8 @@ use serde_json::Value;
 use crate::compare::Reference;
 use crate::compare_models::Release;
 use crate::engine::Observer;
-use crate::orbit::{Orbit, OrbitRequest};
+use crate::orbit::diagram::Column;
+use crate::orbit::{ContinuedBranch, Orbit, OrbitRequest};
 use crate::runner::ensemble::{EnsembleReport, EnsembleRequest};
 use crate::runner::{Control, Report, Trajectory};
 use crate::scene::SceneError;
@@ -82,6 +83,44 @@ pub trait SceneModel: fmt::Debug + Send + Sync + 'static {
             "section",
             format!(
                 "a {} scene has no periodic-orbit search (automata do: write the model as one)",
+                self.model()
+            ),
+        ))
+    }
+
+    /// The branch of periodic orbits through the one `request` finds,
+    /// followed in `parameter` to `to` (`points`: at most so many orbits,
+    /// the longest step as a fraction of the way): `flicker continue`. With the state's names and the parameter's component.
+    /// Default: the model offers no continuation.
+    fn continue_orbit(
+        &self,
+        request: &OrbitRequest,
+        parameter: &str,
+        to: f64,
+        points: (usize, f64),
+    ) -> Result<ContinuedBranch, SceneError> {
+        let _ = (request, parameter, to, points);
+        Err(SceneError::field(
+            "param",
+            format!("a {} scene has no continuation (automata do)", self.model()),
+        ))
+    }
+
+    /// The brute-force bifurcation diagram over `values` of `parameter`:
+    /// the section states of `events` events of `guard` after `settle`.
+    fn brute_force(
+        &self,
+        parameter: &str,
+        values: &[f64],
+        guard: &str,
+        settle: f64,
+        events: usize,
+    ) -> Result<Vec<Column>, SceneError> {
+        let _ = (parameter, values, guard, settle, events);
+        Err(SceneError::field(
+            "param",
+            format!(
+                "a {} scene has no bifurcation diagram (automata do)",
                 self.model()
             ),
         ))

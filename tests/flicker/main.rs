@@ -11,6 +11,7 @@ mod chain_invariants;
 mod cli;
 mod compare;
 mod compare_models;
+mod continuation;
 mod continuum;
 mod convergence;
 mod engine_generic;

@@ -11,7 +11,8 @@ use crate::engine::{
 };
 use crate::models::automaton::definition::Definition;
 use crate::models::automaton::model::Automaton;
-use crate::orbit::{Orbit, OrbitRequest};
+use crate::orbit::diagram::Column;
+use crate::orbit::{ContinuedBranch, Orbit, OrbitRequest};
 use crate::runner::ensemble::{EnsembleReport, EnsembleRequest};
 use crate::runner::{Control, Report, Trajectory};
 use crate::scene::fields::Fields;
@@ -315,6 +316,33 @@ impl SceneModel for AutomatonScene {
     /// Every return of the section map within the scene's `t_end`.
     fn orbit(&self, request: &OrbitRequest) -> Result<Orbit, SceneError> {
         crate::orbit::search(&self.automaton, request, self.t_end)
+    }
+
+    fn continue_orbit(
+        &self,
+        request: &OrbitRequest,
+        parameter: &str,
+        to: f64,
+        points: (usize, f64),
+    ) -> Result<ContinuedBranch, SceneError> {
+        crate::orbit::follow(&self.definition, request, parameter, to, points, self.t_end)
+    }
+
+    fn brute_force(
+        &self,
+        parameter: &str,
+        values: &[f64],
+        guard: &str,
+        settle: f64,
+        events: usize,
+    ) -> Result<Vec<Column>, SceneError> {
+        crate::orbit::diagram::brute_force(
+            &self.definition,
+            parameter,
+            values,
+            guard,
+            (settle, events, self.t_end),
+        )
     }
 
     fn set_sensitivities(&mut self, directions: &[String]) -> Result<(), SceneError> {

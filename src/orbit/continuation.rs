@@ -1,0 +1,408 @@
+//! Following a periodic orbit as a parameter moves: pseudo-arclength
+//! continuation, with the bifurcations of impacting orbits found on the
+//! way.
+//!
+//! The unknowns are the orbit's section state (the free components) and
+//! the parameter, held by the automaton as a state that never changes
+//! ([`Definition::with_parameters_as_states`]), so that the section map's
+//! Jacobian has its derivative with respect to the parameter as one more
+//! column. From each orbit the branch's tangent (the null vector of `[DP -
+//! I | dP/dp]`, oriented as the last) predicts the next, which Newton
+//! corrects on the plane orthogonal to the tangent: the branch is followed
+//! through folds, where the parameter turns back. The step grows while
+//! Newton converges fast and halves where it does not.
+//!
+//! Between two orbits, a test function that changes sign marks a
+//! bifurcation, located by bisection along the chord between them (each
+//! trial corrected across it) to 1e-10:
+//!
+//! - **fold**: a multiplier through +1, `det(DP - I)` (the trivial 0 of
+//!   `DP` gives -1 there, a fixed sign);
+//! - **period doubling**: a multiplier through -1, `det(DP + I)`;
+//! - **torus**: a complex pair through the unit circle, the product of
+//!   `|mu|^2 - 1` over the pairs.
+//!
+//! **Grazing**, the orbit touching a guard tangentially, ends the branch
+//! where a section map can no longer tell whether an event fires: the run
+//! says so, and so does the branch's last label.
+//!
+//! [`Definition::with_parameters_as_states`]: crate::models::automaton::Definition::with_parameters_as_states
+
+use nalgebra::{DMatrix, DVector};
+
+use crate::engine::{HybridModel, Mode};
+use crate::orbit::section::{Return, Section};
+use crate::orbit::shooting::{Unknowns, least_squares, multipliers};
+
+/// Newton iterations of a corrector at most.
+const CORRECTOR_ITERATIONS: usize = 8;
+
+/// Residual at which a corrector stops, relative to the state's size.
+const TOLERANCE: f64 = 1e-11;
+
+/// How far a bifurcation is pinned along the branch, relative to the
+/// unknowns' size.
+const LOCATE: f64 = 1e-10;
+
+/// What a continuation is asked: the parameter's index among the
+/// (promoted) states, where to stop, the step limits.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Plan {
+    /// The parameter's component.
+    pub parameter: usize,
+    /// Where the parameter is to go.
+    pub to: f64,
+    /// Orbits at most.
+    pub points: usize,
+    /// The first and the largest arclength step, relative to the
+    /// parameter's range.
+    pub step: (f64, f64),
+}
+
+/// One orbit of the branch.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Point {
+    /// The parameter.
+    pub parameter: f64,
+    /// The period.
+    pub period: f64,
+    /// The section state (every component).
+    pub state: Vec<f64>,
+    /// The multipliers, the trivial 1 first.
+    pub multipliers: Vec<(f64, f64)>,
+    /// Whether it is stable.
+    pub stable: bool,
+    /// What happens here: empty, `fold`, `period doubling`, `torus`,
+    /// `grazing`, `end`.
+    pub label: String,
+}
+
+/// The branch, and why it ended.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Branch {
+    /// The orbits in order along the branch (bifurcations among them).
+    pub points: Vec<Point>,
+    /// Why the branch ended: `reached`, or what stopped it.
+    pub ended: String,
+}
+
+/// The test functions whose signs mark a bifurcation: `det(DP - I)`,
+/// `det(DP + I)`, and the product of `|mu|^2 - 1` over complex pairs
+/// (NaN without one); last, how many complex pairs there are.
+fn tests(r: &Return, unknowns: &Unknowns) -> [f64; 4] {
+    let k = unknowns.free.len();
+    let dp = DMatrix::from_fn(k, k, |a, b| {
+        r.jacobian[(unknowns.free[a], unknowns.free[b])]
+    });
+    let identity = DMatrix::<f64>::identity(k, k);
+    let fold = (&dp - &identity).determinant();
+    let doubling = (&dp + &identity).determinant();
+    // Over the complex pairs only: where a pair turns real (or back) the
+    // product is not compared (see `push_with_bifurcations`).
+    let pairs: Vec<f64> = dp
+        .complex_eigenvalues()
+        .iter()
+        .filter(|z| z.im > 0.0)
+        .map(|z| z.norm_sqr() - 1.0)
+        .collect();
+    let torus = if pairs.is_empty() {
+        f64::NAN
+    } else {
+        pairs.iter().product()
+    };
+    [fold, doubling, torus, pairs.len() as f64]
+}
+
+/// The labels of the test functions, in order.
+const LABELS: [&str; 3] = ["fold", "period doubling", "torus"];
+
+/// A solved orbit: its state (all components), the map's return from it,
+/// and the tangent of the branch there.
+#[derive(Debug, Clone)]
+struct Solved {
+    x: Vec<f64>,
+    back: Return,
+}
+
+/// The residual `P(x) - x` (the clock on whole forcing periods) and the
+/// augmented Jacobian `[DP - I | dP/dp]` on the free components.
+fn system(unknowns: &Unknowns, p: usize, x: &[f64], back: &Return) -> (DVector<f64>, DMatrix<f64>) {
+    let r = unknowns.residual(x, &back.state, back.elapsed);
+    let k = unknowns.free.len();
+    let a = DMatrix::from_fn(k, k + 1, |i, j| {
+        let row = unknowns.free[i];
+        if j < k {
+            back.jacobian[(row, unknowns.free[j])] - if i == j { 1.0 } else { 0.0 }
+        } else {
+            back.jacobian[(row, p)]
+        }
+    });
+    (r, a)
+}
+
+/// `(x_free, p)` of a state.
+fn unknown_vector(unknowns: &Unknowns, p: usize, x: &[f64]) -> DVector<f64> {
+    DVector::from_iterator(
+        unknowns.free.len() + 1,
+        unknowns
+            .free
+            .iter()
+            .map(|&i| x[i])
+            .chain(std::iter::once(x[p])),
+    )
+}
+
+/// The state with `(x_free, p)` set from `z`.
+fn with_unknowns(unknowns: &Unknowns, p: usize, x: &[f64], z: &DVector<f64>) -> Vec<f64> {
+    let mut out = x.to_vec();
+    for (k, &i) in unknowns.free.iter().enumerate() {
+        out[i] = z[k];
+    }
+    out[p] = z[unknowns.free.len()];
+    out
+}
+
+/// The branch's unit tangent at an orbit: `[DP - I | dP/dp] t = 0`,
+/// oriented along `previous`.
+fn tangent(a: &DMatrix<f64>, previous: &DVector<f64>) -> Option<DVector<f64>> {
+    let k = a.nrows();
+    let mut m = DMatrix::zeros(k + 1, k + 1);
+    m.view_mut((0, 0), (k, k + 1)).copy_from(a);
+    m.row_mut(k).copy_from(&previous.transpose());
+    let mut rhs = DVector::zeros(k + 1);
+    rhs[k] = 1.0;
+    let t = least_squares(&m, &rhs)?;
+    let norm = t.norm();
+    (norm.is_finite() && norm > 0.0).then(|| t / norm)
+}
+
+/// Newton from the state `x` (just after a section event in `mode`) on
+/// `P(x) = x` and, with `plane = Some((z0, t))`, `t . (z - z0) = 0`; with
+/// `None`, at the parameter `x` has.
+fn correct(
+    section: &Section,
+    unknowns: &Unknowns,
+    p: usize,
+    mode: Mode,
+    x: Vec<f64>,
+    plane: Option<(&DVector<f64>, &DVector<f64>)>,
+) -> Result<Solved, String> {
+    let k = unknowns.free.len();
+    let mut x = x;
+    for _ in 0..CORRECTOR_ITERATIONS {
+        let back = section.map(mode, &x)?;
+        if back.mode != mode {
+            return Err(format!(
+                "the orbit returns in mode `{}`, not `{}`",
+                section.model.mode_name(back.mode),
+                section.model.mode_name(mode)
+            ));
+        }
+        let (r, a) = system(unknowns, p, &x, &back);
+        let scale = x.iter().fold(1.0_f64, |m, v| m.max(v.abs()));
+        let on_plane = plane.map_or(0.0, |(z0, t)| {
+            t.dot(&(unknown_vector(unknowns, p, &x) - z0))
+        });
+        if r.amax() <= TOLERANCE * scale && on_plane.abs() <= TOLERANCE * scale {
+            return Ok(Solved { x, back });
+        }
+        let step = match plane {
+            Some((_, t)) => {
+                let mut m = DMatrix::zeros(k + 1, k + 1);
+                m.view_mut((0, 0), (k, k + 1)).copy_from(&a);
+                m.row_mut(k).copy_from(&t.transpose());
+                let mut rhs = DVector::zeros(k + 1);
+                rhs.rows_mut(0, k).copy_from(&(-&r));
+                rhs[k] = -on_plane;
+                least_squares(&m, &rhs)
+            }
+            None => least_squares(&a.columns(0, k).into_owned(), &(-&r)).map(|d| {
+                let mut full = DVector::zeros(k + 1);
+                full.rows_mut(0, k).copy_from(&d);
+                full
+            }),
+        }
+        .ok_or("a singular Jacobian")?;
+        let z = unknown_vector(unknowns, p, &x) + step;
+        x = with_unknowns(unknowns, p, &x, &z);
+        if !x.iter().all(|v| v.is_finite()) {
+            return Err("the Newton step left the finite numbers".into());
+        }
+    }
+    Err(format!(
+        "Newton did not converge in {CORRECTOR_ITERATIONS} iterations"
+    ))
+}
+
+/// A point of the branch from a solved orbit.
+fn point(unknowns: &Unknowns, p: usize, s: &Solved, label: &str) -> Point {
+    let (multipliers, stable) = multipliers(&s.back, unknowns);
+    Point {
+        parameter: s.x[p],
+        period: s.back.elapsed,
+        state: s.x.clone(),
+        multipliers,
+        stable,
+        label: label.to_string(),
+    }
+}
+
+/// Pin the bifurcation whose test function `which` changes sign between
+/// the orbits `a` and `b` by bisection along the branch: each trial an
+/// orbit corrected on the plane across the chord from `a` to `b` at a
+/// fraction of it (the parameter alone would not do at a fold, where the
+/// branch turns back in it), until the chord's piece is below 1e-10 of
+/// the unknowns' size.
+fn locate(
+    section: &Section,
+    unknowns: &Unknowns,
+    p: usize,
+    mode: Mode,
+    (a, b): (&Solved, &Solved),
+    which: usize,
+) -> Option<Solved> {
+    let sign = |s: &Solved| tests(&s.back, unknowns)[which].signum();
+    let (za, zb) = (
+        unknown_vector(unknowns, p, &a.x),
+        unknown_vector(unknowns, p, &b.x),
+    );
+    let chord = &zb - &za;
+    let length = chord.norm();
+    let direction = &chord / length;
+    let size = za.amax().max(1.0);
+    let (mut lo, mut hi) = ((0.0, a.clone()), (1.0, b.clone()));
+    for _ in 0..60 {
+        if (hi.0 - lo.0) * length <= LOCATE * size {
+            break;
+        }
+        let s = 0.5 * (lo.0 + hi.0);
+        let z = &za + &chord * s;
+        let x = with_unknowns(unknowns, p, &a.x, &z);
+        let trial = correct(section, unknowns, p, mode, x, Some((&z, &direction))).ok()?;
+        if sign(&trial) == sign(&lo.1) {
+            lo = (s, trial);
+        } else {
+            hi = (s, trial);
+        }
+    }
+    let (lo, hi) = (lo.1, hi.1);
+    Some(
+        if tests(&lo.back, unknowns)[which].abs() <= tests(&hi.back, unknowns)[which].abs() {
+            lo
+        } else {
+            hi
+        },
+    )
+}
+
+/// Follow the orbit at `x` (solved, just after a section event in `mode`)
+/// as `plan` asks.
+pub fn follow(
+    section: &Section,
+    unknowns: &Unknowns,
+    mode: Mode,
+    x: Vec<f64>,
+    plan: &Plan,
+) -> Branch {
+    let p = plan.parameter;
+    let k = unknowns.free.len();
+    let mut points = Vec::new();
+    let start = match correct(section, unknowns, p, mode, x, None) {
+        Ok(s) => s,
+        Err(why) => {
+            return Branch {
+                points,
+                ended: format!("no orbit at the start: {why}"),
+            };
+        }
+    };
+    let range = (plan.to - start.x[p]).abs().max(f64::MIN_POSITIVE);
+    let (mut ds, ds_max) = (plan.step.0 * range, plan.step.1 * range);
+    let toward = (plan.to - start.x[p]).signum();
+    let mut previous = DVector::zeros(k + 1);
+    previous[k] = toward;
+    points.push(point(unknowns, p, &start, ""));
+    let mut here = start;
+    let mut ended = format!("stopped after {} orbits", plan.points);
+    while points.len() < plan.points {
+        let (_, a) = system(unknowns, p, &here.x, &here.back);
+        let Some(t) = tangent(&a, &previous) else {
+            ended = "the branch's tangent is undefined here".into();
+            break;
+        };
+        let z0 = unknown_vector(unknowns, p, &here.x);
+        // Past the end: the last orbit at the end's parameter itself.
+        let z_pred = &z0 + &t * ds;
+        if (z_pred[k] - plan.to) * toward >= 0.0 {
+            let mut x = with_unknowns(unknowns, p, &here.x, &z_pred);
+            x[p] = plan.to;
+            match correct(section, unknowns, p, mode, x, None) {
+                Ok(last) => {
+                    push_with_bifurcations(section, unknowns, p, mode, &here, &last, &mut points);
+                    ended = "reached".into();
+                }
+                Err(why) => ended = format!("no orbit at the end: {why}"),
+            }
+            break;
+        }
+        let x = with_unknowns(unknowns, p, &here.x, &z_pred);
+        match correct(section, unknowns, p, mode, x, Some((&z_pred, &t))) {
+            Ok(next) => {
+                push_with_bifurcations(section, unknowns, p, mode, &here, &next, &mut points);
+                here = next;
+                previous = t;
+                ds = (ds * 1.3).min(ds_max);
+            }
+            Err(why) if why.contains("grazes") || why.contains("uncertain") => {
+                if let Some(last) = points.last_mut() {
+                    last.label = "grazing".into();
+                }
+                ended = format!("grazing: {why}");
+                break;
+            }
+            Err(why) => {
+                ds *= 0.5;
+                if ds < 1e-9 * range {
+                    ended = format!("the step shrank to nothing: {why}");
+                    break;
+                }
+            }
+        }
+    }
+    if let Some(last) = points.last_mut()
+        && last.label.is_empty()
+    {
+        last.label = "end".into();
+    }
+    Branch { points, ended }
+}
+
+/// Push `next`, after the bifurcations between `here` and it.
+fn push_with_bifurcations(
+    section: &Section,
+    unknowns: &Unknowns,
+    p: usize,
+    mode: Mode,
+    here: &Solved,
+    next: &Solved,
+    points: &mut Vec<Point>,
+) {
+    let (before, after) = (tests(&here.back, unknowns), tests(&next.back, unknowns));
+    for which in 0..3 {
+        // A test function that stays within round-off of zero (a
+        // conservative orbit's multiplier 1, always) marks nothing.
+        let clear = |v: f64| v.abs() > 1e-9;
+        // A pair of multipliers turning real is no torus.
+        let same_pairs = which != 2 || before[3] == after[3];
+        if same_pairs
+            && clear(before[which])
+            && clear(after[which])
+            && before[which].signum() != after[which].signum()
+        {
+            if let Some(at) = locate(section, unknowns, p, mode, (here, next), which) {
+                points.push(point(unknowns, p, &at, LABELS[which]));
+            }
+        }
+    }
+    points.push(point(unknowns, p, next, ""));
+}

@@ -1,0 +1,168 @@
+//! Continuation (`flicker continue`) of the ball on a vibrating table in
+//! the table's amplitude `A`, against Holmes's closed forms written out
+//! here: along the period-one branch the impact phase `cos(phi) = pi (1 -
+//! r) / ((1 + r) Gamma)` and the take-off speed `g T / 2`; the branch is
+//! born in a fold at `Gamma_1 = pi (1 - r) / (1 + r)`, and the exact
+//! impact map's eigenvalue reaches -1 (trace `1 + r^2 - (1 + r)^2 Gamma
+//! sin(phi)` equal to `-(1 + r^2)`) at `Gamma_PD^2 = Gamma_1^2 + 4 (1 +
+//! r^2)^2 / (1 + r)^4`.
+
+use std::f64::consts::PI;
+use std::path::Path;
+
+use crate::automata::automaton;
+use crate::support::flicker;
+
+const G: f64 = 9.81;
+const R: f64 = 0.5;
+const W: f64 = 10.0;
+
+/// `flicker continue` of `vibrating_table.json` in `A` to `to`: exit code,
+/// stdout, and the rows of `continuation.csv` (header first).
+fn follow(to: f64, points: usize, out: &Path) -> (Option<i32>, String, Vec<Vec<String>>) {
+    let period = (2.0 * PI / W).to_string();
+    let done = flicker(&[
+        "continue",
+        &automaton("vibrating_table.json"),
+        "--section",
+        "impact",
+        "--param",
+        "A",
+        "--to",
+        &to.to_string(),
+        "--settle",
+        "2",
+        "--forcing-period",
+        &period,
+        "--points",
+        &points.to_string(),
+        "--brute-force",
+        "20",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let rows = csv::ReaderBuilder::new()
+        .has_headers(false)
+        .from_path(out.join("continuation.csv"))
+        .unwrap()
+        .records()
+        .map(|r| r.unwrap().iter().map(String::from).collect())
+        .collect();
+    (
+        done.status.code(),
+        String::from_utf8_lossy(&done.stdout).into_owned(),
+        rows,
+    )
+}
+
+fn gamma(a: f64) -> f64 {
+    a * W * W / G
+}
+
+/// The row whose label is `label`.
+fn labelled<'r>(rows: &'r [Vec<String>], label: &str) -> &'r Vec<String> {
+    rows.iter()
+        .find(|r| r.last().map(String::as_str) == Some(label))
+        .unwrap_or_else(|| panic!("no `{label}` in {rows:?}"))
+}
+
+#[test]
+fn the_table_branch_follows_the_closed_form_and_period_doubles_where_it_should() {
+    let dir = tempfile::tempdir().unwrap();
+    let (code, said, rows) = follow(0.16, 200, dir.path());
+    assert_eq!(code, Some(0), "{said}");
+    assert_eq!(
+        rows[0],
+        [
+            "parameter",
+            "period",
+            "y",
+            "v",
+            "t",
+            "largest_multiplier",
+            "stable",
+            "label"
+        ]
+    );
+    let gamma_1 = PI * (1.0 - R) / (1.0 + R);
+    let gamma_pd = (gamma_1.powi(2) + 4.0 * (1.0 + R * R).powi(2) / (1.0 + R).powi(4)).sqrt();
+    let a_pd = gamma_pd * G / (W * W);
+    let pd = labelled(&rows, "period doubling");
+    let found: f64 = pd[0].parse().unwrap();
+    assert!(
+        (found - a_pd).abs() < 1e-8,
+        "period doubling at {found}, closed form {a_pd}"
+    );
+    assert!(said.contains("period doubling at A ="), "{said}");
+    let period = 2.0 * PI / W;
+    for row in &rows[1..] {
+        let x = |k: usize| row[k].parse::<f64>().unwrap();
+        let (a, v, t) = (x(0), x(3), x(4));
+        let phi = (PI * (1.0 - R) / ((1.0 + R) * gamma(a))).acos();
+        let phase = (W * t).rem_euclid(2.0 * PI);
+        assert!(
+            (phase - phi).abs() < 1e-9,
+            "A {a}: phase {phase} against {phi}"
+        );
+        assert!((v - G * period / 2.0).abs() < 1e-9, "A {a}: speed {v}");
+        assert!((x(1) - period).abs() < 1e-9);
+        // Stable below the period doubling, not above (the point itself
+        // sits on the boundary).
+        if row[7].is_empty() {
+            assert_eq!(row[6] == "true", a < a_pd, "A {a}: {row:?}");
+        }
+    }
+    assert!(rows.len() > 20);
+    for picture in ["bifurcation.svg", "bifurcation.png"] {
+        assert!(std::fs::metadata(dir.path().join(picture)).unwrap().len() > 1000);
+    }
+}
+
+#[test]
+fn the_table_branch_turns_back_at_its_fold_onto_the_unstable_orbit() {
+    let dir = tempfile::tempdir().unwrap();
+    let (code, said, rows) = follow(0.09, 60, dir.path());
+    assert_eq!(code, Some(0), "{said}");
+    let a_fold = PI * (1.0 - R) / (1.0 + R) * G / (W * W);
+    let fold = labelled(&rows, "fold");
+    let found: f64 = fold[0].parse().unwrap();
+    assert!(
+        (found - a_fold).abs() < 1e-8,
+        "fold at {found}, closed form {a_fold}"
+    );
+    // Past the fold the parameter grows again, on the other branch: the
+    // impact phase's sine negative, the orbit unstable.
+    let at = rows
+        .iter()
+        .position(|r| r.last().map(String::as_str) == Some("fold"))
+        .unwrap();
+    let after = &rows[at + 1..];
+    assert!(!after.is_empty());
+    for row in after {
+        let x = |k: usize| row[k].parse::<f64>().unwrap();
+        let phase = (W * x(4)).rem_euclid(2.0 * PI);
+        assert!(phase.sin() < 0.0, "{row:?}");
+        assert_eq!(row[6], "false");
+        let phi = -(PI * (1.0 - R) / ((1.0 + R) * gamma(x(0)))).acos();
+        assert!((phase - phi.rem_euclid(2.0 * PI)).abs() < 1e-8, "{row:?}");
+    }
+}
+
+#[test]
+fn continuation_of_a_model_without_it_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let done = flicker(&[
+        "continue",
+        &crate::support::models("mechanism_impacting.json"),
+        "--section",
+        "impact",
+        "--param",
+        "eta",
+        "--to",
+        "1.5",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    assert_eq!(done.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&done.stderr).contains("automata do"));
+}
