@@ -31,7 +31,7 @@ import numpy as np
 from . import _flicker
 from ._flicker import SceneError
 
-__all__ = ["Run", "SceneError", "check", "compare", "run", "sweep"]
+__all__ = ["Run", "SceneError", "check", "compare", "continuation", "orbit", "run", "sweep"]
 
 Scene = Union[str, "os.PathLike[str]", Dict[str, Any]]
 
@@ -145,6 +145,7 @@ def run(
     step: Optional[float] = None,
     log: Optional[Union[str, "os.PathLike[str]"]] = None,
     events: bool = True,
+    sensitivities: Optional[Sequence[str]] = None,
 ) -> Run:
     """Run a scene and return its `Run`.
 
@@ -159,6 +160,11 @@ def run(
         log: a file to stream the event log to (JSON Lines, as
             `flicker run` writes `events.jsonl`); none is written otherwise.
         events: keep the events as arrays (`Run.events`).
+        sensitivities: directions (a parameter's name, or `initial.STATE`)
+            to carry the derivatives of the state and of every event time
+            along (automata): the summary's `sensitivities`, and
+            `d{state}/d{direction}`, `dt/d{direction}` among the events'
+            states.
 
     Raises:
         SceneError: the scene or an argument is refused; `field` and
@@ -175,6 +181,7 @@ def run(
         step=step,
         log=None if log is None else os.fspath(log),
         events=events,
+        sensitivities=None if sensitivities is None else list(sensitivities),
     )
     return Run(raw)
 
@@ -219,3 +226,62 @@ def sweep(sweep_file: Scene, *, threads: Optional[int] = None) -> Dict[str, Any]
     `energy_error`, `t_reached` (NaN where a value is missing)."""
     text, path = _source(sweep_file)
     return _flicker.sweep(text, path, threads=threads)
+
+
+def orbit(
+    scene: Scene,
+    section: str,
+    *,
+    events: int = 1,
+    settle: float = 0.0,
+    forcing_period: Optional[float] = None,
+) -> Dict[str, Any]:
+    """`flicker orbit`: a periodic orbit through the Poincare section of the
+    events of transition `section` (`events` of them per period), by
+    Newton shooting from the scene's start after `settle`; for an
+    automaton that reads the clock, its period a whole number of
+    `forcing_period`. Returns what `orbit.json` holds: `status`,
+    `converged`, `period`, `section_state`, `multipliers` (`[re, im]`, the
+    trivial 1 first), `stable`, `residual` (recomputed by a plain run),
+    `iterations`. A search that does not converge returns, saying why in
+    `status`."""
+    text, path = _source(scene)
+    return json.loads(
+        _flicker.orbit(
+            text, path, section=section, events=events, settle=float(settle), forcing_period=forcing_period
+        )
+    )
+
+
+def continuation(
+    scene: Scene,
+    section: str,
+    param: str,
+    to: float,
+    *,
+    events: int = 1,
+    settle: float = 0.0,
+    forcing_period: Optional[float] = None,
+    points: int = 200,
+    max_step: float = 0.05,
+) -> Dict[str, Any]:
+    """`flicker continue`: the orbit `orbit` finds, followed in parameter
+    `param` to `to` by pseudo-arclength continuation (at most `points`
+    orbits, the longest step `max_step` of the way). Returns the branch as
+    columns: `parameter`, `period`, each state at the section (float64
+    arrays), `largest_multiplier`, `stable` and `label` (`fold`, `period
+    doubling`, `torus`, `grazing`, `end` or empty), and `ended`, why the
+    branch ended."""
+    text, path = _source(scene)
+    return _flicker.continuation(
+        text,
+        path,
+        section=section,
+        param=param,
+        to=float(to),
+        events=events,
+        settle=float(settle),
+        forcing_period=forcing_period,
+        points=points,
+        max_step=float(max_step),
+    )

@@ -21,6 +21,7 @@ def run(
     step: Optional[float] = None,
     log: Optional[str] = None,
     events: bool = True,
+    sensitivities: Optional[List[str]] = None,
 ) -> Dict[str, Any]: ...
 def check(text: Optional[str] = None, path: Optional[str] = None) -> List[str]: ...
 def compare(
@@ -32,4 +33,24 @@ def compare(
 ) -> Dict[str, Any]: ...
 def sweep(
     text: Optional[str] = None, path: Optional[str] = None, threads: Optional[int] = None
+) -> Dict[str, Any]: ...
+def orbit(
+    text: Optional[str] = None,
+    path: Optional[str] = None,
+    section: str = "",
+    events: int = 1,
+    settle: float = 0.0,
+    forcing_period: Optional[float] = None,
+) -> str: ...
+def continuation(
+    text: Optional[str] = None,
+    path: Optional[str] = None,
+    section: str = "",
+    param: str = "",
+    to: float = 0.0,
+    events: int = 1,
+    settle: float = 0.0,
+    forcing_period: Optional[float] = None,
+    points: int = 200,
+    max_step: float = 0.05,
 ) -> Dict[str, Any]: ...

@@ -103,11 +103,12 @@ impl Observer for Keep {
 }
 
 /// Run a scene; see `flicker.run` for what the arguments mean. Returns a
-/// dict: `summary` (the JSON text of `summary.json`), `events` (columns,
+/// dict: `summary` (the JSON text of `summary.json`, with the derivatives
+/// along `sensitivities` where asked), `events` (columns,
 /// see `convert::events`), `fields` (a chain's or continuum's trace and
 /// profiles, or None).
 #[pyfunction]
-#[pyo3(signature = (text=None, path=None, t_end=None, method=None, rtol=None, atol=None, step=None, log=None, events=true))]
+#[pyo3(signature = (text=None, path=None, t_end=None, method=None, rtol=None, atol=None, step=None, log=None, events=true, sensitivities=None))]
 #[allow(clippy::too_many_arguments)]
 fn run<'py>(
     py: Python<'py>,
@@ -120,8 +121,14 @@ fn run<'py>(
     step: Option<f64>,
     log: Option<&str>,
     events: bool,
+    sensitivities: Option<Vec<String>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (mut scene, label) = load(py, text, path)?;
+    if let Some(directions) = &sensitivities {
+        scene
+            .set_sensitivities(directions)
+            .map_err(|e| override_error(py, "sensitivities", e.reason))?;
+    }
     if let Some(t) = t_end {
         scene
             .set_t_end(t)
@@ -221,5 +228,7 @@ fn _flicker(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(tools::check, m)?)?;
     m.add_function(wrap_pyfunction!(tools::compare, m)?)?;
     m.add_function(wrap_pyfunction!(tools::sweep, m)?)?;
+    m.add_function(wrap_pyfunction!(tools::orbit, m)?)?;
+    m.add_function(wrap_pyfunction!(tools::continuation, m)?)?;
     Ok(())
 }

@@ -10,6 +10,7 @@ use pyo3::types::{PyDict, PyList};
 use serde_json::Value;
 
 use flicker::compare::{Plan, compare as run_compare};
+use flicker::orbit::OrbitRequest;
 use flicker::scene::Registry;
 use flicker::sweep::{Row as SweepRow, Shard, Sweep, is_sweep, parse_text};
 
@@ -182,4 +183,103 @@ fn rayon_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, String> {
         .num_threads(threads.unwrap_or(0))
         .build()
         .map_err(|e| e.to_string())
+}
+
+/// The orbit request of `flicker orbit`'s flags.
+fn request(
+    section: String,
+    events: usize,
+    settle: f64,
+    forcing_period: Option<f64>,
+) -> OrbitRequest {
+    OrbitRequest {
+        guard: section,
+        events,
+        settle,
+        forcing_period,
+    }
+}
+
+/// `flicker orbit`: the JSON text of `orbit.json` for the orbit found (or
+/// why none was).
+#[pyfunction]
+#[pyo3(signature = (text=None, path=None, section=String::new(), events=1, settle=0.0, forcing_period=None))]
+pub fn orbit(
+    py: Python<'_>,
+    text: Option<&str>,
+    path: Option<&str>,
+    section: String,
+    events: usize,
+    settle: f64,
+    forcing_period: Option<f64>,
+) -> PyResult<String> {
+    let (scene, label) = load(py, text, path)?;
+    let request = request(section.clone(), events, settle, forcing_period);
+    let started = std::time::Instant::now();
+    let found = py.detach(|| scene.orbit(&request));
+    let found =
+        found.map_err(|e| override_error(py, e.field.as_deref().unwrap_or("section"), e.reason))?;
+    let json = flicker::cli::orbit::orbit_json(
+        &found,
+        Path::new(&label),
+        &section,
+        started.elapsed().as_secs_f64(),
+    );
+    Ok(json.to_string())
+}
+
+/// `flicker continue`: the branch as columns (`parameter`, `period`, each
+/// state at the section, `largest_multiplier`, `stable`, `label`), and
+/// `ended`, why it ended.
+#[pyfunction]
+#[pyo3(signature = (text=None, path=None, section=String::new(), param=String::new(), to=0.0, events=1, settle=0.0, forcing_period=None, points=200, max_step=0.05))]
+#[allow(clippy::too_many_arguments)]
+pub fn continuation<'py>(
+    py: Python<'py>,
+    text: Option<&str>,
+    path: Option<&str>,
+    section: String,
+    param: String,
+    to: f64,
+    events: usize,
+    settle: f64,
+    forcing_period: Option<f64>,
+    points: usize,
+    max_step: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    let (scene, _) = load(py, text, path)?;
+    let request = request(section, events, settle, forcing_period);
+    let followed = py.detach(|| scene.continue_orbit(&request, &param, to, (points, max_step)));
+    let (branch, names, p) = followed
+        .map_err(|e| override_error(py, e.field.as_deref().unwrap_or("param"), e.reason))?;
+    let out = PyDict::new(py);
+    let column = |f: &dyn Fn(&flicker::orbit::continuation::Point) -> f64| -> Vec<f64> {
+        branch.points.iter().map(f).collect()
+    };
+    out.set_item("parameter", column(&|q| q.parameter).into_pyarray(py))?;
+    out.set_item("period", column(&|q| q.period).into_pyarray(py))?;
+    for (i, name) in names.iter().enumerate().filter(|(i, _)| *i != p) {
+        out.set_item(*name, column(&|q| q.state[i]).into_pyarray(py))?;
+    }
+    out.set_item(
+        "largest_multiplier",
+        column(&|q| {
+            q.multipliers
+                .iter()
+                .skip(1)
+                .map(|z| z.0.hypot(z.1))
+                .fold(0.0, f64::max)
+        })
+        .into_pyarray(py),
+    )?;
+    out.set_item(
+        "stable",
+        PyList::new(py, branch.points.iter().map(|q| q.stable))?,
+    )?;
+    out.set_item(
+        "label",
+        PyList::new(py, branch.points.iter().map(|q| q.label.clone()))?,
+    )?;
+    out.set_item("ended", branch.ended.clone())?;
+    Ok(out)
 }
