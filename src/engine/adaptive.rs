@@ -137,8 +137,12 @@ pub struct StepControl {
     h_next: Option<f64>,
     /// Right-hand-side evaluations so far.
     pub evaluations: u64,
-    /// Largest component of the error estimate of the last accepted step.
+    /// Largest component of the error estimate of the last accepted step,
+    /// over the first `bounded` components.
     pub local_error: f64,
+    /// The components the local error is measured on (see
+    /// [`HybridModel::bounded_dimension`]).
+    pub bounded: usize,
 }
 
 /// A trial's error: the scaled norm step control uses (accepted at most 1,
@@ -166,6 +170,7 @@ impl StepControl {
             h_next: None,
             evaluations: 0,
             local_error: 0.0,
+            bounded: usize::MAX,
         }
     }
 

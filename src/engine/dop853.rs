@@ -417,7 +417,9 @@ impl EmbeddedPair for Dop853 {
             let scale = self.control.tol.scale(y0[i].abs().max(self.y1[i].abs()));
             err5 += (e5 / scale).powi(2);
             err3 += (e3 / scale).powi(2);
-            largest = largest.max(e5.abs());
+            if i < self.control.bounded {
+                largest = largest.max(e5.abs());
+            }
         }
         if self.y1.iter().any(|v| !v.is_finite()) || !(err5.is_finite() && err3.is_finite()) {
             return TrialError {

@@ -167,7 +167,9 @@ impl EmbeddedPair for Dopri5 {
                     + E7 * k[6][i]);
             let scale = self.control.tol.scale(y0[i].abs().max(self.y1[i].abs()));
             sum += (e / scale).powi(2);
-            largest = largest.max(e.abs());
+            if i < self.control.bounded {
+                largest = largest.max(e.abs());
+            }
         }
         let blew_up = self.y1.iter().any(|v| !v.is_finite()) || k[6].iter().any(|v| !v.is_finite());
         TrialError {

@@ -176,6 +176,17 @@ impl Integrator {
         }
     }
 
+    /// Measure the local error on the first `bounded` components only
+    /// ([`HybridModel::bounded_dimension`]).
+    pub fn bound_first(&mut self, bounded: usize) {
+        match self {
+            Integrator::Dopri5(m) => m.parts().0.bounded = bounded,
+            Integrator::Dop853(m) => m.parts().0.bounded = bounded,
+            Integrator::Linear(m) => m.bound_first(bounded),
+            Integrator::Verlet(_) | Integrator::Taylor(_) => {}
+        }
+    }
+
     /// The method's name, for messages.
     pub fn name(&self) -> &'static str {
         match self {

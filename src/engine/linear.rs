@@ -55,6 +55,8 @@ pub struct Linear {
     y1: Vec<f64>,
     /// Propagator evaluations; a `Cell` because evaluation reads `&self`.
     evaluations: Cell<u64>,
+    /// The components the local error is measured on.
+    bounded: usize,
 }
 
 /// `out = a v` for a square matrix `a` laid out row by row.
@@ -82,6 +84,7 @@ impl Linear {
             guard: vec![0.0; ORDER + 1],
             y1: vec![0.0; dimension],
             evaluations: Cell::new(0),
+            bounded: usize::MAX,
         }
     }
 
@@ -102,7 +105,7 @@ impl Linear {
         mode: Mode,
         y0: &[f64],
         h_max: f64,
-        _h_min: f64,
+        h_min: f64,
     ) -> Result<(), StepFailure> {
         let n = y0.len();
         if self.mode != Some(mode) {
@@ -157,6 +160,9 @@ impl Linear {
         self.evaluations.set(self.evaluations.get() + 1);
         if model.has_series(mode) {
             self.fit_guards(model, mode);
+            if self.h < h_min {
+                return Err(StepFailure::Collapsed { h: self.h });
+            }
         }
         let mut y1 = std::mem::take(&mut self.y1);
         self.eval(self.h, &mut y1);
@@ -175,14 +181,16 @@ impl Linear {
         let w = ORDER + 1;
         let guards = model.guards(mode).len();
         self.guards.resize(guards * w, 0.0);
-        let size = self.y0.iter().fold(1.0_f64, |m, v| m.max(v.abs()));
+        // Measured as the state's own series are: against the state's size
+        // (a guard's own coefficients, which a fast sine makes large, would
+        // excuse any step).
+        let scale = self.y0.iter().fold(1.0_f64, |m, v| m.max(v.abs()));
         for g in 0..guards {
             let c = &mut self.guards[g * w..(g + 1) * w];
             model.guard_series(mode, g, &self.series, ORDER, c);
-            let scale = c.iter().fold(size, |m, v| m.max(v.abs()));
             // The last two terms at the step's length far below round-off
-            // (1e-20 of the guard's size: as far as the state's own, whose
-            // last term is at most 1 / 24!).
+            // (1e-20 of the state's size: as far as the state's own, whose
+            // last term is at most 1 / 24! of it).
             while self.h > 0.0
                 && (c[ORDER - 1].abs() * self.h.powi(ORDER as i32 - 1)
                     + c[ORDER].abs() * self.h.powi(ORDER as i32))
@@ -243,7 +251,16 @@ impl Linear {
 
     /// Round-off of one propagation: a few ulps of the state.
     pub fn local_error(&self) -> f64 {
-        8.0 * f64::EPSILON * self.y1.iter().fold(1.0, |m: f64, x| m.max(x.abs()))
+        let bounded = self.bounded.min(self.y1.len());
+        8.0 * f64::EPSILON
+            * self.y1[..bounded]
+                .iter()
+                .fold(1.0, |m: f64, x| m.max(x.abs()))
+    }
+
+    /// Measure the local error on the first `bounded` components only.
+    pub fn bound_first(&mut self, bounded: usize) {
+        self.bounded = bounded;
     }
 
     /// The state at the end of the step.

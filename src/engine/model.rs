@@ -313,6 +313,14 @@ pub trait HybridModel {
         false
     }
 
+    /// How many leading components of the state the run's error bound is
+    /// about (all, unless the state carries more than the model's own:
+    /// the derivatives of [`crate::engine::variational`], whose errors
+    /// say nothing of where the events are).
+    fn bounded_dimension(&self) -> usize {
+        self.dimension()
+    }
+
     /// Whether a guard or a reset may be undefined somewhere (a model read
     /// from a file, whose expressions may take a square root of a negative
     /// number): the run then checks every guard where each stretch of flow

@@ -285,7 +285,11 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
             origin: Time::new(0.0),
             state: x0.to_vec(),
             queue: EventQueue::default(),
-            integrator: Integrator::for_method(options.method, n, options.tolerances),
+            integrator: {
+                let mut integrator = Integrator::for_method(options.method, n, options.tolerances);
+                integrator.bound_first(model.bounded_dimension());
+                integrator
+            },
             motion: Motion::Frozen,
             motions: Vec::new(),
             exact_evaluations: 0,

@@ -264,6 +264,11 @@ impl<M: HybridModel + ?Sized> HybridModel for Variational<'_, M> {
         self.model.labels(mode, guard, &before[..self.n])
     }
 
+    /// The error bound is the model's state's, not its derivatives'.
+    fn bounded_dimension(&self) -> usize {
+        self.n
+    }
+
     fn may_be_undefined(&self) -> bool {
         self.model.may_be_undefined()
     }

@@ -171,7 +171,7 @@ fn tangent(a: &DMatrix<f64>, previous: &DVector<f64>) -> Option<DVector<f64>> {
     m.row_mut(k).copy_from(&previous.transpose());
     let mut rhs = DVector::zeros(k + 1);
     rhs[k] = 1.0;
-    let t = least_squares(&m, &rhs)?;
+    let (t, _) = least_squares(&m, &rhs)?;
     let norm = t.norm();
     (norm.is_finite() && norm > 0.0).then(|| t / norm)
 }
@@ -199,7 +199,7 @@ fn correct(
             ));
         }
         let (r, a) = system(unknowns, p, &x, &back);
-        let scale = x.iter().fold(1.0_f64, |m, v| m.max(v.abs()));
+        let scale = unknowns.scale(&x).max(x[p].abs());
         let on_plane = plane.map_or(0.0, |(z0, t)| {
             t.dot(&(unknown_vector(unknowns, p, &x) - z0))
         });
@@ -214,16 +214,18 @@ fn correct(
                 let mut rhs = DVector::zeros(k + 1);
                 rhs.rows_mut(0, k).copy_from(&(-&r));
                 rhs[k] = -on_plane;
-                least_squares(&m, &rhs)
+                least_squares(&m, &rhs).map(|(d, _)| d)
             }
-            None => least_squares(&a.columns(0, k).into_owned(), &(-&r)).map(|d| {
+            None => least_squares(&a.columns(0, k).into_owned(), &(-&r)).map(|(d, _)| {
                 let mut full = DVector::zeros(k + 1);
                 full.rows_mut(0, k).copy_from(&d);
                 full
             }),
         }
-        .ok_or("a singular Jacobian")?;
+        .ok_or("the Newton matrix is not finite (a graze on the way round?)")?;
         let z = unknown_vector(unknowns, p, &x) + step;
+        // The clock is not folded here: the branch's tangent and the
+        // corrector's plane are about the unknowns as they move.
         x = with_unknowns(unknowns, p, &x, &z);
         if !x.iter().all(|v| v.is_finite()) {
             return Err("the Newton step left the finite numbers".into());
@@ -340,10 +342,18 @@ pub fn follow(
                 Ok(last) => {
                     push_with_bifurcations(section, unknowns, p, mode, &here, &last, &mut points);
                     ended = "reached".into();
+                    break;
                 }
-                Err(why) => ended = format!("no orbit at the end: {why}"),
+                // Too far a leap to the end: come closer first.
+                Err(why) => {
+                    ds *= 0.5;
+                    if ds < 1e-9 * range {
+                        ended = format!("no orbit at the end: {why}");
+                        break;
+                    }
+                    continue;
+                }
             }
-            break;
         }
         let x = with_unknowns(unknowns, p, &here.x, &z_pred);
         match correct(section, unknowns, p, mode, x, Some((&z_pred, &t))) {
@@ -353,7 +363,7 @@ pub fn follow(
                 previous = t;
                 ds = (ds * 1.3).min(ds_max);
             }
-            Err(why) if why.contains("grazes") || why.contains("uncertain") => {
+            Err(why) if why.contains("grazes") || why.contains("(a graze") => {
                 if let Some(last) = points.last_mut() {
                     last.label = "grazing".into();
                 }
@@ -398,10 +408,9 @@ fn push_with_bifurcations(
             && clear(before[which])
             && clear(after[which])
             && before[which].signum() != after[which].signum()
+            && let Some(at) = locate(section, unknowns, p, mode, (here, next), which)
         {
-            if let Some(at) = locate(section, unknowns, p, mode, (here, next), which) {
-                points.push(point(unknowns, p, &at, LABELS[which]));
-            }
+            points.push(point(unknowns, p, &at, LABELS[which]));
         }
     }
     points.push(point(unknowns, p, next, ""));

@@ -29,7 +29,7 @@ pub fn brute_force(
     guard: &str,
     (settle, events, t_max): (f64, usize, f64),
 ) -> Result<Vec<Column>, SceneError> {
-    let (promoted, _) = definition.with_parameters_as_states(&[parameter.to_string()])?;
+    let (promoted, _) = definition.with_parameters_as_states(&[parameter.to_string()], "param")?;
     let model = Automaton::compile(&promoted)?;
     let p = definition.states.len();
     let section = Section {
@@ -41,7 +41,11 @@ pub fn brute_force(
     Ok(values
         .par_iter()
         .map(|&value| {
+            // The start at this value: initial values may depend on it.
             let mut x0 = model.initial().to_vec();
+            if let Ok(initial) = definition.initial_with(parameter, value) {
+                x0[..p].copy_from_slice(&initial);
+            }
             x0[p] = value;
             let mut states = Vec::with_capacity(events);
             if let Ok((mut mode, mut x)) = start(&section, model.initial_mode(), &x0, settle) {

@@ -162,7 +162,17 @@ pub fn follow(
             format!("a finite number (got {to})"),
         ));
     }
-    let (promoted, _) = definition.with_parameters_as_states(&[parameter.to_string()])?;
+    if request.forcing_period.is_some() && definition.sets_the_forcing(parameter) {
+        return Err(SceneError::field(
+            "param",
+            format!(
+                "`{parameter}` enters a function of the clock with it (a forcing's frequency): the \
+                 forcing's period would move with it, and --forcing-period holds it fixed; follow \
+                 another parameter"
+            ),
+        ));
+    }
+    let (promoted, _) = definition.with_parameters_as_states(&[parameter.to_string()], "param")?;
     let model = Automaton::compile(&promoted)?;
     check(&model, request)?;
     let n = model.dimension();

@@ -92,6 +92,25 @@ impl Unknowns {
         )
     }
 
+    /// The size residuals are measured against: the largest free
+    /// component but the clock (whose time grows with every period), at
+    /// least 1.
+    pub fn scale(&self, x: &[f64]) -> f64 {
+        let clock = self.clock.map(|(c, _)| c);
+        self.free
+            .iter()
+            .filter(|&&i| Some(i) != clock)
+            .fold(1.0_f64, |m, &i| m.max(x[i].abs()))
+    }
+
+    /// Bring the clock back into its first forcing period (the same
+    /// forcing phase), so the states Newton sees keep their precision.
+    pub fn fold_clock(&self, x: &mut [f64]) {
+        if let Some((c, period)) = self.clock {
+            x[c] = x[c].rem_euclid(period);
+        }
+    }
+
     /// `DP - I` on the free components.
     pub fn newton_matrix(&self, r: &Return) -> DMatrix<f64> {
         let k = self.free.len();
@@ -102,16 +121,24 @@ impl Unknowns {
 }
 
 /// The largest component of `v`, relative to the state's size.
-fn size(v: &DVector<f64>, x: &[f64]) -> f64 {
-    let scale = x.iter().fold(1.0_f64, |m, v| m.max(v.abs()));
-    v.amax() / scale
+fn size(v: &DVector<f64>, unknowns: &Unknowns, x: &[f64]) -> f64 {
+    v.amax() / unknowns.scale(x)
 }
 
+/// Relative size below which a singular value counts as zero.
+const RANK_CUTOFF: f64 = 1e-10;
+
 /// `a x = b` by least squares: directions `a` barely moves are left alone.
-pub fn least_squares(a: &DMatrix<f64>, b: &DVector<f64>) -> Option<DVector<f64>> {
-    let svd = a.clone().svd(true, true);
-    let largest = svd.singular_values.max();
-    svd.solve(b, 1e-10 * largest.max(f64::MIN_POSITIVE)).ok()
+/// Also says whether there were such directions (`a` singular); `None`
+/// where `a` is not finite or the SVD does not converge.
+pub fn least_squares(a: &DMatrix<f64>, b: &DVector<f64>) -> Option<(DVector<f64>, bool)> {
+    if !a.iter().chain(b.iter()).all(|v| v.is_finite()) {
+        return None;
+    }
+    let svd = a.clone().try_svd(true, true, f64::EPSILON, 10_000)?;
+    let cutoff = RANK_CUTOFF * svd.singular_values.max().max(f64::MIN_POSITIVE);
+    let singular = svd.singular_values.iter().any(|&s| s <= cutoff);
+    svd.solve(b, cutoff).ok().map(|x| (x, singular))
 }
 
 /// The orbit's multipliers on the free components, and whether it is
@@ -120,15 +147,18 @@ pub fn least_squares(a: &DMatrix<f64>, b: &DVector<f64>) -> Option<DVector<f64>>
 /// The monodromy matrix `M` has the trivial multiplier 1 along the flow
 /// (or the clock), exactly; where the orbit is conservative a second 1
 /// makes `M` a Jordan block, whose computed eigenvalues split by the
-/// square root of its rounding (1e-8). The section map's Jacobian `DP = M
-/// + f+ dtau^T` has the same eigenvalues but 0 in place of the trivial
-/// one (`DP f = 0`): its eigenvalues, the one nearest 0 replaced by an
+/// square root of its rounding (1e-8). The section map's Jacobian
+/// `DP = M + f+ dtau^T` has the same eigenvalues but 0 in place of the
+/// trivial one (`DP f = 0`): its eigenvalues, the one nearest 0 replaced by an
 /// exact 1, are the multipliers, to round-off.
 pub fn multipliers(r: &Return, unknowns: &Unknowns) -> (Vec<(f64, f64)>, bool) {
     let k = unknowns.free.len();
     let jacobian = DMatrix::from_fn(k, k, |a, b| {
         r.jacobian[(unknowns.free[a], unknowns.free[b])]
     });
+    if !jacobian.iter().all(|v| v.is_finite()) {
+        return (Vec::new(), false);
+    }
     let mut eigen: Vec<(f64, f64)> = jacobian
         .complex_eigenvalues()
         .iter()
@@ -152,7 +182,11 @@ pub fn multipliers(r: &Return, unknowns: &Unknowns) -> (Vec<(f64, f64)>, bool) {
 pub fn shoot(section: &Section, unknowns: &Unknowns, mode: Mode, x: Vec<f64>) -> Orbit {
     let names = section.model.state_names(mode);
     let mut x = x;
+    unknowns.fold_clock(&mut x);
     let mut residuals = Vec::new();
+    // Whether a Newton step met a rank-deficient matrix: said if Newton
+    // then fails (an orbit in a family meets one at every step).
+    let mut singular = false;
     let failed = |status: String, residuals: Vec<f64>, x: &[f64]| Orbit {
         converged: false,
         status,
@@ -184,22 +218,24 @@ pub fn shoot(section: &Section, unknowns: &Unknowns, mode: Mode, x: Vec<f64>) ->
             );
         }
         let r = unknowns.residual(&x, &back.state, back.elapsed);
-        let norm = size(&r, &x);
+        let norm = size(&r, unknowns, &x);
         residuals.push(norm);
         if norm <= TOLERANCE {
             return verified(section, unknowns, mode, &x, &back, residuals);
         }
         let a = unknowns.newton_matrix(&back);
-        let Some(step) = least_squares(&a, &(-&r)) else {
+        let Some((step, rank_deficient)) = least_squares(&a, &(-&r)) else {
             return failed(
-                "a singular Jacobian: the Newton step is undefined".into(),
+                "the Newton matrix is not finite (a graze on the way round?)".into(),
                 residuals,
                 &x,
             );
         };
+        singular |= rank_deficient;
         for (k, &i) in unknowns.free.iter().enumerate() {
             x[i] += step[k];
         }
+        unknowns.fold_clock(&mut x);
         if !x.iter().all(|v| v.is_finite()) {
             return failed(
                 "the Newton step left the finite numbers".into(),
@@ -209,9 +245,14 @@ pub fn shoot(section: &Section, unknowns: &Unknowns, mode: Mode, x: Vec<f64>) ->
         }
     }
     let last = residuals.last().copied().unwrap_or(f64::NAN);
+    let why = if singular {
+        " (a singular Jacobian on the way: the orbit may be degenerate, or a family's)"
+    } else {
+        ""
+    };
     failed(
         format!(
-            "no orbit near the start: the residual is still {last:.2e} after {MAX_ITERATIONS} Newton iterations"
+            "no orbit near the start: the residual is still {last:.2e} after {MAX_ITERATIONS} Newton iterations{why}"
         ),
         residuals,
         &x,
@@ -234,7 +275,7 @@ fn verified(
     let (converged, status, residual) = match plain {
         Ok((elapsed, _, state)) => {
             let r = unknowns.residual(x, &state, elapsed);
-            let residual = size(&r, x);
+            let residual = size(&r, unknowns, x);
             if residual <= 1e3 * TOLERANCE {
                 (true, "converged".to_string(), residual)
             } else {

@@ -166,3 +166,29 @@ fn continuation_of_a_model_without_it_is_refused() {
     assert_eq!(done.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&done.stderr).contains("automata do"));
 }
+
+/// The table's frequency `w` sets the forcing, whose period
+/// `--forcing-period` holds fixed: following it is refused (exit 2), not
+/// run on orbits that close on the wrong period.
+#[test]
+fn continuation_in_the_forcing_frequency_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let done = flicker(&[
+        "continue",
+        &automaton("vibrating_table.json"),
+        "--section",
+        "impact",
+        "--param",
+        "w",
+        "--to",
+        "11",
+        "--forcing-period",
+        &(2.0 * PI / W).to_string(),
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    assert_eq!(done.status.code(), Some(2));
+    let said = String::from_utf8_lossy(&done.stderr);
+    assert!(said.contains("`w`") && said.contains("forcing"), "{said}");
+    assert!(!dir.path().join("continuation.csv").exists());
+}

@@ -212,3 +212,28 @@ fn unknown_directions_are_refused() {
     let err = builtin.set_sensitivities(&["eta".to_string()]).unwrap_err();
     assert!(err.reason.contains("automata do"));
 }
+
+/// The exact linear propagator asked for where a direction makes a flow
+/// non-affine (`omega^2 strain` with `omega` carried as a state) is
+/// refused with the methods that do run (exit 2).
+#[test]
+fn the_linear_propagator_is_refused_where_the_derivatives_are_not_affine() {
+    let dir = tempfile::tempdir().unwrap();
+    let done = crate::support::flicker(&[
+        "run",
+        &automaton("mechanism.json"),
+        "--sensitivities",
+        "omega",
+        "--method",
+        "linear",
+        "--quiet",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    assert_eq!(done.status.code(), Some(2));
+    let said = String::from_utf8_lossy(&done.stderr);
+    assert!(
+        said.contains("solver.method") && said.contains("dop853"),
+        "{said}"
+    );
+}

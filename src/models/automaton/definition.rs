@@ -6,7 +6,7 @@
 use serde_json::{Map, Value};
 
 use crate::engine::Direction;
-use crate::models::automaton::expr::{Ast, parse};
+use crate::models::automaton::expr::{Ast, Scope, Tape, parse};
 use crate::scene::SceneError;
 use crate::scene::fields::{Fields, kind};
 
@@ -201,36 +201,27 @@ impl Definition {
     /// what depends on them can be differentiated as on any state; and,
     /// for each, the derivative of every initial value with respect to it
     /// (an initial value may be an expression of the parameters). An
-    /// unknown name is refused with the nearest.
+    /// unknown name is refused with the nearest, as said of `field`.
     pub fn with_parameters_as_states(
         &self,
         names: &[String],
+        field: &str,
     ) -> Result<(Definition, Vec<Vec<f64>>), SceneError> {
         use crate::models::automaton::expr::derivative::jacobian;
-        use crate::models::automaton::expr::{Scope, Tape};
         let known: Vec<&str> = self.parameters.iter().map(|(p, _)| p.as_str()).collect();
         let mut promoted = self.clone();
         let mut slopes = Vec::new();
         for name in names {
-            let k = index_of(name, &known, "parameter", "sensitivities")?;
+            let k = index_of(name, &known, "parameter", field)?;
             let (_, value) = self.parameters[k].clone();
             // d x0 / d p: the initial values' expressions with p as their input.
-            let scope = Scope {
-                inputs: vec![name.clone()],
-                constants: self
-                    .parameters
+            let tapes = self.initial_of(name)?;
+            slopes.push(
+                tapes
                     .iter()
-                    .filter(|(p, _)| p != name)
-                    .cloned()
+                    .map(|t| jacobian(t, &[value])[(0, 0)])
                     .collect(),
-            };
-            let mut slope = Vec::new();
-            for source in &self.initial_sources {
-                let tape = Tape::compile(&[&source.ast], &scope)
-                    .map_err(|e| source.error(e.at, &e.message))?;
-                slope.push(jacobian(&tape, &[value])[(0, 0)]);
-            }
-            slopes.push(slope);
+            );
             promoted.parameters.retain(|(p, _)| p != name);
             promoted.states.push(name.clone());
             promoted.initial.push(value);
@@ -249,6 +240,53 @@ impl Definition {
     /// Whether any expression reads the clock `t` (a forced system).
     pub fn reads_clock(&self) -> bool {
         self.sources().any(|s| mentions(&s.ast, "t"))
+    }
+
+    /// Whether `name` enters a function's argument together with the
+    /// clock (`sin(w * t)`): the forcing's period then moves with it.
+    pub fn sets_the_forcing(&self, name: &str) -> bool {
+        fn inside(ast: &Ast, name: &str) -> bool {
+            match ast {
+                Ast::Number(_) | Ast::Name(..) => false,
+                Ast::Neg(a) => inside(a, name),
+                Ast::Binary(_, a, b) => inside(a, name) || inside(b, name),
+                Ast::Call(_, args, _) => {
+                    args.iter().any(|a| mentions(a, name)) && args.iter().any(|a| mentions(a, "t"))
+                        || args.iter().any(|a| inside(a, name))
+                }
+            }
+        }
+        self.sources().any(|s| inside(&s.ast, name))
+    }
+
+    /// The initial values with the parameter `name` at `value` (an initial
+    /// value may be an expression of it).
+    pub fn initial_with(&self, name: &str, value: f64) -> Result<Vec<f64>, SceneError> {
+        Ok(self
+            .initial_of(name)?
+            .iter()
+            .map(|t| t.eval1(&[value]))
+            .collect())
+    }
+
+    /// Each initial value's expression compiled as a function of the
+    /// parameter `name` (the other parameters held at their values).
+    fn initial_of(&self, name: &str) -> Result<Vec<Tape>, SceneError> {
+        let scope = Scope {
+            inputs: vec![name.to_string()],
+            constants: self
+                .parameters
+                .iter()
+                .filter(|(p, _)| p != name)
+                .cloned()
+                .collect(),
+        };
+        self.initial_sources
+            .iter()
+            .map(|source| {
+                Tape::compile(&[&source.ast], &scope).map_err(|e| source.error(e.at, &e.message))
+            })
+            .collect()
     }
 }
 

@@ -151,17 +151,7 @@ impl AutomatonScene {
         observer: &mut dyn Observer,
     ) -> Result<Report, SceneError> {
         if !self.sensitivities.is_empty() {
-            return super::sensitivities::run(
-                &self.definition,
-                &self.sensitivities,
-                self.method,
-                self.tolerances,
-                (self.t_end, self.max_events),
-                control,
-                times,
-                on_sample,
-                observer,
-            );
+            return super::sensitivities::run(self, control, times, on_sample, observer);
         }
         let (method, description) = self.resolved();
         let options = control.options(self.t_end, self.max_events, method, self.tolerances);

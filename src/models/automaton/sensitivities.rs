@@ -9,9 +9,10 @@
 //! vector on it plus the derivative of the initial values it enters; an
 //! initial value's direction is the unit vector on its state. The run is
 //! the model with its derivatives, integrated as one: by the exact linear
-//! propagator where every mode stays affine, else by DOP853 at 1e-13
-//! (Taylor's method needs series the derivatives do not have), or by the
-//! Runge-Kutta method and tolerances the scene asks for. Each logged event
+//! propagator where every mode stays affine, else by DOP853 at 1e-13 or
+//! the scene's `rtol`/`atol` (Taylor's method needs series the
+//! derivatives do not have), or by the Runge-Kutta method the scene asks
+//! for. Each logged event
 //! carries `d{state}/d{direction}` and `dt/d{direction}` in its states.
 
 use serde_json::{Map, Value, json};
@@ -20,6 +21,7 @@ use crate::engine::variational::Variational;
 use crate::engine::{HybridModel, Method, Observer, Sample, Tolerances, simulate_sampled};
 use crate::models::automaton::definition::Definition;
 use crate::models::automaton::model::Automaton;
+use crate::models::automaton::scene::AutomatonScene;
 use crate::runner::{Control, Report};
 use crate::scene::SceneError;
 
@@ -86,22 +88,18 @@ fn directions(definition: &Definition, names: &[String]) -> Result<Vec<Direction
     Ok(out)
 }
 
-/// The run of `definition` from its initial state with the derivatives
-/// along `names`, by `method` (`Auto`: see the module doc) under
+/// The run of `scene` from its initial state with the derivatives along
+/// its `sensitivities`, by its method (`Auto`: see the module doc) under
 /// `control`; samples and events as any run's.
-#[allow(clippy::too_many_arguments)]
 pub fn run(
-    definition: &Definition,
-    names: &[String],
-    method: Method,
-    tolerances: Tolerances,
-    (t_end, max_events): (f64, u64),
+    scene: &AutomatonScene,
     control: &Control,
     times: &[f64],
     on_sample: &mut dyn FnMut(&Sample),
     observer: &mut dyn Observer,
 ) -> Result<Report, SceneError> {
-    let directions = directions(definition, names)?;
+    let definition = &scene.definition;
+    let directions = directions(definition, &scene.sensitivities)?;
     let parameters: Vec<String> = directions
         .iter()
         .filter_map(|d| match d {
@@ -109,7 +107,7 @@ pub fn run(
             Direction::Initial(_) => None,
         })
         .collect();
-    let (promoted, slopes) = definition.with_parameters_as_states(&parameters)?;
+    let (promoted, slopes) = definition.with_parameters_as_states(&parameters, "sensitivities")?;
     let model = Automaton::compile(&promoted)?;
     let states = definition.states.len();
     let n = model.dimension();
@@ -138,7 +136,7 @@ pub fn run(
         .collect();
     let modes = model.modes();
     let variational = Variational::new(&model, modes.len(), &labels);
-    let (method, description) = match method {
+    let (method, description) = match scene.method {
         Method::Auto | Method::Linear if modes.iter().all(|&m| variational.is_linear(m)) => (
             Method::Linear,
             "every mode's flow stays affine with its derivatives: exact linear propagator"
@@ -146,15 +144,27 @@ pub fn run(
         ),
         Method::Auto => {
             let tol = Tolerances {
-                rtol: TOLERANCE,
-                atol: TOLERANCE,
+                rtol: scene.solver.rtol.unwrap_or(TOLERANCE),
+                atol: scene.solver.atol.unwrap_or(TOLERANCE),
             };
             (
                 Method::Dop853(tol),
-                format!("DOP853 (Dormand-Prince 8(5,3)), rtol {TOLERANCE:e}, atol {TOLERANCE:e}"),
+                format!(
+                    "DOP853 (Dormand-Prince 8(5,3)), rtol {:e}, atol {:e}",
+                    tol.rtol, tol.atol
+                ),
             )
         }
-        Method::Dopri5(_) | Method::Dop853(_) => (
+        Method::Linear => {
+            return Err(SceneError::field(
+                "solver.method",
+                "the exact linear propagator needs every mode's flow to stay affine with its \
+                 derivatives, and one does not here (a parameter multiplies a state?): \
+                 use dopri5 or dop853"
+                    .into(),
+            ));
+        }
+        method @ (Method::Dopri5(_) | Method::Dop853(_)) => (
             method,
             format!("{} at the scene's tolerances", method.name()),
         ),
@@ -169,7 +179,7 @@ pub fn run(
             ));
         }
     };
-    let options = control.options(t_end, max_events, method, tolerances);
+    let options = control.options(scene.t_end, scene.max_events, method, scene.tolerances);
     let x0 = variational.initial(model.initial(), &s0);
     let outcome = simulate_sampled(
         &variational,
