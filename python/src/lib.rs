@@ -124,11 +124,6 @@ fn run<'py>(
     sensitivities: Option<Vec<String>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (mut scene, label) = load(py, text, path)?;
-    if let Some(directions) = &sensitivities {
-        scene
-            .set_sensitivities(directions)
-            .map_err(|e| override_error(py, "sensitivities", e.reason))?;
-    }
     if let Some(t) = t_end {
         scene
             .set_t_end(t)
@@ -144,6 +139,12 @@ fn run<'py>(
         scene
             .override_solver(&solver)
             .map_err(|e| override_error(py, "method/rtol/atol/step", e.to_string()))?;
+    }
+    // After the method: whether it can carry the derivatives depends on it.
+    if let Some(directions) = &sensitivities {
+        scene
+            .set_sensitivities(directions)
+            .map_err(|e| override_error(py, "sensitivities", e.reason))?;
     }
     let writer = match log {
         None => None,

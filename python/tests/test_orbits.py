@@ -15,7 +15,7 @@ G, R, W = 9.81, 0.5, 10.0
 PERIOD = 2 * math.pi / W
 
 
-def test_sensitivities_come_back_in_the_summary_and_the_events():
+def test_sensitivities_come_back_in_the_summary_and_the_events(tmp_path):
     run = flicker.run(MODELS / "automata" / "mechanism.json", t_end=100.0, sensitivities=["eta", "initial.strain"])
     s = run.summary["sensitivities"]
     assert set(s) == {"eta", "initial.strain"}
@@ -26,6 +26,14 @@ def test_sensitivities_come_back_in_the_summary_and_the_events():
     with pytest.raises(flicker.SceneError) as caught:
         flicker.run(MODELS / "automata" / "mechanism.json", sensitivities=["etta"])
     assert caught.value.field == "sensitivities"
+    # omega multiplies the strain: no affine flow, so no linear propagator,
+    # refused before the log is touched.
+    log = tmp_path / "events.jsonl"
+    log.write_text("an earlier run\n")
+    with pytest.raises(flicker.SceneError) as caught:
+        flicker.run(MODELS / "automata" / "mechanism.json", method="linear", sensitivities=["omega"], log=str(log))
+    assert caught.value.field == "sensitivities" and "dop853" in str(caught.value)
+    assert log.read_text() == "an earlier run\n"
 
 
 def test_the_table_orbit_and_its_multipliers_meet_holmes_closed_form(cli, tmp_path):

@@ -215,10 +215,13 @@ fn unknown_directions_are_refused() {
 
 /// The exact linear propagator asked for where a direction makes a flow
 /// non-affine (`omega^2 strain` with `omega` carried as a state) is
-/// refused with the methods that do run (exit 2).
+/// refused with the methods that do run (exit 2), before the output
+/// folder's event log from an earlier run is touched.
 #[test]
 fn the_linear_propagator_is_refused_where_the_derivatives_are_not_affine() {
     let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("events.jsonl");
+    std::fs::write(&log, "an earlier run's events\n").unwrap();
     let done = crate::support::flicker(&[
         "run",
         &automaton("mechanism.json"),
@@ -233,7 +236,11 @@ fn the_linear_propagator_is_refused_where_the_derivatives_are_not_affine() {
     assert_eq!(done.status.code(), Some(2));
     let said = String::from_utf8_lossy(&done.stderr);
     assert!(
-        said.contains("solver.method") && said.contains("dop853"),
+        said.contains("linear propagator") && said.contains("dop853"),
         "{said}"
+    );
+    assert_eq!(
+        std::fs::read_to_string(&log).unwrap(),
+        "an earlier run's events\n"
     );
 }

@@ -336,7 +336,7 @@ impl SceneModel for AutomatonScene {
     }
 
     fn set_sensitivities(&mut self, directions: &[String]) -> Result<(), SceneError> {
-        super::sensitivities::check(&self.definition, directions)?;
+        super::sensitivities::check(self, directions)?;
         self.sensitivities = directions.to_vec();
         Ok(())
     }

@@ -37,11 +37,113 @@ enum Direction {
     Initial(usize),
 }
 
-/// Check `names` against `definition`: each a parameter (`NAME` or
-/// `parameters.NAME`) or a state's initial value (`initial.NAME`), each
-/// once.
-pub fn check(definition: &Definition, names: &[String]) -> Result<(), SceneError> {
-    directions(definition, names).map(|_| ())
+/// Check `names` against `scene` before anything runs: each a parameter
+/// (`NAME` or `parameters.NAME`) or a state's initial value
+/// (`initial.NAME`), each once, and the scene's method able to carry them.
+pub fn check(scene: &AutomatonScene, names: &[String]) -> Result<(), SceneError> {
+    let setup = Setup::new(&scene.definition, names)?;
+    let variational = Variational::new(&setup.model, setup.model.modes().len(), &setup.labels);
+    method(scene, &setup.model, &variational).map(|_| ())
+}
+
+/// The model with the derivatives' parameters as states, where the
+/// derivatives start, and what they are called.
+struct Setup {
+    model: Automaton,
+    /// Each direction's initial derivative of the whole state.
+    s0: Vec<Vec<f64>>,
+    /// Each direction as the summary names it.
+    labels: Vec<String>,
+}
+
+impl Setup {
+    fn new(definition: &Definition, names: &[String]) -> Result<Setup, SceneError> {
+        let directions = directions(definition, names)?;
+        let parameters: Vec<String> = directions
+            .iter()
+            .filter_map(|d| match d {
+                Direction::Parameter(p) => Some(p.clone()),
+                Direction::Initial(_) => None,
+            })
+            .collect();
+        let (promoted, slopes) =
+            definition.with_parameters_as_states(&parameters, "sensitivities")?;
+        let model = Automaton::compile(&promoted)?;
+        let states = definition.states.len();
+        let n = model.dimension();
+        let mut promoted_index = 0;
+        let s0 = directions
+            .iter()
+            .map(|d| {
+                let mut s = vec![0.0; n];
+                match d {
+                    Direction::Initial(i) => s[*i] = 1.0,
+                    Direction::Parameter(_) => {
+                        s[states + promoted_index] = 1.0;
+                        s[..states].copy_from_slice(&slopes[promoted_index]);
+                        promoted_index += 1;
+                    }
+                }
+                s
+            })
+            .collect();
+        let labels = directions
+            .iter()
+            .map(|d| match d {
+                Direction::Parameter(p) => p.clone(),
+                Direction::Initial(i) => format!("initial.{}", definition.states[*i]),
+            })
+            .collect();
+        Ok(Setup { model, s0, labels })
+    }
+}
+
+/// The method the derivatives' run uses, and why (see the module doc).
+fn method(
+    scene: &AutomatonScene,
+    model: &Automaton,
+    variational: &Variational<'_, Automaton>,
+) -> Result<(Method, String), SceneError> {
+    let affine = model.modes().iter().all(|&m| variational.is_linear(m));
+    match scene.method {
+        Method::Auto | Method::Linear if affine => Ok((
+            Method::Linear,
+            "every mode's flow stays affine with its derivatives: exact linear propagator"
+                .to_string(),
+        )),
+        Method::Auto => {
+            let tol = Tolerances {
+                rtol: scene.solver.rtol.unwrap_or(TOLERANCE),
+                atol: scene.solver.atol.unwrap_or(TOLERANCE),
+            };
+            Ok((
+                Method::Dop853(tol),
+                format!(
+                    "DOP853 (Dormand-Prince 8(5,3)), rtol {:e}, atol {:e}",
+                    tol.rtol, tol.atol
+                ),
+            ))
+        }
+        Method::Linear => Err(SceneError::field(
+            "solver.method",
+            "the exact linear propagator needs every mode's flow to stay affine with its \
+             derivatives, and one does not here (a parameter multiplies a state?): \
+             use dopri5 or dop853"
+                .into(),
+        )),
+        method @ (Method::Dopri5(_) | Method::Dop853(_)) => Ok((
+            method,
+            format!("{} at the scene's tolerances", method.name()),
+        )),
+        other => Err(SceneError::field(
+            "solver.method",
+            format!(
+                "sensitivities are integrated with the model (variational equations): \
+                 use linear (affine modes), dopri5 or dop853, not {}",
+                other.name()
+            ),
+        )),
+    }
 }
 
 fn directions(definition: &Definition, names: &[String]) -> Result<Vec<Direction>, SceneError> {
@@ -98,87 +200,11 @@ pub fn run(
     on_sample: &mut dyn FnMut(&Sample),
     observer: &mut dyn Observer,
 ) -> Result<Report, SceneError> {
-    let definition = &scene.definition;
-    let directions = directions(definition, &scene.sensitivities)?;
-    let parameters: Vec<String> = directions
-        .iter()
-        .filter_map(|d| match d {
-            Direction::Parameter(p) => Some(p.clone()),
-            Direction::Initial(_) => None,
-        })
-        .collect();
-    let (promoted, slopes) = definition.with_parameters_as_states(&parameters, "sensitivities")?;
-    let model = Automaton::compile(&promoted)?;
-    let states = definition.states.len();
+    let Setup { model, s0, labels } = Setup::new(&scene.definition, &scene.sensitivities)?;
+    let states = scene.definition.states.len();
     let n = model.dimension();
-    let mut promoted_index = 0;
-    let s0: Vec<Vec<f64>> = directions
-        .iter()
-        .map(|d| {
-            let mut s = vec![0.0; n];
-            match d {
-                Direction::Initial(i) => s[*i] = 1.0,
-                Direction::Parameter(_) => {
-                    s[states + promoted_index] = 1.0;
-                    s[..states].copy_from_slice(&slopes[promoted_index]);
-                    promoted_index += 1;
-                }
-            }
-            s
-        })
-        .collect();
-    let labels: Vec<String> = directions
-        .iter()
-        .map(|d| match d {
-            Direction::Parameter(p) => p.clone(),
-            Direction::Initial(i) => format!("initial.{}", definition.states[*i]),
-        })
-        .collect();
-    let modes = model.modes();
-    let variational = Variational::new(&model, modes.len(), &labels);
-    let (method, description) = match scene.method {
-        Method::Auto | Method::Linear if modes.iter().all(|&m| variational.is_linear(m)) => (
-            Method::Linear,
-            "every mode's flow stays affine with its derivatives: exact linear propagator"
-                .to_string(),
-        ),
-        Method::Auto => {
-            let tol = Tolerances {
-                rtol: scene.solver.rtol.unwrap_or(TOLERANCE),
-                atol: scene.solver.atol.unwrap_or(TOLERANCE),
-            };
-            (
-                Method::Dop853(tol),
-                format!(
-                    "DOP853 (Dormand-Prince 8(5,3)), rtol {:e}, atol {:e}",
-                    tol.rtol, tol.atol
-                ),
-            )
-        }
-        Method::Linear => {
-            return Err(SceneError::field(
-                "solver.method",
-                "the exact linear propagator needs every mode's flow to stay affine with its \
-                 derivatives, and one does not here (a parameter multiplies a state?): \
-                 use dopri5 or dop853"
-                    .into(),
-            ));
-        }
-        method @ (Method::Dopri5(_) | Method::Dop853(_)) => (
-            method,
-            format!("{} at the scene's tolerances", method.name()),
-        ),
-        other => {
-            return Err(SceneError::field(
-                "solver.method",
-                format!(
-                    "sensitivities are integrated with the model (variational equations): \
-                     use linear (affine modes), dopri5 or dop853, not {}",
-                    other.name()
-                ),
-            ));
-        }
-    };
+    let variational = Variational::new(&model, model.modes().len(), &labels);
+    let (method, description) = method(scene, &model, &variational)?;
     let options = control.options(scene.t_end, scene.max_events, method, scene.tolerances);
     let x0 = variational.initial(model.initial(), &s0);
     let outcome = simulate_sampled(
