@@ -16,8 +16,9 @@
 //!   not the bound's.
 //! - Exact flows add no error: their bound is a round-off allowance of
 //!   [`ROUNDOFF_ULPS`] ulps of the state's size per event (an estimate of
-//!   how round-off grows, not a bound), and an exact run pays for nothing
-//!   else.
+//!   how round-off grows, not a bound), and of each event's time, where a
+//!   slow crossing turns the state's rounding into a larger time error (its
+//!   size over the closing speed); an exact run pays for nothing else.
 
 use crate::engine::error_set::{ErrorSet, TRACKED};
 use crate::engine::model::{HybridModel, Mode};
@@ -49,13 +50,22 @@ pub(crate) struct Bound {
     /// The largest state component seen (initial state and events): the
     /// round-off allowance's scale.
     state_scale: f64,
+    /// Scratch: the rate of the state at an event.
+    rate: Vec<f64>,
+    /// The clock component, which carries no error.
+    clock: Option<usize>,
+    /// The largest time error the rounding of an exact flow's state makes
+    /// at an event, over its closing speed (a slow crossing's time is
+    /// uncertain by far more ulps than its state).
+    crossing_rounding: f64,
 }
 
 impl Bound {
-    /// No error yet, for a run of dimension `n` from `x0`.
-    pub fn new(n: usize, x0: &[f64]) -> Self {
+    /// No error yet, for a run of dimension `n` from `x0`, whose component
+    /// `clock` (if any) is the run's time, which carries no error.
+    pub fn new(n: usize, x0: &[f64], clock: Option<usize>) -> Self {
         Bound {
-            errors: ErrorSet::new(n),
+            errors: ErrorSet::new(n).with_exact(clock),
             tangents: Tangents::new(n),
             matrix: vec![0.0; if n <= TRACKED { n * n } else { 0 }],
             gradient: vec![0.0; n],
@@ -64,7 +74,14 @@ impl Bound {
             event_time_bound: 0.0,
             last_time_bound: 0.0,
             last_event: None,
-            state_scale: x0.iter().fold(0.0, |m: f64, v| m.max(v.abs())),
+            state_scale: x0
+                .iter()
+                .enumerate()
+                .filter(|(i, _)| Some(*i) != clock)
+                .fold(0.0, |m: f64, (_, v)| m.max(v.abs())),
+            clock,
+            rate: vec![0.0; n],
+            crossing_rounding: 0.0,
         }
     }
 
@@ -189,11 +206,41 @@ impl Bound {
     /// exact run too).
     #[inline(always)]
     pub fn note_state(&mut self, before: &[f64]) {
-        for x in before {
+        for (i, x) in before.iter().enumerate() {
             let size = x.abs();
-            if size > self.state_scale {
+            if size > self.state_scale && Some(i) != self.clock {
                 self.state_scale = size;
             }
+        }
+    }
+
+    /// Note how far rounding moves the time of an exact flow's event of
+    /// guard `slot` at `before`: [`ROUNDOFF_ULPS`] ulps of the sizes its
+    /// guard sums, over its closing speed.
+    pub fn note_crossing<M: HybridModel + ?Sized>(
+        &mut self,
+        model: &M,
+        mode: Mode,
+        slot: usize,
+        before: &[f64],
+    ) {
+        if model.guards(mode)[slot].internal || !self.errors.tracked() {
+            return;
+        }
+        self.gradient_of(model, mode, slot, before);
+        let mut rate = std::mem::take(&mut self.rate);
+        self.tangents.rate(model, mode, before, &mut rate);
+        let closing: f64 = self.gradient.iter().zip(&rate).map(|(g, f)| g * f).sum();
+        let sizes: f64 = self
+            .gradient
+            .iter()
+            .zip(before)
+            .map(|(g, x)| (g * x).abs())
+            .sum();
+        self.rate = rate;
+        let shift = ROUNDOFF_ULPS * f64::EPSILON * sizes / closing.abs();
+        if shift.is_finite() && shift > self.crossing_rounding {
+            self.crossing_rounding = shift;
         }
     }
 
@@ -284,25 +331,33 @@ impl Bound {
         Ok(())
     }
 
+    /// The time error of the last event.
+    pub fn last_time_bound(&self) -> f64 {
+        self.last_time_bound
+    }
+
     /// Whether the run may end at `t`, with its next event predicted at
-    /// `next`: an event within its time error of the end may or may not
-    /// belong to the run, and then its count and final state are uncertain.
-    pub fn at_end(&self, t: Time, next: Option<Time>) -> Result<(), String> {
+    /// `next`, whose time is uncertain by the second number: an event within
+    /// its time error of the end may or may not belong to the run, and then
+    /// its count and final state are uncertain. One within `window` of the
+    /// end (the rounding of times there) is at the end by the run's
+    /// convention (applied), not uncertain.
+    pub fn at_end(&self, t: Time, next: Option<(Time, f64)>, window: f64) -> Result<(), String> {
         let around = [
-            self.last_event.map(|last| t.since(last)),
-            next.map(|next| next.since(t)),
+            self.last_event
+                .map(|last| (t.since(last), self.last_time_bound)),
+            next.map(|(next, error)| (next.since(t), error)),
         ];
         match around
             .into_iter()
             .flatten()
-            .find(|gap| self.last_time_bound > 0.0 && *gap <= self.last_time_bound)
+            .find(|&(gap, error)| error > 0.0 && gap > window && gap <= error)
         {
-            Some(gap) => Err(format!(
+            Some((gap, error)) => Err(format!(
                 "an event lies {gap:.2e} from t_end = {}, within the time error of the events \
-                 ({:.2e}): whether it happens before the end is uncertain, so the final state cannot \
-                 be trusted; tighten the method or move t_end",
+                 ({error:.2e}): whether it happens before the end is uncertain, so the final state \
+                 cannot be trusted; tighten the method or move t_end",
                 t.value(),
-                self.last_time_bound
             )),
             None => Ok(()),
         }
@@ -317,8 +372,10 @@ impl Bound {
     /// The bound on every event time of a run that reached `t`; `None`
     /// where the errors are not tracked.
     pub fn event_time_bound(&self, t: Time) -> Option<f64> {
-        self.errors
-            .tracked()
-            .then(|| self.event_time_bound + ROUNDOFF_ULPS * f64::EPSILON * t.value().abs())
+        self.errors.tracked().then(|| {
+            self.event_time_bound
+                + self.crossing_rounding
+                + ROUNDOFF_ULPS * f64::EPSILON * t.value().abs()
+        })
     }
 }

@@ -9,7 +9,7 @@ use crate::engine::adaptive::{EmbeddedPair, StepFailure, Tolerances};
 use crate::engine::dop853::Dop853;
 use crate::engine::dopri5::Dopri5;
 use crate::engine::linear::Linear;
-use crate::engine::locate::{Interpolant, StepScan};
+use crate::engine::locate::{Interpolant, Start, StepScan};
 use crate::engine::model::{Flow, HybridModel, Mode};
 use crate::engine::taylor::Taylor;
 use crate::engine::verlet::Verlet;
@@ -182,8 +182,7 @@ impl Integrator {
         match self {
             Integrator::Dopri5(m) => m.parts().0.bounded = bounded,
             Integrator::Dop853(m) => m.parts().0.bounded = bounded,
-            Integrator::Linear(m) => m.bound_first(bounded),
-            Integrator::Verlet(_) | Integrator::Taylor(_) => {}
+            Integrator::Linear(_) | Integrator::Verlet(_) | Integrator::Taylor(_) => {}
         }
     }
 
@@ -280,12 +279,12 @@ impl Integrator {
         model: &M,
         mode: Mode,
         guard: usize,
-        check_start: bool,
+        start: Start,
         uncertainty: f64,
     ) -> Option<Result<StepScan, String>> {
         match self {
-            Integrator::Taylor(m) => Some(m.locate(model, mode, guard, check_start, uncertainty)),
-            Integrator::Linear(m) => m.locate(model, mode, guard, check_start, uncertainty),
+            Integrator::Taylor(m) => Some(m.locate(model, mode, guard, start, uncertainty)),
+            Integrator::Linear(m) => m.locate(model, mode, guard, start, uncertainty),
             _ => None,
         }
     }

@@ -20,7 +20,7 @@ use std::cell::Cell;
 use nalgebra::{DMatrix, DVector};
 
 use crate::engine::adaptive::StepFailure;
-use crate::engine::locate::StepScan;
+use crate::engine::locate::{Start, StepScan};
 use crate::engine::model::{HybridModel, Mode};
 use crate::numerics::polynomial::eval_compensated;
 
@@ -55,8 +55,6 @@ pub struct Linear {
     y1: Vec<f64>,
     /// Propagator evaluations; a `Cell` because evaluation reads `&self`.
     evaluations: Cell<u64>,
-    /// The components the local error is measured on.
-    bounded: usize,
 }
 
 /// `out = a v` for a square matrix `a` laid out row by row.
@@ -84,7 +82,6 @@ impl Linear {
             guard: vec![0.0; ORDER + 1],
             y1: vec![0.0; dimension],
             evaluations: Cell::new(0),
-            bounded: usize::MAX,
         }
     }
 
@@ -224,7 +221,7 @@ impl Linear {
         model: &M,
         mode: Mode,
         guard: usize,
-        check_start: bool,
+        start: Start,
         uncertainty: f64,
     ) -> Option<Result<StepScan, String>> {
         if !model.has_series(mode) {
@@ -239,7 +236,7 @@ impl Linear {
             guard,
             &mut self.guard,
             self.h,
-            check_start,
+            start,
             uncertainty,
         ))
     }
@@ -249,18 +246,11 @@ impl Linear {
         self.evaluations.get()
     }
 
-    /// Round-off of one propagation: a few ulps of the state.
+    /// The truncation of one propagation's series: below `1 / 25!` of the
+    /// state, nothing beside the step's rounding (which the engine adds:
+    /// see `STEP_ROUNDING_ULPS` in `src/engine/simulation.rs`).
     pub fn local_error(&self) -> f64 {
-        let bounded = self.bounded.min(self.y1.len());
-        8.0 * f64::EPSILON
-            * self.y1[..bounded]
-                .iter()
-                .fold(1.0, |m: f64, x| m.max(x.abs()))
-    }
-
-    /// Measure the local error on the first `bounded` components only.
-    pub fn bound_first(&mut self, bounded: usize) {
-        self.bounded = bounded;
+        0.0
     }
 
     /// The state at the end of the step.

@@ -38,6 +38,25 @@
 use crate::engine::model::{Direction, Guard};
 use crate::numerics::polynomial::eval_plain;
 
+/// How a guard stands where a step starts, which decides what counts as
+/// its first crossing in the step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Start {
+    /// As its value says: it crosses when it passes from strictly before
+    /// zero (in its direction) to zero or beyond; a guard past zero must
+    /// first come back.
+    Armed,
+    /// It sits on zero after a reset or at `t = 0`: it fires at once if it
+    /// moves further its way (either way, for a guard of either
+    /// direction), and otherwise counts as just before zero.
+    OnZero,
+    /// It has just fired and the state went on through (a marker: a
+    /// Poincare section, a threshold): it counts as exactly on zero,
+    /// whatever side rounding left it on, and must come back before it can
+    /// cross again. A crossing fires once.
+    Spent,
+}
+
 /// What one step says about one guard.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StepScan {
@@ -51,23 +70,47 @@ pub struct StepScan {
     /// below the integration error means the method cannot tell a graze from
     /// a near miss.
     pub margin: f64,
+    /// Where in the step (`s in [0, 1]`) the margin was measured: a graze
+    /// after an earlier event of the step does not matter, for the step is
+    /// taken again after it.
+    pub margin_at: f64,
+}
+
+impl StepScan {
+    /// No crossing, nothing near.
+    pub const CLEAR: StepScan = StepScan {
+        crossing: None,
+        margin: f64::INFINITY,
+        margin_at: 1.0,
+    };
+
+    /// A crossing at `s`, nothing near before it.
+    pub fn at(s: f64) -> StepScan {
+        StepScan {
+            crossing: Some(s),
+            ..StepScan::CLEAR
+        }
+    }
 }
 
 /// Scan one step for `guard`, where `g(s)` is the guard along the step.
 ///
-/// With `check_start` (a guard that sits on zero at `s = 0` after a reset),
-/// the guard fires at `s = 0` if it moves further its way, and otherwise
-/// counts as being just before zero: a return to zero that comes sooner
-/// than rounding lets the guard rise visibly above it (a reset that barely
-/// turned the motion round) is still a crossing. See the module docs.
+/// With [`Start::OnZero`] (a guard that sits on zero at `s = 0` after a
+/// reset), the guard fires at `s = 0` if it moves further its way, and
+/// otherwise counts as being just before zero: a return to zero that comes
+/// sooner than rounding lets the guard rise visibly above it (a reset that
+/// barely turned the motion round) is still a crossing. With
+/// [`Start::Spent`] it starts at exactly zero, from where only a return and
+/// a new passage cross. See the module docs.
 pub fn scan_step(
     guard: &Guard,
-    check_start: bool,
+    start: Start,
     interpolant: Interpolant,
     resolution: f64,
     mut g: impl FnMut(f64) -> f64,
 ) -> StepScan {
-    let g0 = g(0.0);
+    let check_start = start == Start::OnZero;
+    let g0 = if start == Start::Spent { 0.0 } else { g(0.0) };
     let start = if check_start {
         just_before_zero(guard.direction, g0)
     } else {
@@ -78,7 +121,7 @@ pub fn scan_step(
         let crossing = scan_from(guard.direction, 0.0, &cuts, start, &mut g, &|_| f64::NAN);
         return StepScan {
             crossing,
-            margin: f64::INFINITY,
+            ..StepScan::CLEAR
         };
     }
     // Fits of a fixed size, so their loops unroll: a quartic takes
@@ -172,7 +215,8 @@ fn scan_piece<const N: usize>(
     // Most steps: the guard stays clearly on one side, which a bound on the
     // polynomial's variation shows without finding its turning points.
     let variation: f64 = poly[1..].iter().map(|c| c.abs()).sum();
-    if depth >= MAX_DEPTH && !check_start && start.signum() == poly[0].signum() {
+    // (A start on exactly zero, a spent guard, has no side yet.)
+    if depth >= MAX_DEPTH && !check_start && start != 0.0 && start.signum() == poly[0].signum() {
         let clearance = poly[0].abs() - variation;
         let before = match direction {
             Direction::Falling => poly[0] > 0.0,
@@ -180,10 +224,7 @@ fn scan_piece<const N: usize>(
             Direction::Either => true,
         };
         if clearance > resolution && (before || direction == Direction::Either) {
-            return StepScan {
-                crossing: None,
-                margin: f64::INFINITY,
-            };
+            return StepScan::CLEAR;
         }
     }
     let turning = critical_points(poly);
@@ -225,9 +266,14 @@ fn scan_piece<const N: usize>(
                 check_start: false,
             };
             let right = scan_piece::<N>(direction, right_piece, resolution, g, depth + 1);
+            let nearer = if left.margin <= right.margin {
+                left
+            } else {
+                right
+            };
             return StepScan {
                 crossing: right.crossing,
-                margin: left.margin.min(right.margin),
+                ..nearer
             };
         }
     }
@@ -235,12 +281,7 @@ fn scan_piece<const N: usize>(
     let mut from = (a, start);
     if check_start {
         match leaves_zero(direction, poly, &samples) {
-            Leaves::Inward => {
-                return StepScan {
-                    crossing: Some(a),
-                    margin: f64::INFINITY,
-                };
-            }
+            Leaves::Inward => return StepScan::at(a),
             Leaves::Outward(u) if u > 0.0 => {
                 let s = a + u * w;
                 from = (s, g(s));
@@ -261,24 +302,33 @@ fn scan_piece<const N: usize>(
         &|s| eval_plain(poly, (s - a) / w),
     );
     let local = crossing.map(|s| (s - a) / w);
-    let margin = margin(direction, poly, local, turning.as_slice());
+    let (margin, at) = margin(direction, poly, local, turning.as_slice());
+    if margin > resolution {
+        return StepScan {
+            crossing,
+            ..StepScan::CLEAR
+        };
+    }
     StepScan {
         crossing,
-        margin: if margin > resolution {
-            f64::INFINITY
-        } else {
-            margin
-        },
+        margin,
+        margin_at: a + at * w,
     }
 }
 
-/// See [`StepScan::margin`].
-fn margin(direction: Direction, poly: &[f64], crossing: Option<f64>, turning: &[f64]) -> f64 {
+/// See [`StepScan::margin`]: the margin, and where in `[0, 1]` it was
+/// measured.
+fn margin(
+    direction: Direction,
+    poly: &[f64],
+    crossing: Option<f64>,
+    turning: &[f64],
+) -> (f64, f64) {
     // `inward` is the sign of the side a crossing goes to.
     let inward = match direction {
         Direction::Falling => -1.0,
         Direction::Rising => 1.0,
-        Direction::Either => return f64::INFINITY,
+        Direction::Either => return (f64::INFINITY, 1.0),
     };
     match crossing {
         Some(s) => {
@@ -289,16 +339,18 @@ fn margin(direction: Direction, poly: &[f64], crossing: Option<f64>, turning: &[
                 eval_plain(&d2[..poly.len().saturating_sub(2)], s),
             );
             if curvature * inward < 0.0 {
-                slope * slope / (2.0 * curvature.abs())
+                (slope * slope / (2.0 * curvature.abs()), s)
             } else {
-                f64::INFINITY
+                (f64::INFINITY, 1.0)
             }
         }
         None => turning
             .iter()
-            .map(|&s| eval_plain(poly, s) * -inward)
-            .filter(|height| *height > 0.0)
-            .fold(f64::INFINITY, f64::min),
+            .map(|&s| (eval_plain(poly, s) * -inward, s))
+            .filter(|(height, _)| *height > 0.0)
+            .fold((f64::INFINITY, 1.0), |best, next| {
+                if next.0 < best.0 { next } else { best }
+            }),
     }
 }
 
@@ -413,8 +465,8 @@ enum Leaves {
     Inward,
     /// Back the way it came, visibly so from this `s` (in the piece) on.
     Outward(f64),
-    /// Still before zero, not visibly moving within the piece, or a guard
-    /// of either direction: scanned as usual.
+    /// Still before zero, or not visibly moving within the piece: scanned
+    /// as usual.
     Undecided,
 }
 
@@ -425,10 +477,11 @@ enum Leaves {
 /// differences of states far larger than the guard) or an excursion far
 /// below anything the step resolves.
 fn leaves_zero(direction: Direction, poly: &[f64], samples: &[f64]) -> Leaves {
+    // A guard of either direction on zero crosses whichever way it moves.
     let sign = match direction {
         Direction::Falling => -1.0,
         Direction::Rising => 1.0,
-        Direction::Either => return Leaves::Undecided,
+        Direction::Either => 0.0,
     };
     if poly[0] * sign < 0.0 {
         // Still before zero: it has not crossed, and the scan finds when it does.
@@ -439,7 +492,7 @@ fn leaves_zero(direction: Direction, poly: &[f64], samples: &[f64]) -> Leaves {
     while s <= 1.0 {
         let moved = eval_plain(poly, s) - poly[0];
         if moved.abs() > floor {
-            return if moved * sign > 0.0 {
+            return if sign == 0.0 || moved * sign > 0.0 {
                 Leaves::Inward
             } else {
                 Leaves::Outward(s)
@@ -553,9 +606,14 @@ mod tests {
     const FALLING: Guard = Guard::affine("g", Direction::Falling);
 
     fn first_crossing(guard: &Guard, check_start: bool, g: impl FnMut(f64) -> f64) -> Option<f64> {
+        let start = if check_start {
+            Start::OnZero
+        } else {
+            Start::Armed
+        };
         scan_step(
             guard,
-            check_start,
+            start,
             Interpolant::Polynomial { degree: 4 },
             f64::INFINITY,
             g,
@@ -616,7 +674,7 @@ mod tests {
         for degree in [4, 7] {
             let scan = scan_step(
                 &FALLING,
-                true,
+                Start::OnZero,
                 Interpolant::Polynomial { degree },
                 f64::INFINITY,
                 g,
@@ -629,7 +687,7 @@ mod tests {
         for degree in [4, 7] {
             let scan = scan_step(
                 &FALLING,
-                true,
+                Start::OnZero,
                 Interpolant::Polynomial { degree },
                 1e-20,
                 dip,
@@ -650,7 +708,13 @@ mod tests {
         assert_eq!(first_crossing(&FALLING, true, |_| 0.0), None);
         // Zero (to rounding) for a while, then closing: it fires when it goes.
         let g = |s: f64| if s < 0.5 { 0.0 } else { -(s - 0.5) };
-        let scan = scan_step(&FALLING, true, Interpolant::Other, f64::INFINITY, g);
+        let scan = scan_step(
+            &FALLING,
+            Start::OnZero,
+            Interpolant::Other,
+            f64::INFINITY,
+            g,
+        );
         let root = scan.crossing.unwrap();
         assert!((0.49..=0.51).contains(&root), "root {root}");
     }
@@ -664,6 +728,58 @@ mod tests {
     }
 
     #[test]
+    fn a_spent_guard_fires_only_after_it_comes_back() {
+        // Located a rounding short of zero (the near side), going on
+        // through: the crossing just fired is not found again...
+        let rising = Guard::affine("g", Direction::Rising).as_crossing();
+        let g = |s: f64| -1e-17 + s * (0.7 - s);
+        let scan = scan_step(
+            &rising,
+            Start::Spent,
+            Interpolant::Polynomial { degree: 4 },
+            f64::INFINITY,
+            g,
+        );
+        assert_eq!(scan.crossing, None);
+        // ...while armed it would be, at once.
+        let armed = scan_step(
+            &rising,
+            Start::Armed,
+            Interpolant::Polynomial { degree: 4 },
+            f64::INFINITY,
+            g,
+        );
+        assert!(armed.crossing.is_some_and(|s| s < 1e-12));
+        // Back below zero at 0.7 and up again at 0.9: that passage fires.
+        let g = |s: f64| -1e-17 + s * (0.7 - s) * (0.9 - s);
+        let root = scan_step(
+            &rising,
+            Start::Spent,
+            Interpolant::Polynomial { degree: 4 },
+            f64::INFINITY,
+            g,
+        )
+        .crossing
+        .unwrap();
+        assert!((root - 0.9).abs() < 1e-14, "root {root}");
+    }
+
+    #[test]
+    fn a_guard_of_either_direction_on_zero_fires_whichever_way_it_moves() {
+        let either = Guard::affine("g", Direction::Either);
+        for sign in [1.0, -1.0] {
+            let scan = scan_step(
+                &either,
+                Start::OnZero,
+                Interpolant::Polynomial { degree: 4 },
+                f64::INFINITY,
+                |s| sign * s,
+            );
+            assert_eq!(scan.crossing, Some(0.0), "sign {sign}");
+        }
+    }
+
+    #[test]
     fn returns_the_side_that_has_crossed() {
         let root = first_crossing(&FALLING, false, |s| 0.3 - s).unwrap();
         assert!(0.3 - root <= 0.0 && 0.3 - root > -1e-15);
@@ -674,7 +790,7 @@ mod tests {
         // Dips to -1e-6 and back: margin = depth = 1e-6.
         let graze = scan_step(
             &FALLING,
-            false,
+            Start::Armed,
             Interpolant::Polynomial { degree: 4 },
             f64::INFINITY,
             |s| (s - 0.5).powi(2) - 1e-6,
@@ -688,7 +804,7 @@ mod tests {
         // Turns back 1e-6 short of zero: a near miss, margin 1e-6.
         let miss = scan_step(
             &FALLING,
-            false,
+            Start::Armed,
             Interpolant::Polynomial { degree: 4 },
             f64::INFINITY,
             |s| (s - 0.5).powi(2) + 1e-6,
@@ -699,7 +815,7 @@ mod tests {
         assert_eq!(
             scan_step(
                 &FALLING,
-                false,
+                Start::Armed,
                 Interpolant::Polynomial { degree: 4 },
                 f64::INFINITY,
                 |s| 0.1 - s * s
@@ -715,7 +831,7 @@ mod tests {
         // through five samples cannot see it; halving until the fit is
         // exact does.
         let g = |s: f64| 1e-3 + (s - 0.3).powi(2) - 1.001e-3 * (-((s - 0.3) / 0.01).powi(2)).exp();
-        let scan = scan_step(&FALLING, false, Interpolant::Other, f64::INFINITY, g);
+        let scan = scan_step(&FALLING, Start::Armed, Interpolant::Other, f64::INFINITY, g);
         let root = scan.crossing.expect("the dip must be found");
         assert!((root - 0.3).abs() < 0.01, "root {root}");
         assert!(g(root) <= 0.0 && g(root - 1e-9) > 0.0);

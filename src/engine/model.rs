@@ -142,7 +142,10 @@ impl Jump {
 /// States are `&[f64]` of length [`dimension`](HybridModel::dimension); the
 /// meaning of each component may differ from mode to mode (a chart switch
 /// changes coordinates). Time is autonomous: flows depend on the elapsed
-/// time `tau` since the last event, never on the absolute clock.
+/// time `tau` since the last event, never on the absolute clock; a forced
+/// model carries the clock as a state of rate one and names it
+/// ([`clock`](HybridModel::clock)), which the engine keeps equal to the
+/// run's own time.
 pub trait HybridModel {
     /// Length of the continuous state.
     fn dimension(&self) -> usize;
@@ -311,6 +314,17 @@ pub trait HybridModel {
     fn reset_jacobian(&self, mode: Mode, guard: usize, x: &[f64], out: &mut [f64]) -> bool {
         let _ = (mode, guard, x, out);
         false
+    }
+
+    /// The state component that is the clock, if the model reads time (a
+    /// forced system, whose clock is a state of rate one so that its flows
+    /// stay autonomous). The engine writes its run's time into it, the
+    /// clock's initial value added, wherever a stretch of flow starts, at
+    /// every event (before and after the reset) and at the end: a clock
+    /// integrated step by step would drift from the run's double-double
+    /// time by a rounding per step.
+    fn clock(&self) -> Option<usize> {
+        None
     }
 
     /// How many leading components of the state the run's error bound is

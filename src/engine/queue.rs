@@ -73,6 +73,17 @@ impl EventQueue {
         Some((slot, self.exact[slot]))
     }
 
+    /// The slots predicted at or before `time`, into `out`.
+    pub fn due_by(&self, time: Time, out: &mut Vec<usize>) {
+        out.clear();
+        out.extend(
+            self.queue
+                .iter()
+                .map(|(slot, _)| *slot)
+                .filter(|&slot| self.exact[slot] <= time),
+        );
+    }
+
     /// Forget every prediction.
     pub fn clear(&mut self) {
         self.queue.clear();

@@ -13,6 +13,15 @@
 //!   event at the very end of a segment happens before the segment ends.
 //!   Nothing past `t_end` happens: the source is asked to reach `t_end` and
 //!   say whether it can vouch for the state there.
+//! - **An event at `t_end`** is the run's: it is applied, and the final
+//!   state is the state after its reset (the log has the state before it).
+//!   "At `t_end`" means within [`end_window`] of it, the rounding of times
+//!   there: an event that lands on `t_end` by construction (a clock that
+//!   ticks every unit, `t_end` a whole number of ticks) is found a few
+//!   ulps to either side, and is fired whichever (at its own time, or at
+//!   `t_end` where a step that ends there finds it just beyond). Past the
+//!   window nothing happens; an event the run cannot place on one side of
+//!   the window (its time error reaches across) stops the run there.
 //! - **Samples.** Sample times (increasing, up to `t_end`) due before what
 //!   happens next are reported from the flow as it is: a sample at an
 //!   event's time sees the state before the reset, and sampling changes
@@ -43,6 +52,7 @@
 //! [`simulate`]: crate::engine::simulate
 //! [`simulate_local`]: crate::engine::simulate_local
 
+use crate::engine::bound::ROUNDOFF_ULPS;
 use crate::engine::ledger::Ledger;
 use crate::engine::observer::Observer;
 use crate::engine::run::Status;
@@ -101,8 +111,17 @@ pub(crate) trait Segments {
     /// Report the state at sample time `s` (not past what happens next).
     fn sample(&mut self, s: f64, ledger: &mut Ledger);
 
+    /// The guard, if any, that crosses in `(t_end, t_end + window]`
+    /// beyond what the source has predicted (a step that ends at `t_end`
+    /// does not look past it): it is due at `t_end`.
+    fn due_at_end(&mut self, t_end: Time, window: f64) -> Option<usize> {
+        let _ = (t_end, window);
+        None
+    }
+
     /// Reach `t_end` with nothing more to happen before it, or say why the
-    /// state there cannot be vouched for.
+    /// state there cannot be vouched for. An event due at `t_end` may have
+    /// fired a rounding past it: the state after it is the final state.
     fn finish(&mut self, t_end: Time) -> Result<(), End>;
 }
 
@@ -137,7 +156,21 @@ fn turns<S: Segments + ?Sized, O: Observer + ?Sized>(
             source.sample(s, ledger);
         }
         if t.value() > t_end {
-            return source.finish(Time::new(t_end));
+            let end = Time::new(t_end);
+            let window = end_window(t_end);
+            // A predicted event fires at its own time, a state that has
+            // just crossed; one the source finds past its last step at
+            // the end.
+            let due = match guard {
+                Some(guard) if t.since(end) <= window => Some((guard, t)),
+                _ => source.due_at_end(end, window).map(|guard| (guard, end)),
+            };
+            match due {
+                Some((guard, at)) => source.fire(guard, at, ledger, observer)?,
+                None => return source.finish(end),
+            }
+            ledger.check_events(source.origin())?;
+            continue;
         }
         match guard {
             Some(guard) => source.fire(guard, t, ledger, observer)?,
@@ -145,6 +178,12 @@ fn turns<S: Segments + ?Sized, O: Observer + ?Sized>(
         }
         ledger.check_events(source.origin())?;
     }
+}
+
+/// How far past `t_end` an event still counts as at `t_end`: the rounding
+/// of times there, [`ROUNDOFF_ULPS`] ulps of `t_end`.
+pub fn end_window(t_end: f64) -> f64 {
+    ROUNDOFF_ULPS * f64::EPSILON * t_end.abs()
 }
 
 /// Turns of the loop between two readings of the wall clock.

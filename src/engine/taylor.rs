@@ -24,7 +24,7 @@
 //! [`HybridModel::guard_series`]: crate::engine::HybridModel::guard_series
 
 use crate::engine::adaptive::{StepFailure, Tolerances};
-use crate::engine::locate::StepScan;
+use crate::engine::locate::{Start, StepScan};
 use crate::engine::model::{Direction, HybridModel, Mode};
 use crate::numerics::polynomial::eval_compensated;
 use crate::numerics::taylor::{eval2, first_fall};
@@ -95,7 +95,13 @@ impl Taylor {
                 .chunks_exact(w)
                 .fold(0.0_f64, |m, c| m.max(c[k].abs()))
         };
-        let size = y0.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+        // The clock, the run's time, carries no error and sets no scale.
+        let clock = model.clock();
+        let size = y0
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| Some(*i) != clock)
+            .fold(0.0_f64, |m, (_, x)| m.max(x.abs()));
         let Tolerances { rtol, atol } = self.tolerances;
         // Relative where the state is large enough for rtol to govern.
         let scale = if rtol * size > atol { size } else { 1.0 };
@@ -178,16 +184,14 @@ impl Taylor {
     /// The first crossing of `guard` on the step in its direction, as a
     /// fraction of the step, and how clearly the step decides (see
     /// [`StepScan`]; turning points are looked for only where the guard
-    /// may come within `uncertainty` of zero). With `check_start` (the
-    /// guard sits on zero after a reset) it fires at once if it moves on
-    /// its way; otherwise a guard that starts past zero must first come
-    /// back before it can cross.
+    /// may come within `uncertainty` of zero). How the guard counts at the
+    /// step's start is `start`'s (see [`Start`]).
     pub fn locate<M: HybridModel + ?Sized>(
         &mut self,
         model: &M,
         mode: Mode,
         guard: usize,
-        check_start: bool,
+        start: Start,
         uncertainty: f64,
     ) -> Result<StepScan, String> {
         let w = self.order + 1;
@@ -199,7 +203,7 @@ impl Taylor {
             guard,
             &mut self.guard,
             self.h,
-            check_start,
+            start,
             uncertainty,
         )
     }
@@ -215,7 +219,7 @@ pub(crate) fn locate_on_series<M: HybridModel + ?Sized>(
     guard: usize,
     series: &mut [f64],
     h: f64,
-    check_start: bool,
+    start: Start,
     uncertainty: f64,
 ) -> Result<StepScan, String> {
     if !series.iter().all(|c| c.is_finite()) {
@@ -224,7 +228,14 @@ pub(crate) fn locate_on_series<M: HybridModel + ?Sized>(
             model.guards(mode)[guard].name
         ));
     }
-    let (first, margin) = match model.guards(mode)[guard].direction {
+    // A spent guard starts on zero: from exactly zero a series only
+    // crosses once it has come back (its slope there decides which way it
+    // leaves), whichever side rounding left the located state on.
+    if start == Start::Spent {
+        series[0] = 0.0;
+    }
+    let check_start = start == Start::OnZero;
+    let (first, (margin, at)) = match model.guards(mode)[guard].direction {
         Direction::Falling => falls(series, h, check_start, uncertainty)?,
         Direction::Rising => {
             series.iter_mut().for_each(|c| *c = -*c);
@@ -238,12 +249,13 @@ pub(crate) fn locate_on_series<M: HybridModel + ?Sized>(
                 (Some(a), Some(b)) => Some(a.min(b)),
                 (a, b) => a.or(b),
             };
-            (first, ma.min(mb))
+            (first, if ma.0 <= mb.0 { ma } else { mb })
         }
     };
     Ok(StepScan {
         crossing: first.map(|tau| (tau / h).min(1.0)),
         margin,
+        margin_at: (at / h).min(1.0),
     })
 }
 
@@ -258,20 +270,21 @@ pub fn order_for(tolerances: Tolerances) -> usize {
 pub const MAX_ORDER: usize = 60;
 
 /// The first fall of `c` through zero on `[0, h]` (see [`first_fall`]),
-/// and the margin: for a crossing that curves back, the depth its dip
-/// would reach, `p'^2 / (2 p'')`; without one, the lowest turning point
-/// still above zero, where it may come within `uncertainty` of zero;
-/// infinite when nothing comes that close.
+/// and the margin with where it was measured: for a crossing that curves
+/// back, the depth its dip would reach, `p'^2 / (2 p'')`; without one, the
+/// lowest turning point still above zero, where it may come within
+/// `uncertainty` of zero; infinite when nothing comes that close.
 fn falls(
     c: &[f64],
     h: f64,
     check_start: bool,
     uncertainty: f64,
-) -> Result<(Option<f64>, f64), String> {
+) -> Result<(Option<f64>, (f64, f64)), String> {
+    const CLEAR: (f64, f64) = (f64::INFINITY, f64::INFINITY);
     // Most steps: the guard stays further from zero than the errors can
     // move it, which its coefficients show at once.
     if stays_above(c, h, uncertainty) || (check_start && rises_clear(c, h)) {
-        return Ok((None, f64::INFINITY));
+        return Ok((None, CLEAR));
     }
     // Series are at most MAX_ORDER + 1 long: scratch on the stack.
     let n = c.len();
@@ -282,14 +295,14 @@ fn falls(
         back.iter_mut().zip(c).for_each(|(b, x)| *b = -x);
         match first_fall(back, 0.0, h)? {
             Some(up) => up,
-            None => return Ok((None, f64::INFINITY)),
+            None => return Ok((None, CLEAR)),
         }
     } else {
         0.0
     };
     let crossing = first_fall(c, from, h)?;
     let end = crossing.unwrap_or(h);
-    let mut margin = f64::INFINITY;
+    let mut margin = CLEAR;
     let slope = &mut scratch[..n - 1];
     for (k, d) in slope.iter_mut().enumerate() {
         *d = (k + 1) as f64 * c[k + 1];
@@ -315,8 +328,8 @@ fn falls(
                 // turning point there.
                 Some(turn) if turn > at => {
                     let (value, _, _) = eval2(c, turn);
-                    if value > 0.0 {
-                        margin = margin.min(value);
+                    if value > 0.0 && value < margin.0 {
+                        margin = (value, turn);
                     }
                     if turn >= end {
                         break;
@@ -329,8 +342,9 @@ fn falls(
     }
     if let Some(t) = crossing {
         let (_, slope, curvature) = eval2(c, t);
-        if curvature > 0.0 && t > 0.0 {
-            margin = margin.min(slope * slope / (2.0 * curvature));
+        let depth = slope * slope / (2.0 * curvature);
+        if curvature > 0.0 && t > 0.0 && depth < margin.0 {
+            margin = (depth, t);
         }
     }
     Ok((crossing, margin))
@@ -425,12 +439,16 @@ mod tests {
     #[test]
     fn a_fall_a_graze_and_a_near_miss() {
         // (s - 1)(s - 2) falls through zero at 1 (coming from above) and rises at 2.
-        let (t, margin) = falls(&[2.0, -3.0, 1.0], 3.0, false, 0.0).unwrap();
+        let (t, (margin, _)) = falls(&[2.0, -3.0, 1.0], 3.0, false, 0.0).unwrap();
         assert!((t.unwrap() - 1.0).abs() < 1e-15);
         // Slope -1 and curvature 2 at the root: a dip of 1/4 if it curves back.
         assert!((margin - 0.25).abs() < 1e-12, "{margin}");
         // (s - 1)^2 + 1e-6: a near miss whose turning point is 1e-6 above zero.
-        let (t, margin) = falls(&[1.0 + 1e-6, -2.0, 1.0], 3.0, false, 0.0).unwrap();
+        let (t, (margin, at)) = falls(&[1.0 + 1e-6, -2.0, 1.0], 3.0, false, 0.0).unwrap();
+        assert!(
+            (at - 1.0).abs() < 1e-9,
+            "the turning point is at 1, not {at}"
+        );
         assert_eq!(t, None);
         assert!((margin - 1e-6).abs() < 1e-12, "{margin}");
         // Starting below zero and falling further: no crossing without check_start...
@@ -442,12 +460,12 @@ mod tests {
         assert!((t.unwrap() - 1.0).abs() < 1e-15);
         // Just above zero and rising (a state just after an impact): no
         // turning point at the start, so nothing near.
-        let (t, margin) = falls(&[5e-17, 1.0, 1.0], 2.0, true, 0.0).unwrap();
+        let (t, (margin, _)) = falls(&[5e-17, 1.0, 1.0], 2.0, true, 0.0).unwrap();
         assert_eq!((t, margin), (None, f64::INFINITY));
         // Far from zero for the whole step: decided from the coefficients.
         assert_eq!(
-            falls(&[1.0, -0.1, 0.01], 2.0, false, 1e-3).unwrap(),
-            (None, f64::INFINITY)
+            falls(&[1.0, -0.1, 0.01], 2.0, false, 1e-3).unwrap().1.0,
+            f64::INFINITY
         );
     }
 }

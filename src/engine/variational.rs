@@ -265,6 +265,11 @@ impl<M: HybridModel + ?Sized> HybridModel for Variational<'_, M> {
     }
 
     /// The error bound is the model's state's, not its derivatives'.
+    /// The model's own clock: its derivatives stay zero.
+    fn clock(&self) -> Option<usize> {
+        self.model.clock()
+    }
+
     fn bounded_dimension(&self) -> usize {
         self.n
     }

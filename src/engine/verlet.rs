@@ -105,14 +105,17 @@ impl Verlet {
     pub fn eval(&self, tau: f64, x: &mut [f64]) {
         let h = self.h;
         let s = tau / h;
-        let (h00, h10, h01, h11) = (
-            (1.0 + 2.0 * s) * (1.0 - s).powi(2),
+        // h00 = 1 - h01: written from y0 and the change over the step, a
+        // component that does not move reads exactly its value.
+        let (h10, h01, h11) = (
             s * (1.0 - s).powi(2),
             s * s * (3.0 - 2.0 * s),
             s * s * (s - 1.0),
         );
         for (i, xi) in x.iter_mut().enumerate() {
-            *xi = h00 * self.y0[i] + h10 * h * self.f0[i] + h01 * self.y1[i] + h11 * h * self.f1[i];
+            *xi = self.y0[i]
+                + h01 * (self.y1[i] - self.y0[i])
+                + h * (h10 * self.f0[i] + h11 * self.f1[i]);
         }
     }
 

@@ -4,7 +4,37 @@
 use std::path::Path;
 use std::process::{Command, Output};
 
+use flicker::engine::{EventRecord, Observer};
 use serde_json::Value;
+
+/// An event as the in-process tests check it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Seen {
+    pub t: f64,
+    pub guard: &'static str,
+    pub mode_before: &'static str,
+    pub mode_after: &'static str,
+    pub before: Vec<f64>,
+    pub after: Vec<f64>,
+}
+
+/// Keeps every event of a run, with its modes.
+#[derive(Default)]
+pub struct EventLog(pub Vec<Seen>);
+
+impl Observer for EventLog {
+    fn on_event(&mut self, e: &EventRecord) -> std::io::Result<()> {
+        self.0.push(Seen {
+            t: e.t,
+            guard: e.guard,
+            mode_before: e.mode_before,
+            mode_after: e.mode_after,
+            before: e.before.to_vec(),
+            after: e.after.to_vec(),
+        });
+        Ok(())
+    }
+}
 
 /// Run the binary with `args` and collect what it did.
 pub fn flicker(args: &[&str]) -> Output {

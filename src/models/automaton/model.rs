@@ -344,6 +344,10 @@ impl HybridModel for Automaton {
         self.is_terminal(mode, guard)
     }
 
+    fn clock(&self) -> Option<usize> {
+        self.clock.then(|| self.states.len() - 1)
+    }
+
     fn energy(&self, mode: Mode, x: &[f64]) -> Option<f64> {
         self.energy.as_ref().map(|e| e[mode].eval1(x))
     }

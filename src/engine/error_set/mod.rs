@@ -1,8 +1,9 @@
 //! The set of state errors a run may carry: what its stated error bound
 //! is read from.
 //!
-//! Every numerical step leaves a local error (its embedded estimate, a box
-//! of that half-width around the state). Later steps carry it along the
+//! Every numerical step leaves a local error (its embedded estimate, the
+//! first term its series leaves out, and never less than its rounding: a
+//! box of that half-width around the state). Later steps carry it along the
 //! flow's tangent map, and every event carries it across the reset by the
 //! saltation matrix: an error `d` moves the event by `d / closing speed`,
 //! which the reset then turns into a jump of the state (see
@@ -12,67 +13,77 @@
 //! applied a thousand times grows linearly, its norm's power
 //! exponentially).
 //!
-//! So the set is kept as Lohner's parallelepiped: `{ B u : |u_j| <= r_j }`
-//! with `B` orthogonal. A linear map `M` takes it to `M B box(r)`, which is
-//! held again in the orthogonal factor `Q` of `M B` (columns taken
-//! longest first): `Q box(|Q^T M B| r)`. The frame follows the flow's
-//! rotation, so an oscillation does not inflate the box at every step
-//! (the wrapping effect). A new local error box of half-width `l` is
-//! added as `Q box(|Q^T| l)`.
+//! So the set is enclosed twice, and every question (the bound on a
+//! component, the error along a guard's gradient) takes the smaller answer:
+//! both hold the same errors, so both answers bound them.
+//! - Lohner's parallelepiped (`parallelepiped.rs`) follows a rotating,
+//!   shearing set of one degree of freedom closely, but re-boxing it at
+//!   every step inflates it where the tangent turns several planes at once
+//!   (the wrapping effect: Henon-Heiles's bound grew 1e8 times its error
+//!   over 2000 time units).
+//! - An ellipsoid (`ellipsoid.rs`) takes every map exactly, but adding a
+//!   round local error to a long thin set swells its thin axes (the
+//!   mechanism's phase error after 43,000 impacts: 1e3 times looser).
 //!
+//! A component the engine keeps exact (the clock) carries no error.
 //! Dimensions above [`TRACKED`] are not tracked (the `n^3` cost per step
 //! would dominate a large ODE): there the bound is the plain sum of the
 //! local errors, without amplification, and no event-time bound is stated.
 //!
 //! [`tangent::saltation`]: crate::engine::tangent::Tangents::saltation
 
+mod ellipsoid;
+mod parallelepiped;
+
+use ellipsoid::Ellipsoid;
+use parallelepiped::Parallelepiped;
+
 /// Largest state dimension whose errors are carried through flows and
 /// events.
 pub const TRACKED: usize = 8;
 
-/// The errors a run may carry, for dimensions up to [`TRACKED`].
+/// The errors a run may carry.
 #[derive(Debug, Clone)]
 pub struct ErrorSet {
     n: usize,
-    /// Orthonormal directions, column-major `n x n` (fixed arrays: the
-    /// map below runs at every step, and small copies of slices of
-    /// unknown length are calls).
-    basis: [f64; TRACKED * TRACKED],
-    /// Half-widths along each direction.
-    radii: [f64; TRACKED],
+    /// The two enclosures, where the dimension is tracked.
+    enclosures: Option<(Parallelepiped, Ellipsoid)>,
     /// Sum of the local errors added (the untracked bound), and of their
     /// squares (the untracked graze check's scale).
     sum: f64,
     squares: f64,
     /// Set once a non-finite error entered: every bound is then infinite.
     poisoned: bool,
-    order: [usize; TRACKED],
+    /// A component that carries no error (the clock, which the engine
+    /// keeps equal to the run's time): every map clears it, and no local
+    /// error is added to it.
+    exact: Option<usize>,
 }
 
 impl ErrorSet {
     /// No error yet, in dimension `n`.
     pub fn new(n: usize) -> Self {
-        let mut basis = [0.0; TRACKED * TRACKED];
-        if n <= TRACKED {
-            for i in 0..n {
-                basis[i * n + i] = 1.0;
-            }
-        }
         ErrorSet {
             n,
-            basis,
-            radii: [0.0; TRACKED],
+            enclosures: (n <= TRACKED).then(|| (Parallelepiped::new(n), Ellipsoid::new(n))),
             sum: 0.0,
             squares: 0.0,
             poisoned: false,
-            order: std::array::from_fn(|i| i),
+            exact: None,
         }
+    }
+
+    /// The same, with component `exact` free of error: the clock, which
+    /// the engine keeps equal to the run's time.
+    pub fn with_exact(mut self, exact: Option<usize>) -> Self {
+        self.exact = exact.filter(|&c| c < self.n);
+        self
     }
 
     /// Whether errors are carried through flows and events in this
     /// dimension.
     pub fn tracked(&self) -> bool {
-        self.n <= TRACKED
+        self.enclosures.is_some()
     }
 
     /// Whether no error has been added: an exact run's set stays empty, and
@@ -89,53 +100,13 @@ impl ErrorSet {
         if !local.is_finite() || !m.iter().all(|x| x.is_finite()) {
             self.poisoned = true;
         }
-        if !self.tracked() || self.poisoned {
+        if self.poisoned {
             return;
         }
-        let n = self.n;
-        let mut product = [0.0; TRACKED * TRACKED];
-        // product = m * basis, column-major.
-        for j in 0..n {
-            for i in 0..n {
-                product[j * n + i] = (0..n).map(|k| m[i * n + k] * self.basis[j * n + k]).sum();
-            }
+        if let Some((box_, ellipsoid)) = &mut self.enclosures {
+            box_.map(m, local, self.exact);
+            ellipsoid.map(m, local, self.exact);
         }
-        // Longest error columns first: Q's first direction follows the
-        // dominant error.
-        let mut weight = [0.0; TRACKED];
-        for (j, w) in weight[..n].iter_mut().enumerate() {
-            let column = &product[j * n..(j + 1) * n];
-            *w = column.iter().map(|x| x * x).sum::<f64>() * self.radii[j] * self.radii[j];
-        }
-        // The old basis is spent: the new one is written over it.
-        if n == 2 {
-            // The common case (one degree of freedom): the frame is the
-            // heavier column's direction and its perpendicular.
-            let first = usize::from(weight[1] > weight[0]);
-            let (c, s) = direction(&product[2 * first..2 * first + 2])
-                .or_else(|| direction(&product[2 - 2 * first..4 - 2 * first]))
-                .unwrap_or((1.0, 0.0));
-            self.basis[..4].copy_from_slice(&[c, s, -s, c]);
-        } else {
-            let order = &mut self.order[..n];
-            order.sort_unstable_by(|&a, &b| weight[b].total_cmp(&weight[a]));
-            orthonormalize(n, &product, order, &mut self.basis);
-        }
-        let q = &self.basis;
-        // New radii: |Q^T product| r + |Q^T| local.
-        let mut radii = [0.0; TRACKED];
-        for (a, r) in radii[..n].iter_mut().enumerate() {
-            let qa = &q[a * n..(a + 1) * n];
-            let carried: f64 = (0..n)
-                .map(|j| {
-                    let dot: f64 = (0..n).map(|i| qa[i] * product[j * n + i]).sum();
-                    dot.abs() * self.radii[j]
-                })
-                .sum();
-            let added: f64 = qa.iter().map(|x| x.abs()).sum::<f64>() * local;
-            *r = carried + added;
-        }
-        self.radii = radii;
     }
 
     /// Add an error box of half-width `local` where the state stands (a
@@ -155,94 +126,23 @@ impl ErrorSet {
         if self.poisoned {
             return f64::INFINITY;
         }
-        if !self.tracked() {
-            return self.sum;
+        match &self.enclosures {
+            Some((box_, ellipsoid)) => box_.state_bound().min(ellipsoid.state_bound()),
+            None => self.sum,
         }
-        let n = self.n;
-        (0..n)
-            .map(|i| {
-                (0..n)
-                    .map(|j| self.basis[j * n + i].abs() * self.radii[j])
-                    .sum::<f64>()
-            })
-            .fold(0.0, f64::max)
     }
 
     /// The largest error of the linear function `gradient . x`. Where the
     /// set is not tracked, an optimistic scale instead: `sum |gradient_i|`
     /// times the root-sum-square of the local errors, as if independent.
     pub fn along(&self, gradient: &[f64]) -> f64 {
-        let n = self.n;
         if self.poisoned {
             return f64::INFINITY;
         }
-        if !self.tracked() {
-            return gradient.iter().map(|g| g.abs()).sum::<f64>() * self.squares.sqrt();
+        match &self.enclosures {
+            Some((box_, ellipsoid)) => box_.along(gradient).min(ellipsoid.along(gradient)),
+            None => gradient.iter().map(|g| g.abs()).sum::<f64>() * self.squares.sqrt(),
         }
-        (0..n)
-            .map(|j| {
-                let dot: f64 = (0..n).map(|i| gradient[i] * self.basis[j * n + i]).sum();
-                dot.abs() * self.radii[j]
-            })
-            .sum()
-    }
-}
-
-/// The unit vector along a plane vector, if it has a direction.
-fn direction(v: &[f64]) -> Option<(f64, f64)> {
-    let length = v[0].hypot(v[1]);
-    (length > 0.0 && length.is_finite()).then(|| (v[0] / length, v[1] / length))
-}
-
-/// Orthonormal columns `q` (column-major) spanning the columns of `m` taken
-/// in `order`, completed by unit vectors where `m` is rank-deficient (a
-/// reset that collapses a direction). Gram-Schmidt twice over, which keeps
-/// `q` orthogonal to round-off for the small `n` tracked.
-fn orthonormalize(n: usize, m: &[f64], order: &[usize], q: &mut [f64]) {
-    let mut filled = 0;
-    let mut candidate = [0.0; TRACKED];
-    let candidate = &mut candidate[..n];
-    for pick in order
-        .iter()
-        .map(|&j| Some(j))
-        .chain((0..n).map(|_| None))
-        .enumerate()
-    {
-        if filled == n {
-            break;
-        }
-        match pick {
-            (_, Some(j)) => candidate.copy_from_slice(&m[j * n..(j + 1) * n]),
-            (k, None) => {
-                candidate.fill(0.0);
-                candidate[k - order.len()] = 1.0;
-            }
-        }
-        let norm0 = candidate.iter().map(|x| x * x).sum::<f64>().sqrt();
-        if norm0 == 0.0 || !norm0.is_finite() {
-            continue;
-        }
-        for _ in 0..2 {
-            for k in 0..filled {
-                let qk = &q[k * n..(k + 1) * n];
-                let dot: f64 = qk.iter().zip(candidate.iter()).map(|(a, b)| a * b).sum();
-                for (c, a) in candidate.iter_mut().zip(qk) {
-                    *c -= dot * a;
-                }
-            }
-        }
-        let norm = candidate.iter().map(|x| x * x).sum::<f64>().sqrt();
-        // A column (nearly) inside the span so far adds no direction.
-        if norm <= 1e-10 * norm0 {
-            continue;
-        }
-        for (slot, c) in q[filled * n..(filled + 1) * n]
-            .iter_mut()
-            .zip(candidate.iter())
-        {
-            *slot = c / norm;
-        }
-        filled += 1;
     }
 }
 
@@ -300,6 +200,55 @@ mod tests {
     }
 
     #[test]
+    fn a_map_turning_two_planes_does_not_wrap() {
+        // Two planes turned at different rates, the first sheared by the
+        // second (the tangent of a quasi-periodic orbit), with a local error
+        // at every one of k steps: the exact set's half-widths are summed
+        // from its generators, mapped one by one.
+        let (k, l) = (3000usize, 1e-12);
+        let (c1, s1) = (0.1f64.cos(), 0.1f64.sin());
+        let (c2, s2) = (0.13f64.cos(), 0.13f64.sin());
+        let e = 0.01;
+        #[rustfmt::skip]
+        let m = [
+            c1, -s1, e, 0.0,
+            s1, c1, 0.0, e,
+            0.0, 0.0, c2, -s2,
+            0.0, 0.0, s2, c2,
+        ];
+        let mut set = ErrorSet::new(4);
+        let mut boxed = Parallelepiped::new(4);
+        let mut columns: Vec<[f64; 4]> = Vec::new();
+        for _ in 0..k {
+            set.map(&m, l);
+            boxed.map(&m, l, None);
+            for c in &mut columns {
+                *c = std::array::from_fn(|i| (0..4).map(|j| m[i * 4 + j] * c[j]).sum());
+            }
+            for i in 0..4 {
+                let mut c = [0.0; 4];
+                c[i] = l;
+                columns.push(c);
+            }
+        }
+        let exact = (0..4)
+            .map(|i| columns.iter().map(|c| c[i].abs()).sum::<f64>())
+            .fold(0.0, f64::max);
+        let bound = set.state_bound();
+        assert!(
+            bound >= exact * (1.0 - 1e-9),
+            "{bound} below the exact {exact}"
+        );
+        assert!(bound <= 3.0 * exact, "{bound} far above the exact {exact}");
+        // The parallelepiped alone wraps.
+        assert!(
+            boxed.state_bound() > 10.0 * exact,
+            "{} against {exact}",
+            boxed.state_bound()
+        );
+    }
+
+    #[test]
     fn a_collapsing_map_keeps_an_orthonormal_frame() {
         let mut set = ErrorSet::new(2);
         set.map(&[1.0, 0.0, 0.0, 1.0], 1.0);
@@ -310,6 +259,26 @@ mod tests {
         set.map(&[0.0, 1.0, 1.0, 0.0], 0.5);
         assert!((set.along(&[0.0, 1.0]) - 1.5).abs() < 1e-15);
         assert!((set.along(&[1.0, 0.0]) - 0.5).abs() < 1e-15);
+    }
+
+    #[test]
+    fn an_exact_component_carries_no_error() {
+        // A clock beside a state: the map feeds the clock's error into the
+        // state (a forcing), but the clock has none, so the state keeps
+        // only its own local errors.
+        let mut set = ErrorSet::new(2).with_exact(Some(1));
+        for _ in 0..100 {
+            set.map(&[1.0, 5.0, 0.0, 1.0], 1e-12);
+        }
+        assert_eq!(set.along(&[0.0, 1.0]), 0.0);
+        let bound = set.state_bound();
+        assert!((bound - 1e-10).abs() < 1e-22, "{bound}");
+        // Without it the clock's errors, sheared into the state, dominate.
+        let mut plain = ErrorSet::new(2);
+        for _ in 0..100 {
+            plain.map(&[1.0, 5.0, 0.0, 1.0], 1e-12);
+        }
+        assert!(plain.state_bound() > 100.0 * bound);
     }
 
     #[test]

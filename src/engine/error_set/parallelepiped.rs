@@ -1,0 +1,181 @@
+//! Lohner's parallelepiped: one of the two enclosures of a run's errors
+//! (see [`super`]).
+//!
+//! The set is `{ B u : |u_j| <= r_j }` with `B` orthogonal. A linear map
+//! `M` takes it to `M B box(r)`, which is held again in the orthogonal
+//! factor `Q` of `M B` (columns taken longest first): `Q box(|Q^T M B|
+//! r)`. The frame follows the flow's rotation, so an oscillation does not
+//! inflate the box at every step, and a shear grows it linearly, as it
+//! grows the errors. A new local error box of half-width `l` is added as
+//! `Q box(|Q^T| l)`. Where the map is neither (a quasi-periodic flow in
+//! four dimensions, whose tangent turns several planes at once and shears
+//! them), re-boxing in a new frame at every step inflates it by a factor
+//! each time: the wrapping effect, which the ellipsoid beside it does not
+//! have.
+
+use super::TRACKED;
+
+/// The parallelepiped, for dimensions up to [`TRACKED`].
+#[derive(Debug, Clone)]
+pub(super) struct Parallelepiped {
+    n: usize,
+    /// Orthonormal directions, column-major `n x n` (fixed arrays: the
+    /// map below runs at every step, and small copies of slices of
+    /// unknown length are calls).
+    basis: [f64; TRACKED * TRACKED],
+    /// Half-widths along each direction.
+    radii: [f64; TRACKED],
+    order: [usize; TRACKED],
+}
+
+impl Parallelepiped {
+    /// No error, in dimension `n <= TRACKED`.
+    pub(super) fn new(n: usize) -> Self {
+        let mut basis = [0.0; TRACKED * TRACKED];
+        for i in 0..n {
+            basis[i * n + i] = 1.0;
+        }
+        Parallelepiped {
+            n,
+            basis,
+            radii: [0.0; TRACKED],
+            order: std::array::from_fn(|i| i),
+        }
+    }
+
+    /// Carry the set through `m` (row-major), clearing component `exact`,
+    /// and add a local error box of half-width `local` in the others.
+    pub(super) fn map(&mut self, m: &[f64], local: f64, exact: Option<usize>) {
+        let n = self.n;
+        let mut product = [0.0; TRACKED * TRACKED];
+        // product = m * basis, column-major.
+        for j in 0..n {
+            for i in 0..n {
+                product[j * n + i] = (0..n).map(|k| m[i * n + k] * self.basis[j * n + k]).sum();
+            }
+            if let Some(c) = exact {
+                product[j * n + c] = 0.0;
+            }
+        }
+        // Longest error columns first: Q's first direction follows the
+        // dominant error.
+        let mut weight = [0.0; TRACKED];
+        for (j, w) in weight[..n].iter_mut().enumerate() {
+            let column = &product[j * n..(j + 1) * n];
+            *w = column.iter().map(|x| x * x).sum::<f64>() * self.radii[j] * self.radii[j];
+        }
+        // The old basis is spent: the new one is written over it.
+        if n == 2 {
+            // The common case (one degree of freedom): the frame is the
+            // heavier column's direction and its perpendicular.
+            let first = usize::from(weight[1] > weight[0]);
+            let (c, s) = direction(&product[2 * first..2 * first + 2])
+                .or_else(|| direction(&product[2 - 2 * first..4 - 2 * first]))
+                .unwrap_or((1.0, 0.0));
+            self.basis[..4].copy_from_slice(&[c, s, -s, c]);
+        } else {
+            let order = &mut self.order[..n];
+            order.sort_unstable_by(|&a, &b| weight[b].total_cmp(&weight[a]));
+            orthonormalize(n, &product, order, &mut self.basis);
+        }
+        let q = &self.basis;
+        // New radii: |Q^T product| r + |Q^T| local.
+        let mut radii = [0.0; TRACKED];
+        for (a, r) in radii[..n].iter_mut().enumerate() {
+            let qa = &q[a * n..(a + 1) * n];
+            let carried: f64 = (0..n)
+                .map(|j| {
+                    let dot: f64 = (0..n).map(|i| qa[i] * product[j * n + i]).sum();
+                    dot.abs() * self.radii[j]
+                })
+                .sum();
+            let mut spread: f64 = qa.iter().map(|x| x.abs()).sum();
+            if let Some(c) = exact {
+                spread -= qa[c].abs();
+            }
+            *r = carried + spread.max(0.0) * local;
+        }
+        self.radii = radii;
+    }
+
+    /// The half-width of the set along each component, the largest.
+    pub(super) fn state_bound(&self) -> f64 {
+        let n = self.n;
+        (0..n)
+            .map(|i| {
+                (0..n)
+                    .map(|j| self.basis[j * n + i].abs() * self.radii[j])
+                    .sum::<f64>()
+            })
+            .fold(0.0, f64::max)
+    }
+
+    /// The half-width of the set along `gradient`.
+    pub(super) fn along(&self, gradient: &[f64]) -> f64 {
+        let n = self.n;
+        (0..n)
+            .map(|j| {
+                let dot: f64 = (0..n).map(|i| gradient[i] * self.basis[j * n + i]).sum();
+                dot.abs() * self.radii[j]
+            })
+            .sum()
+    }
+}
+
+/// The unit vector along a plane vector, if it has a direction.
+fn direction(v: &[f64]) -> Option<(f64, f64)> {
+    let length = v[0].hypot(v[1]);
+    (length > 0.0 && length.is_finite()).then(|| (v[0] / length, v[1] / length))
+}
+
+/// Orthonormal columns `q` (column-major) spanning the columns of `m` taken
+/// in `order`, completed by unit vectors where `m` is rank-deficient (a
+/// reset that collapses a direction). Gram-Schmidt twice over, which keeps
+/// `q` orthogonal to round-off for the small `n` tracked.
+fn orthonormalize(n: usize, m: &[f64], order: &[usize], q: &mut [f64]) {
+    let mut filled = 0;
+    let mut candidate = [0.0; TRACKED];
+    let candidate = &mut candidate[..n];
+    for pick in order
+        .iter()
+        .map(|&j| Some(j))
+        .chain((0..n).map(|_| None))
+        .enumerate()
+    {
+        if filled == n {
+            break;
+        }
+        match pick {
+            (_, Some(j)) => candidate.copy_from_slice(&m[j * n..(j + 1) * n]),
+            (k, None) => {
+                candidate.fill(0.0);
+                candidate[k - order.len()] = 1.0;
+            }
+        }
+        let norm0 = candidate.iter().map(|x| x * x).sum::<f64>().sqrt();
+        if norm0 == 0.0 || !norm0.is_finite() {
+            continue;
+        }
+        for _ in 0..2 {
+            for k in 0..filled {
+                let qk = &q[k * n..(k + 1) * n];
+                let dot: f64 = qk.iter().zip(candidate.iter()).map(|(a, b)| a * b).sum();
+                for (c, a) in candidate.iter_mut().zip(qk) {
+                    *c -= dot * a;
+                }
+            }
+        }
+        let norm = candidate.iter().map(|x| x * x).sum::<f64>().sqrt();
+        // A column (nearly) inside the span so far adds no direction.
+        if norm <= 1e-10 * norm0 {
+            continue;
+        }
+        for (slot, c) in q[filled * n..(filled + 1) * n]
+            .iter_mut()
+            .zip(candidate.iter())
+        {
+            *slot = c / norm;
+        }
+        filled += 1;
+    }
+}
