@@ -246,8 +246,9 @@ impl Bound {
 
     /// Carry the errors across the event of guard `slot` of `mode` at `t`,
     /// from `before` to `after` in `mode_after`, by its saltation matrix,
-    /// and bound the event's time; why the run cannot go on, if it cannot
-    /// (`method` names the method in the reason).
+    /// and bound the event's time (the crossing's dip is `depth` deep,
+    /// infinite for a guard that does not curve back); why the run cannot
+    /// go on, if it cannot (`method` names the method in the reason).
     #[allow(clippy::too_many_arguments)]
     #[inline(never)]
     pub fn across<M: HybridModel + ?Sized>(
@@ -258,7 +259,7 @@ impl Bound {
         t: Time,
         (before, after): (&[f64], &[f64]),
         mode_after: Mode,
-        t_end: f64,
+        (t_end, depth): (f64, f64),
         method: &str,
     ) -> Result<(), String> {
         if self.errors.is_empty() || !self.errors.tracked() {
@@ -278,7 +279,13 @@ impl Bound {
             after,
             &mut self.matrix,
         );
-        let shift = along / closing.abs();
+        // A guard that curves back after crossing (its dip `depth` deep)
+        // moves by more than `along / closing` towards its turning point:
+        // on the parabola through the crossing, by up to twice that as the
+        // error nears the depth (beyond it the crossing may vanish, which
+        // the graze check refuses).
+        let ratio = (along / depth).min(1.0);
+        let shift = along / closing.abs() * 2.0 / (1.0 + (1.0 - ratio).sqrt());
         let since = self.last_event.map(|last| t.since(last));
         // Events closer than the run can resolve are the Zeno watch's to
         // judge (it settles them or stops), not the error bound's: their

@@ -64,11 +64,12 @@ pub struct StepScan {
     /// direction.
     pub crossing: Option<f64>,
     /// How clearly the step decides: for a crossing that curves back (a
-    /// graze), the depth its dip would reach, `g'^2 / (2 |g''|)`; without a
-    /// crossing, the smallest height of a turning point still short of zero;
-    /// infinite when nothing comes close or the guard is not affine. A margin
-    /// below the integration error means the method cannot tell a graze from
-    /// a near miss.
+    /// graze), the depth its dip would reach, `g'^2 / (2 |g''|)` (which also
+    /// says how far an error moves the crossing); without a crossing, the
+    /// smallest height of a turning point still short of zero; infinite
+    /// where the guard does not curve back, nothing comes within `resolution`
+    /// of zero, or the guard is not affine. A margin below the integration
+    /// error means the method cannot tell a graze from a near miss.
     pub margin: f64,
     /// Where in the step (`s in [0, 1]`) the margin was measured: a graze
     /// after an earlier event of the step does not matter, for the step is
@@ -303,12 +304,6 @@ fn scan_piece<const N: usize>(
     );
     let local = crossing.map(|s| (s - a) / w);
     let (margin, at) = margin(direction, poly, local, turning.as_slice());
-    if margin > resolution {
-        return StepScan {
-            crossing,
-            ..StepScan::CLEAR
-        };
-    }
     StepScan {
         crossing,
         margin,

@@ -130,6 +130,10 @@ struct Run<'m, 's, M: HybridModel + ?Sized> {
     simultaneous: Vec<usize>,
     /// Scratch for a guard's gradient.
     gradient: Vec<f64>,
+    /// How deep the dip of each guard's predicted crossing in the current
+    /// step is (infinite where it does not curve back): what its time
+    /// error grows by.
+    depths: Vec<f64>,
     before: Vec<f64>,
     after: Vec<f64>,
     /// The model's clock component and its value at `t = 0`: the clock
@@ -345,6 +349,7 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
             fresh: false,
             simultaneous: Vec::new(),
             gradient: vec![0.0; n],
+            depths: Vec::new(),
             before: vec![0.0; n],
             after: vec![0.0; n],
             clock: model.clock().map(|c| (c, x0[c])),
@@ -691,6 +696,8 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
                 let fresh = std::mem::replace(&mut self.fresh, false);
                 let mut graze: Option<(usize, f64, f64, f64)> = None;
                 let mut earliest = f64::INFINITY;
+                self.depths.clear();
+                self.depths.resize(guards.len(), f64::INFINITY);
                 if let Err(failure) =
                     self.integrator
                         .step(model, mode, &self.state, remaining, h_min)
@@ -735,6 +742,7 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
                     }
                     if let Some(s) = scan.crossing {
                         self.queue.schedule(g, self.origin.after(s * h));
+                        self.depths[g] = scan.margin;
                         earliest = earliest.min(s);
                     }
                 }
@@ -870,6 +878,10 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
                 .note_crossing(self.model, self.mode, slot, before);
             return Ok(());
         }
+        let depth = match self.motion {
+            Motion::Stepped => self.depths.get(slot).copied().unwrap_or(f64::INFINITY),
+            _ => f64::INFINITY,
+        };
         self.bound.across(
             self.model,
             self.mode,
@@ -877,7 +889,7 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
             t,
             (before, &self.after),
             mode_after,
-            self.options.t_end,
+            (self.options.t_end, depth),
             self.integrator.name(),
         )
     }

@@ -5,7 +5,6 @@ use flicker::engine::{
     Direction, Flow, Guard, HybridModel, Jump, Method, Mode, Options, Outcome, Recorder, Status,
     Tolerances, simulate,
 };
-use proptest::prelude::*;
 
 /// A harmonic oscillator `x'' = -x` whose guard `x = level` is reached only
 /// briefly near each crest: with a loose tolerance the integrator takes a
@@ -71,16 +70,28 @@ fn run_crest(level: f64, phase: f64, method: Method, periods: f64) -> (Outcome, 
 /// within the event-time bound the run stated.
 fn assert_exact_crossings(outcome: &Outcome, times: &[f64], exact: &[f64]) {
     assert_eq!(times.len(), exact.len(), "times {times:?}, exact {exact:?}");
-    let bound = outcome
-        .event_time_bound
-        .expect("a 2-state run states its event-time bound");
-    for (k, (t, want)) in times.iter().zip(exact).enumerate() {
-        assert!(
-            (t - want).abs() <= bound,
-            "crossing {k} at {t}, exact {want}: off by {:.2e}, stated bound {bound:.2e}",
-            (t - want).abs()
-        );
+    if let Err(why) = exact_prefix(outcome, times, exact) {
+        panic!("{why}");
     }
+}
+
+/// Whether the crossings a run found (all of them, or those before it
+/// stopped) are the exact solution's, in order, each within the
+/// event-time bound the run stated.
+fn exact_prefix(outcome: &Outcome, times: &[f64], exact: &[f64]) -> Result<(), String> {
+    if times.len() > exact.len() {
+        return Err(format!("times {times:?}, exact {exact:?}"));
+    }
+    let bound = outcome.event_time_bound.unwrap_or(f64::INFINITY);
+    for (k, (t, want)) in times.iter().zip(exact).enumerate() {
+        if (t - want).abs() > bound {
+            return Err(format!(
+                "crossing {k} at {t}, exact {want}: off by {:.2e}, stated bound {bound:.2e}",
+                (t - want).abs()
+            ));
+        }
+    }
+    Ok(())
 }
 
 #[test]
@@ -104,45 +115,76 @@ fn a_crossing_in_and_out_within_one_step_is_found() {
     );
 }
 
-proptest! {
-    #![proptest_config(ProptestConfig {
-        cases: 64,
-        rng_seed: proptest::test_runner::RngSeed::Fixed(20261125),
-        ..ProptestConfig::default()
-    })]
-
-    /// Over crest heights down to a near graze, tolerances and phases, each
-    /// embedded pair either finds exactly the exact solution's crossings,
-    /// each within its stated time bound, or says that it cannot tell.
-    #[test]
-    fn no_crossing_is_missed_or_misplaced_without_a_word(
-        depth in -7.0f64..-2.0,
-        log_tol in -11.0f64..-5.0,
-        phase in 0.0f64..std::f64::consts::TAU,
-        pair in 0..2usize,
-    ) {
-        let level = 1.0 - 10f64.powf(depth);
-        let tol = Tolerances { rtol: 10f64.powf(log_tol), atol: 10f64.powf(log_tol) };
-        let method = [Method::Dopri5(tol), Method::Dop853(tol)][pair];
-        let (outcome, times) = run_crest(level, phase, method, 10.0);
-        match outcome.status {
-            Status::Completed => {
-                assert_exact_crossings(&outcome, &times, &crest_times(level, phase, outcome.t_end));
-                // The final state is within the stated bound too.
-                let t = outcome.t_end + phase;
-                let exact = [t.cos(), -t.sin()];
-                for (x, want) in outcome.final_state.iter().zip(exact) {
-                    prop_assert!((x - want).abs() <= outcome.error_bound, "{x} vs {want}, bound {}", outcome.error_bound);
+/// Over crest heights down to a near graze (1e-7 above the level),
+/// tolerances from 1e-11 to 1e-5 and phases, each embedded pair either
+/// finds exactly the exact solution's crossings, each within its stated
+/// time bound, and ends within its bound, or says that it cannot tell,
+/// having found only exact crossings before it stopped. Where the crest
+/// rises 1e5 times the tolerance above the level (the errors of some hundred
+/// steps, each estimated pessimistically), nothing is in doubt and
+/// every run completes; over the whole grid, most do.
+#[test]
+fn no_crossing_is_missed_or_misplaced_without_a_word() {
+    let (mut runs, mut completed) = (0, 0);
+    for depth in (0..=10).map(|k| -7.0 + 0.5 * k as f64) {
+        for log_tol in (-11..=-5).map(f64::from) {
+            for phase in [0.3, 2.1, 4.4] {
+                for pair in 0..2 {
+                    let level = 1.0 - 10f64.powf(depth);
+                    let tol = Tolerances {
+                        rtol: 10f64.powf(log_tol),
+                        atol: 10f64.powf(log_tol),
+                    };
+                    let method = [Method::Dopri5(tol), Method::Dop853(tol)][pair];
+                    let (outcome, times) = run_crest(level, phase, method, 10.0);
+                    let case =
+                        format!("depth 1e{depth}, tol 1e{log_tol}, phase {phase}, {method:?}");
+                    runs += 1;
+                    match outcome.status {
+                        Status::Completed => {
+                            completed += 1;
+                            let exact = crest_times(level, phase, outcome.t_end);
+                            assert_eq!(
+                                times.len(),
+                                exact.len(),
+                                "{case}: times {times:?}, exact {exact:?}"
+                            );
+                            if let Err(why) = exact_prefix(&outcome, &times, &exact) {
+                                panic!("{case}: {why}");
+                            }
+                            let t = outcome.t_end + phase;
+                            let exact = [t.cos(), -t.sin()];
+                            for (x, want) in outcome.final_state.iter().zip(exact) {
+                                assert!(
+                                    (x - want).abs() <= outcome.error_bound,
+                                    "{case}: {x} vs {want}, bound {}",
+                                    outcome.error_bound
+                                );
+                            }
+                        }
+                        Status::Failed => {
+                            let reason = outcome.reason.clone().unwrap_or_default();
+                            assert!(reason.contains("cannot"), "{case}: {reason}");
+                            assert!(
+                                depth < log_tol + 5.0,
+                                "{case}: a crest far above the errors stopped the run: {reason}"
+                            );
+                            if let Err(why) = exact_prefix(
+                                &outcome,
+                                &times,
+                                &crest_times(level, phase, outcome.t_end),
+                            ) {
+                                panic!("{case}: {why}");
+                            }
+                        }
+                        other => panic!("{case}: {other:?}: {:?}", outcome.reason),
+                    }
                 }
             }
-            Status::Failed => {
-                let reason = outcome.reason.unwrap_or_default();
-                prop_assert!(reason.contains("cannot"), "{reason}");
-                // What it found before it stopped is right.
-                let exact = crest_times(level, phase, outcome.t_reached);
-                prop_assert!(times.len() <= exact.len() + 1);
-            }
-            other => prop_assert!(false, "{other:?}: {:?}", outcome.reason),
         }
     }
+    assert!(
+        completed * 2 >= runs,
+        "only {completed} of {runs} runs completed"
+    );
 }

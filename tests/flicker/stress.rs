@@ -131,10 +131,16 @@ fn no_method_is_silently_wrong_and_each_says_why_it_fails() {
             matches!(verdict(&rows, "resting", method), Verdict::Passed),
             "{method}"
         );
-        assert!(
-            matches!(verdict(&rows, "event_at_zero", method), Verdict::Passed),
-            "{method}"
-        );
+        // Verlet's bound on its event times (a step of period / 200) is
+        // 0.74 by the end, and the next impact comes 0.70 after t_end:
+        // whether it belongs to the run it cannot tell, and says so.
+        match verdict(&rows, "event_at_zero", method) {
+            Verdict::Passed => {}
+            Verdict::Failed { reason } if method == "verlet" => {
+                assert!(reason.contains("from t_end"), "{reason}")
+            }
+            other => panic!("{method}: {other:?}"),
+        }
     }
 }
 

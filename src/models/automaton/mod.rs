@@ -43,7 +43,12 @@
 //!   `+ - * / ^`, unary minus (`-x^2` is `-(x^2)`), parentheses, and
 //!   `sin cos tan asin acos atan atan2 sinh cosh tanh exp log sqrt abs min
 //!   max pow hypot`. Time may appear anywhere (forced systems): the state
-//!   then carries the clock `t` as its last component.
+//!   then carries the clock `t` as its last component, which the engine
+//!   keeps equal to the run's time.
+//!
+//! What fires and when (markers once per crossing, barriers, simultaneous
+//! events, an event at `t_end`, sliding) is the engine's, the same for
+//! every method: `docs/automata.md`, "Events".
 //!
 //! The file is read into a [`Definition`] (names
 //! checked, expressions parsed, errors with a caret under the character),
