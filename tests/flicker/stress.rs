@@ -13,7 +13,12 @@ use flicker::stress::{Row, Verdict, cases, run_case, settings};
 const WALL: f64 = 2.0;
 
 fn rows() -> Vec<Row> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/stress");
+    rows_of("models/stress")
+}
+
+/// Every case of `folder` (under the repository) with every method.
+fn rows_of(folder: &str) -> Vec<Row> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join(folder);
     let mut rows = Vec::new();
     for (name, scene) in cases(&dir, &Registry::builtin()).unwrap() {
         for setting in settings(&scene) {
@@ -165,4 +170,84 @@ fn every_stress_scene_runs_each_offered_method() {
             "separatrix"
         ]
     );
+}
+
+/// Bounds stay as tight as they were: how many times its measured error
+/// each passing run's bound is (final state and event times), on every
+/// stress case and bundled automaton, against the ratios recorded in
+/// tests/golden/bound_ratios.json (`FLICKER_RECORD_GOLDEN=1` re-records).
+/// A ratio ten times its record fails: a bound that loosened that much no
+/// longer says how accurate a run is. A run that passes must have a record.
+#[test]
+fn bounds_stay_within_ten_times_their_recorded_ratio() {
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/golden/bound_ratios.json");
+    let mut now = serde_json::Map::new();
+    for folder in ["models/stress", "models/automata"] {
+        for r in rows_of(folder)
+            .iter()
+            .filter(|r| r.verdict == Verdict::Passed)
+        {
+            let name = format!(
+                "{}/{}/{}",
+                folder.trim_start_matches("models/"),
+                r.case,
+                r.method
+            );
+            let ratios = serde_json::json!({
+                "state": r.measured.state_ratio(),
+                "time": r.measured.time_ratio(),
+            });
+            now.insert(name, ratios);
+        }
+    }
+    if std::env::var_os("FLICKER_RECORD_GOLDEN").is_some() {
+        let text = serde_json::to_string_pretty(&serde_json::Value::Object(now)).unwrap();
+        std::fs::write(&file, text + "\n").unwrap();
+        return;
+    }
+    let recorded = crate::support::read_json(&file);
+    for (name, ratios) in &now {
+        let Some(record) = recorded.get(name) else {
+            panic!(
+                "{name} passes but has no recorded ratio: re-record tests/golden/bound_ratios.json"
+            );
+        };
+        for key in ["state", "time"] {
+            if let (Some(was), Some(is)) = (record[key].as_f64(), ratios[key].as_f64()) {
+                assert!(
+                    is <= 10.0 * was,
+                    "{name}: the {key} bound is {is:.1e} times its error, recorded {was:.1e}"
+                );
+            }
+        }
+    }
+}
+
+/// The bundled automata, measured against their closed forms where they
+/// have one (`src/stress/closed_forms.rs`): no method is silently wrong or
+/// beyond its own bound, and the methods exact to round-off pass.
+#[test]
+fn no_automaton_is_silently_wrong_against_its_closed_form() {
+    let rows = rows_of("models/automata");
+    for r in &rows {
+        assert!(
+            matches!(r.verdict, Verdict::Passed | Verdict::Failed { .. }),
+            "{} with {}: {:?}",
+            r.case,
+            r.method,
+            r.verdict
+        );
+    }
+    for case in [
+        "mechanism",
+        "rocking_block_linear",
+        "impact_oscillator",
+        "bouncing_ball",
+    ] {
+        for method in ["linear", "taylor"] {
+            if let Some(r) = rows.iter().find(|r| r.case == case && r.method == method) {
+                assert_eq!(r.verdict, Verdict::Passed, "{case} with {method}");
+            }
+        }
+    }
 }

@@ -4,10 +4,13 @@
 //! what this exists to rule out (`tests/flicker/stress.rs` checks it).
 //!
 //! `flicker stress models/stress --markdown` prints the table that
-//! `docs/stress.md` holds.
+//! `docs/stress.md` holds. Bundled automata with a closed form are measured
+//! against it ([`closed_forms`]); the others against their tightest run.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
+
+pub mod closed_forms;
 
 use crate::engine::{EventTimes, Status, zeno};
 use crate::runner::Control;
@@ -184,7 +187,7 @@ pub fn run_case(
 ) -> Result<Row, SceneError> {
     let mut scene = scene.clone();
     scene.set_solver(setting.clone())?;
-    let reference = scene.reference()?;
+    let reference = closed_forms::reference(case, &scene).unwrap_or_else(|| scene.reference())?;
     let mut times = EventTimes::default();
     let control = Control {
         stop: None,
@@ -223,12 +226,32 @@ pub fn run_case(
     })
 }
 
+impl Measured {
+    /// How many times its error the run's bound on its final state is
+    /// (`None` where the error is zero: nothing to measure the bound by).
+    pub fn state_ratio(&self) -> Option<f64> {
+        ratio(self.error_bound, Some(self.final_error))
+    }
+
+    /// The same for its event times.
+    pub fn time_ratio(&self) -> Option<f64> {
+        self.event_time_bound
+            .and_then(|bound| ratio(bound, self.time_error))
+    }
+}
+
+fn ratio(bound: f64, error: Option<f64>) -> Option<f64> {
+    error
+        .filter(|e| *e > 0.0 && e.is_finite())
+        .map(|e| bound / e)
+}
+
 /// The table of outcomes, as Markdown: each run's errors beside the
-/// bounds it stated.
+/// bounds it stated, and how many times its errors the bounds are.
 pub fn markdown(rows: &[Row]) -> String {
     let mut text = String::from(
-        "| case | method | outcome | final error | error bound | event-time error | event-time bound | energy error | events (exact) | wall s |\n\
-         |---|---|---|---|---|---|---|---|---|---|\n",
+        "| case | method | outcome | final error | error bound | bound / error | event-time error | event-time bound | bound / error | energy error | events (exact) | wall s |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     let number = |x: Option<f64>| x.map_or("-".into(), |e| format!("{e:.1e}"));
     for r in rows {
@@ -243,15 +266,18 @@ pub fn markdown(rows: &[Row]) -> String {
             u64::MAX => "unbounded".to_string(),
             n => n.to_string(),
         };
+        let ratio = |x: Option<f64>| x.map_or("-".into(), |r| format!("{r:.1e}"));
         text += &format!(
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} ({}) | {:.2} |\n",
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} ({}) | {:.2} |\n",
             r.case,
             r.method,
             outcome,
             number(Some(m.final_error)),
             number(Some(m.error_bound)),
+            ratio(m.state_ratio()),
             number(m.time_error),
             number(m.event_time_bound),
+            ratio(m.time_ratio()),
             number(r.energy_error),
             m.events,
             reference,
