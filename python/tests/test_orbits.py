@@ -15,6 +15,23 @@ G, R, W = 9.81, 0.5, 10.0
 PERIOD = 2 * math.pi / W
 
 
+def mechanism_closed_form(eta, strain0, t):
+    """The strain mechanism of mechanism.json (omega 1) from rest at
+    `strain0`: impact k at (2k + 1) acos(-c / A), c = eta - 1, A = strain0 -
+    c (the arc starts at its apex), and the state at `t` on the arc since the
+    last impact."""
+    c = eta - 1.0
+    a = strain0 - c
+    half = math.acos(-c / a)
+    impacts = int((t / half + 1) // 2)
+    last = (2 * impacts - 1) * half
+    if impacts == 0:
+        return [], (c + a * math.cos(t), -a * math.sin(t))
+    # From the impact at eps = 0 opening: the arc's phase is -half there.
+    phase = t - last - half
+    return [(2 * k + 1) * half for k in range(impacts)], (c + a * math.cos(phase), -a * math.sin(phase))
+
+
 def test_sensitivities_come_back_in_the_summary_and_the_events(tmp_path):
     run = flicker.run(MODELS / "automata" / "mechanism.json", t_end=100.0, sensitivities=["eta", "initial.strain"])
     s = run.summary["sensitivities"]
@@ -23,6 +40,23 @@ def test_sensitivities_come_back_in_the_summary_and_the_events(tmp_path):
     # The last event's time derivative is the last event's dt/deta.
     column = run.state_names.index("dt/deta")
     assert run.events["after"][-1, column] == s["eta"]["last_event_time"]
+    # Every value against central differences of the closed form (eta 1.2,
+    # strain 0.5 at rest), to 1e-6 of its size.
+    eta, strain0, h = 1.2, 0.5, 1e-6
+    times, _ = mechanism_closed_form(eta, strain0, 100.0)
+    assert len(times) == len(run.events["t"])
+    for name, (up, down) in {
+        "eta": ((eta + h, strain0), (eta - h, strain0)),
+        "initial.strain": ((eta, strain0 + h), (eta, strain0 - h)),
+    }.items():
+        t_up, x_up = mechanism_closed_form(*up, 100.0)
+        t_down, x_down = mechanism_closed_form(*down, 100.0)
+        want = (t_up[-1] - t_down[-1]) / (2 * h)
+        assert abs(s[name]["last_event_time"] - want) <= 1e-6 * abs(want), (name, s[name], want)
+        for i, state in enumerate(["strain", "strain_rate"]):
+            want = (x_up[i] - x_down[i]) / (2 * h)
+            got = s[name]["final_state"][state]
+            assert abs(got - want) <= 1e-6 * max(abs(want), 1.0), (name, state, got, want)
     with pytest.raises(flicker.SceneError) as caught:
         flicker.run(MODELS / "automata" / "mechanism.json", sensitivities=["etta"])
     assert caught.value.field == "sensitivities"
