@@ -130,6 +130,9 @@ struct Run<'m, 's, M: HybridModel + ?Sized> {
     simultaneous: Vec<usize>,
     /// Scratch for a guard's gradient.
     gradient: Vec<f64>,
+    /// The current step's error from a forcing's rounding (see
+    /// [`Run::forcing_rounding`]).
+    forcing_error: f64,
     /// How deep the dip of each guard's predicted crossing in the current
     /// step is (infinite where it does not curve back): what its time
     /// error grows by.
@@ -350,6 +353,7 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
             simultaneous: Vec::new(),
             gradient: vec![0.0; n],
             depths: Vec::new(),
+            forcing_error: 0.0,
             before: vec![0.0; n],
             after: vec![0.0; n],
             clock: model.clock().map(|c| (c, x0[c])),
@@ -704,8 +708,9 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
                 {
                     return Err(self.step_failed(failure));
                 }
-                let local = self.local_error();
                 let h = self.integrator.h();
+                self.forcing_error = self.forcing_rounding(h);
+                let local = self.local_error();
                 let interpolant = self.integrator.interpolant();
                 let n = self.state.len();
                 for (g, guard) in guards.iter().enumerate() {
@@ -847,7 +852,8 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
     /// than the step's rounding ([`STEP_ROUNDING_ULPS`] ulps of the state),
     /// which a step exact in its arithmetic (a Taylor series that ends, on
     /// a polynomial flow; Stormer-Verlet under a constant force) still
-    /// makes, and which a chaotic run amplifies like any other error.
+    /// makes, and which a chaotic run amplifies like any other error; plus
+    /// the rounding of a forcing (see [`Run::forcing_rounding`]).
     fn local_error(&self) -> f64 {
         let bounded = self.model.bounded_dimension().min(self.state.len());
         let clock = self.clock.map(|(c, _)| c);
@@ -859,6 +865,35 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
         self.integrator
             .local_error()
             .max(STEP_ROUNDING_ULPS * f64::EPSILON * size)
+            + self.forcing_error
+    }
+
+    /// What a forced flow's step of length `h` from the origin errs by
+    /// because it reads the clock: `sin(w t)` at `t = 1e4` is computed from
+    /// a product rounded by an ulp of `w t`, a shift of the time by `eps
+    /// |t|`, so the rate errs by `|df/dt| eps |t|` and the step by `h` times
+    /// that (`df/dt` by a central difference of the right-hand side).
+    fn forcing_rounding(&mut self, h: f64) -> f64 {
+        let (model, mode) = (self.model, self.mode);
+        let Some((c, _)) = self.clock.filter(|_| model.has_rhs(mode)) else {
+            return 0.0;
+        };
+        let t = self.state[c];
+        let dt = f64::EPSILON.cbrt() * t.abs().max(1.0);
+        let mut up = std::mem::take(&mut self.before);
+        let mut down = std::mem::take(&mut self.after);
+        let mut x = self.state.clone();
+        x[c] = t + dt;
+        model.rhs(mode, &x, &mut up);
+        x[c] = t - dt;
+        model.rhs(mode, &x, &mut down);
+        let bounded = model.bounded_dimension().min(x.len());
+        let slope = up[..bounded]
+            .iter()
+            .zip(&down[..bounded])
+            .fold(0.0_f64, |m, (a, b)| m.max((a - b).abs() / (2.0 * dt)));
+        (self.before, self.after) = (up, down);
+        h * slope * f64::EPSILON * t.abs()
     }
 
     /// Carry the errors across the event of guard `slot` at `t` (state

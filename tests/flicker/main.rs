@@ -37,3 +37,4 @@ mod stress;
 mod support;
 mod sweep;
 mod thermostat;
+mod user_models;
