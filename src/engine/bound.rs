@@ -176,6 +176,7 @@ impl Bound {
 
     /// The gradient of guard `g` of `mode` at `state`, into
     /// `self.gradient`: once per mode for affine guards.
+    #[inline]
     fn gradient_of<M: HybridModel + ?Sized>(
         &mut self,
         model: &M,
@@ -217,6 +218,7 @@ impl Bound {
     /// Note how far rounding moves the time of an exact flow's event of
     /// guard `slot` at `before`: [`ROUNDOFF_ULPS`] ulps of the sizes its
     /// guard sums, over its closing speed.
+    #[inline]
     pub fn note_crossing<M: HybridModel + ?Sized>(
         &mut self,
         model: &M,
@@ -228,16 +230,24 @@ impl Bound {
             return;
         }
         self.gradient_of(model, mode, slot, before);
-        let mut rate = std::mem::take(&mut self.rate);
-        self.tangents.rate(model, mode, before, &mut rate);
-        let closing: f64 = self.gradient.iter().zip(&rate).map(|(g, f)| g * f).sum();
         let sizes: f64 = self
             .gradient
             .iter()
             .zip(before)
             .map(|(g, x)| (g * x).abs())
             .sum();
-        self.rate = rate;
+        // A guard whose terms all vanish there (a gap closing to zero)
+        // rounds to nothing, whatever its speed.
+        if sizes == 0.0 {
+            return;
+        }
+        self.tangents.rate(model, mode, before, &mut self.rate);
+        let closing: f64 = self
+            .gradient
+            .iter()
+            .zip(&self.rate)
+            .map(|(g, f)| g * f)
+            .sum();
         let shift = ROUNDOFF_ULPS * f64::EPSILON * sizes / closing.abs();
         if shift.is_finite() && shift > self.crossing_rounding {
             self.crossing_rounding = shift;

@@ -60,6 +60,7 @@ impl EventQueue {
     }
 
     /// The earliest slot and its exact time, without removing it.
+    #[inline]
     pub fn peek(&self) -> Option<(usize, Time)> {
         self.queue
             .peek()
@@ -67,6 +68,7 @@ impl EventQueue {
     }
 
     /// Remove and return the earliest slot and its exact time.
+    #[inline]
     pub fn pop(&mut self) -> Option<(usize, Time)> {
         let (slot, _) = self.queue.pop()?;
         self.queued[slot] = false;

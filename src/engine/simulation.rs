@@ -173,7 +173,13 @@ impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
         ledger: &mut Ledger,
         observer: &mut O,
     ) -> Result<(), End> {
-        self.queue.cancel(slot);
+        // Most events are the queue's head (one due at t_end after a step
+        // may not be queued at all).
+        if self.queue.peek().is_some_and(|(head, _)| head == slot) {
+            self.queue.pop();
+        } else {
+            self.queue.cancel(slot);
+        }
         let (model, mode) = (self.model, self.mode);
         let guard = model.guards(mode)[slot];
         let mut before = std::mem::take(&mut self.before);
@@ -251,9 +257,21 @@ impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
             }
             _ => {
                 self.integrator.restart();
-                let instant = t.after(end_window(t.value()));
-                self.queue.due_by(instant, &mut self.simultaneous);
-                self.arm(Some((mode, slot)));
+                // An exact flow's guards start as its model predicts them:
+                // only a marker's, spent, needs the engine's word (the
+                // built-in impacts are all barriers, at millions a second).
+                let exact = if jump.mode == mode {
+                    self.motion == Motion::Exact
+                } else {
+                    self.motion_of(jump.mode)? == Motion::Exact
+                };
+                if exact && model.guards(jump.mode).iter().all(|g| g.barrier) {
+                    self.fresh = false;
+                } else {
+                    let instant = t.after(end_window(t.value()));
+                    self.queue.due_by(instant, &mut self.simultaneous);
+                    self.arm(Some((mode, slot)));
+                }
                 self.start_segment()
             }
         }
@@ -572,14 +590,16 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
         let (model, mode) = (self.model, self.mode);
         let mut starts = std::mem::take(&mut self.starts);
         starts.clear();
+        let same = fired.filter(|(from, _)| *from == mode).map(|(_, s)| s);
         for (g, guard) in model.guards(mode).iter().enumerate() {
+            if same == Some(g) && guard.barrier {
+                starts.push(Start::OnZero);
+                continue;
+            }
             let value = model.guard(mode, g, &self.state);
-            let same = fired.filter(|(from, _)| *from == mode).map(|(_, s)| s);
             let start = if same == Some(g) {
                 let located = model.guard(mode, g, &self.before).abs();
-                if guard.barrier {
-                    Start::OnZero
-                } else if value.abs() <= located || self.on_surface(g, value) {
+                if value.abs() <= located || self.on_surface(g, value) {
                     Start::Spent
                 } else {
                     Start::Armed
@@ -610,6 +630,12 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
         }
         let (model, mode) = (self.model, self.mode);
         let x = &self.state;
+        // Most guards are far from zero after an event: a million times
+        // the state's rounding says so without their gradients.
+        let size = x.iter().fold(1.0_f64, |m, v| m.max(v.abs()));
+        if value.abs() > 1e-6 * size {
+            return false;
+        }
         let drift = if model.has_rhs(mode) {
             let mut rate = std::mem::take(&mut self.after);
             model.rhs(mode, x, &mut rate);
