@@ -212,10 +212,10 @@ impl<M: LocalModel + ?Sized> Segments for LocalRun<'_, M> {
         (self.on_sample)(self.model, at.value());
     }
 
+    /// An event due at `t_end` may have fired a rounding past it: the run
+    /// ends at `t_end` all the same.
     fn finish(&mut self, t_end: Time) -> Result<(), End> {
-        if t_end > self.now {
-            self.now = t_end;
-        }
+        self.now = t_end;
         Ok(())
     }
 }

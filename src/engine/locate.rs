@@ -23,10 +23,15 @@
 //! before it can fire again, so an event whose reset leaves the state where
 //! it was is not found twice.
 //!
+//! A guard that has just fired and gone on through (a marker) starts the
+//! next step spent ([`Start::Spent`]): on exactly zero, whatever side
+//! rounding left it on, so that only a return and a new passage cross.
+//!
 //! A state that sits on a guard at the start of a step has not crossed it.
 //! After a reset the engine asks whether such a guard should fire at once
-//! (`leaves_zero`): it does if it is on or past zero and moves further in
-//! its direction where it first visibly moves (by more than 1e-10 of the
+//! (`leaves_zero`, [`Start::OnZero`]): it does if it is on or past zero and
+//! moves further in its direction (either way, for a guard of either
+//! direction) where it first visibly moves (by more than 1e-10 of the
 //! step's guard values; a rate too small to show before the curvature takes
 //! over is rounding). That is how an event at `t = 0`, or a reset that
 //! fails to turn the motion around (resting contact), shows up. A guard
@@ -66,10 +71,12 @@ pub struct StepScan {
     /// How clearly the step decides: for a crossing that curves back (a
     /// graze), the depth its dip would reach, `g'^2 / (2 |g''|)` (which also
     /// says how far an error moves the crossing); without a crossing, the
-    /// smallest height of a turning point still short of zero; infinite
-    /// where the guard does not curve back, nothing comes within `resolution`
-    /// of zero, or the guard is not affine. A margin below the integration
-    /// error means the method cannot tell a graze from a near miss.
+    /// smallest height of a turning point still short of zero (a piece of
+    /// a step halved around a crossing may report a turning point before it
+    /// instead, which only errs towards caution); infinite where the guard
+    /// does not curve back, stays clearly clear of zero, or is not affine.
+    /// A margin below the integration error means the method cannot tell a
+    /// graze from a near miss.
     pub margin: f64,
     /// Where in the step (`s in [0, 1]`) the margin was measured: a graze
     /// after an earlier event of the step does not matter, for the step is

@@ -133,6 +133,9 @@ struct Run<'m, 's, M: HybridModel + ?Sized> {
     /// The current step's error from a forcing's rounding (see
     /// [`Run::forcing_rounding`]).
     forcing_error: f64,
+    /// Scratch of the state's length: a shifted state, and two rates.
+    probe: Vec<f64>,
+    rates: (Vec<f64>, Vec<f64>),
     /// How deep the dip of each guard's predicted crossing in the current
     /// step is (infinite where it does not curve back): what its time
     /// error grows by.
@@ -221,9 +224,6 @@ impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
         std::mem::swap(&mut self.state, &mut self.after);
         self.origin = t;
         self.mode = jump.mode;
-        if jump.mode != mode && !guard.barrier && !guard.internal {
-            self.slides(mode, slot, t).map_err(End::failed)?;
-        }
         if model.terminal(mode, slot) {
             return Err(End {
                 status: Status::Completed,
@@ -233,6 +233,9 @@ impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
                     t.value()
                 )),
             });
+        }
+        if jump.mode != mode && !guard.barrier && !guard.internal {
+            self.slides(mode, slot, t).map_err(End::failed)?;
         }
         // Internal switches are watched too: a chart that flickers at one
         // instant must not spin either.
@@ -249,11 +252,32 @@ impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
                         first.saturating_add(count)
                     )));
                 }
-                // The guard that fired left the queue: it is always predicted anew.
-                if !(first..first + count).contains(&slot) {
+                // The guard that fired left the queue: it is always predicted
+                // anew, a marker past the crossing it sits on; so is any
+                // other marker on the same surface, crossed with it, unless
+                // it was due at this instant too (simultaneous events).
+                if !guard.barrier {
+                    let instant = t.after(end_window(t.value()));
+                    self.queue.due_by(instant, &mut self.simultaneous);
+                    self.predict_past(slot)?;
+                } else if !(first..first + count).contains(&slot) {
                     self.predict_exact(slot)?;
                 }
-                (first..first + count).try_for_each(|g| self.predict_exact(g))
+                (first..first + count)
+                    .filter(|&g| guard.barrier || g != slot)
+                    .try_for_each(|g| {
+                        let value = model.guard(mode, g, &self.state);
+                        if !guard.barrier
+                            && !model.guards(mode)[g].barrier
+                            && !self.simultaneous.contains(&g)
+                            && self.on_surface(g, value)
+                            && self.same_surface((mode, slot), g)
+                        {
+                            self.predict_past(g)
+                        } else {
+                            self.predict_exact(g)
+                        }
+                    })
             }
             _ => {
                 self.integrator.restart();
@@ -303,7 +327,7 @@ impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
     /// rate there (see [`Run::crossing_after`]).
     fn due_at_end(&mut self, t_end: Time, window: f64) -> Option<usize> {
         self.crossing_after(t_end)
-            .filter(|(_, tau, _)| *tau <= window)
+            .filter(|(_, tau, _)| tau.abs() <= window)
             .map(|(g, _, _)| g)
     }
 
@@ -322,7 +346,7 @@ impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
                 let uncertainty = self
                     .bound
                     .guard_uncertainty(model, mode, g, &self.before, local);
-                (t.after(tau), uncertainty / rate.abs())
+                (t.after(tau.max(0.0)), uncertainty / rate.abs())
             }),
         };
         self.bound
@@ -372,6 +396,8 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
             gradient: vec![0.0; n],
             depths: Vec::new(),
             forcing_error: 0.0,
+            probe: vec![0.0; n],
+            rates: (vec![0.0; n], vec![0.0; n]),
             before: vec![0.0; n],
             after: vec![0.0; n],
             clock: model.clock().map(|c| (c, x0[c])),
@@ -524,35 +550,46 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
     /// rounding to the other side, drift off the surface quietly. (Modes
     /// of a hysteresis, whose guards lie apart, are not caught: the new
     /// mode's guards are off the surface.)
-    fn slides(&self, from: Mode, slot: usize, t: Time) -> Result<(), String> {
+    fn slides(&mut self, from: Mode, slot: usize, t: Time) -> Result<(), String> {
         let (model, to) = (self.model, self.mode);
         if !(model.has_rhs(from) && model.has_rhs(to)) {
             return Ok(());
         }
-        let n = self.state.len();
-        let mut f_from = vec![0.0; n];
-        let mut f_to = vec![0.0; n];
+        let clock = self.clock.map(|(c, _)| c);
+        let (mut f_from, mut f_to) = std::mem::take(&mut self.rates);
+        let mut probe = std::mem::take(&mut self.probe);
         model.rhs(from, &self.before, &mut f_from);
         model.rhs(to, &self.state, &mut f_to);
         let surface = |x: &[f64]| model.guard(from, slot, x);
-        let came = guard_rate(surface, &self.before, &f_from);
-        let back = guard_rate(surface, &self.state, &f_to);
-        if !(came * back < 0.0 && back.abs() > 1e-8 * came.abs()) {
-            return Ok(());
-        }
-        let size = self.state.iter().fold(1.0_f64, |m, v| m.max(v.abs()));
-        let at_once = model.guards(to).iter().enumerate().find(|(h, guard)| {
-            let value = model.guard(to, *h, &self.state);
-            let rate = guard_rate(|x| model.guard(to, *h, x), &self.state, &f_to);
-            // On the surface: as near zero as the crossing was located, or
-            // within rounding of the state (a guard scaled otherwise).
-            let near = value.abs() <= surface(&self.before).abs().max(64.0 * f64::EPSILON * size);
-            near && match guard.direction {
-                Direction::Falling => rate < 0.0,
-                Direction::Rising => rate > 0.0,
-                Direction::Either => rate != 0.0,
-            }
-        });
+        let came = guard_rate(surface, &self.before, &f_from, clock, &mut probe);
+        let back = guard_rate(surface, &self.state, &f_to, clock, &mut probe);
+        let size = size_of(&self.state, clock);
+        let at_once = (came * back < 0.0 && back.abs() > 1e-8 * came.abs())
+            .then(|| {
+                model.guards(to).iter().enumerate().find(|(h, guard)| {
+                    let value = model.guard(to, *h, &self.state);
+                    let rate = guard_rate(
+                        |x| model.guard(to, *h, x),
+                        &self.state,
+                        &f_to,
+                        clock,
+                        &mut probe,
+                    );
+                    // On the surface: as near zero as the crossing was
+                    // located, or within rounding of the state (a guard
+                    // scaled otherwise).
+                    let near =
+                        value.abs() <= surface(&self.before).abs().max(64.0 * f64::EPSILON * size);
+                    near && match guard.direction {
+                        Direction::Falling => rate < 0.0,
+                        Direction::Rising => rate > 0.0,
+                        Direction::Either => rate != 0.0,
+                    }
+                })
+            })
+            .flatten();
+        self.rates = (f_from, f_to);
+        self.probe = probe;
         match at_once {
             None => Ok(()),
             Some((_, guard)) => Err(format!(
@@ -608,7 +645,10 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
                 Start::OnZero
             } else if !self.on_surface(g, value) {
                 Start::Armed
-            } else if fired.is_none() || guard.barrier {
+            } else if fired.is_none()
+                || guard.barrier
+                || fired.is_some_and(|fired| !self.same_surface(fired, g))
+            {
                 Start::OnZero
             } else {
                 Start::Spent
@@ -617,6 +657,23 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
         }
         self.starts = starts;
         self.fresh = true;
+    }
+
+    /// Whether guard `g` of the current mode, on its surface, lies along
+    /// the surface of guard `slot` of mode `from` just crossed (their
+    /// gradients parallel, at the states after and before the event): a
+    /// copy of the same transition, not another surface through the same
+    /// point (a corner), which fires on its own.
+    fn same_surface(&mut self, (from, slot): (Mode, usize), g: usize) -> bool {
+        let model = self.model;
+        let (mut a, mut b) = std::mem::take(&mut self.rates);
+        let mut probe = std::mem::take(&mut self.probe);
+        normal(model, from, slot, &self.before, &mut a, &mut probe);
+        normal(model, self.mode, g, &self.state, &mut b, &mut probe);
+        let dot: f64 = a.iter().zip(&b).map(|(x, y)| x * y).sum();
+        let norms = a.iter().map(|x| x * x).sum::<f64>() * b.iter().map(|y| y * y).sum::<f64>();
+        (self.rates, self.probe) = ((a, b), probe);
+        dot * dot >= (1.0 - 1e-6) * norms && norms > 0.0
     }
 
     /// Whether guard `g` of the current mode, `value` at the state, is on
@@ -629,36 +686,27 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
             return true;
         }
         let (model, mode) = (self.model, self.mode);
+        let clock = self.clock.map(|(c, _)| c);
         let x = &self.state;
-        // Most guards are far from zero after an event: a million times
-        // the state's rounding says so without their gradients.
-        let size = x.iter().fold(1.0_f64, |m, v| m.max(v.abs()));
-        if value.abs() > 1e-6 * size {
+        // Most guards are far from zero after an event: within a millionth
+        // of the state's size they are worth a closer look, beyond it not.
+        if value.abs() > 1e-6 * size_of(x, clock) {
             return false;
         }
+        let mut probe = std::mem::take(&mut self.probe);
         let drift = if model.has_rhs(mode) {
-            let mut rate = std::mem::take(&mut self.after);
+            let mut rate = std::mem::take(&mut self.rates.0);
             model.rhs(mode, x, &mut rate);
-            let drift = guard_rate(|y| model.guard(mode, g, y), x, &rate).abs()
+            let drift = guard_rate(|y| model.guard(mode, g, y), x, &rate, clock, &mut probe).abs()
                 * end_window(self.origin.value());
-            self.after = rate;
+            self.rates.0 = rate;
             drift
         } else {
             0.0
         };
         let mut gradient = std::mem::take(&mut self.gradient);
-        if !model.guard_gradient(mode, g, x, &mut gradient) {
-            let mut y = x.clone();
-            for j in 0..x.len() {
-                let h = f64::EPSILON.cbrt() * x[j].abs().max(1.0);
-                y[j] = x[j] + h;
-                let up = model.guard(mode, g, &y);
-                y[j] = x[j] - h;
-                let down = model.guard(mode, g, &y);
-                y[j] = x[j];
-                gradient[j] = (up - down) / (2.0 * h);
-            }
-        }
+        normal(model, mode, g, x, &mut gradient, &mut probe);
+        self.probe = probe;
         let scale: f64 = gradient.iter().zip(x).map(|(d, v)| (d * v).abs()).sum();
         self.gradient = gradient;
         value.abs() <= 64.0 * f64::EPSILON * scale + drift
@@ -695,6 +743,7 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
         let mut state = std::mem::take(&mut self.state);
         self.set_clock(self.origin, &mut state);
         self.state = state;
+        self.depths.clear();
         self.check_guards()?;
         self.queue.clear();
         self.step_end = None;
@@ -726,7 +775,6 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
                 let fresh = std::mem::replace(&mut self.fresh, false);
                 let mut graze: Option<(usize, f64, f64, f64)> = None;
                 let mut earliest = f64::INFINITY;
-                self.depths.clear();
                 self.depths.resize(guards.len(), f64::INFINITY);
                 if let Err(failure) =
                     self.integrator
@@ -840,18 +888,31 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
 
     /// The earliest guard that a stepped flow would cross just after
     /// `t_end` (which its last step does not look past), by each guard's
-    /// value and rate there: `(guard, time after t_end, rate)`. The state
-    /// at `t_end` is left in `self.before`. A guard that fired at the
-    /// origin counts as its start says: a spent marker is not due again.
+    /// value and rate there: `(guard, time after t_end, rate)`, the time
+    /// negative for one a few ulps before it, where no step was taken. The
+    /// state it was judged from is left in `self.before`. A guard that
+    /// fired at the origin counts as its start says: a spent marker is not
+    /// due again.
     fn crossing_after(&mut self, t_end: Time) -> Option<(usize, f64, f64)> {
         let (model, mode) = (self.model, self.mode);
         if self.motion != Motion::Stepped || !model.has_rhs(mode) {
             return None;
         }
+        // The state at t_end, from the last step; or, where no step was
+        // taken (what was left of the run was below a step), at the
+        // origin, a few ulps before t_end, which the extrapolation covers.
+        let (reach, from) = if self.stepped {
+            (t_end.since(self.origin).max(0.0), t_end)
+        } else {
+            (0.0, self.origin)
+        };
+        let gap = t_end.since(from);
+        let clock = self.clock.map(|(c, _)| c);
         let mut x = std::mem::take(&mut self.before);
-        let mut rate = std::mem::take(&mut self.after);
-        self.state_at(t_end.since(self.origin).max(0.0), &mut x);
-        self.set_clock(t_end, &mut x);
+        let mut rate = std::mem::take(&mut self.rates.0);
+        let mut probe = std::mem::take(&mut self.probe);
+        self.state_at(reach, &mut x);
+        self.set_clock(from, &mut x);
         model.rhs(mode, &x, &mut rate);
         let fresh = !self.stepped && self.fresh;
         let mut first: Option<(usize, f64, f64)> = None;
@@ -860,17 +921,17 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
                 continue;
             }
             let value = model.guard(mode, g, &x);
-            let slope = guard_rate(|y| model.guard(mode, g, y), &x, &rate);
-            let tau = -value / slope;
+            let slope = guard_rate(|y| model.guard(mode, g, y), &x, &rate, clock, &mut probe);
+            let tau = -value / slope - gap;
             if value != 0.0
-                && tau > 0.0
+                && -value / slope > 0.0
                 && guard.direction.accepts(value, -value)
                 && first.is_none_or(|(_, earliest, _)| tau < earliest)
             {
                 first = Some((g, tau, slope));
             }
         }
-        (self.before, self.after) = (x, rate);
+        (self.before, self.rates.0, self.probe) = (x, rate, probe);
         first
     }
 
@@ -905,10 +966,12 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
             return 0.0;
         };
         let t = self.state[c];
-        let dt = f64::EPSILON.cbrt() * t.abs().max(1.0);
-        let mut up = std::mem::take(&mut self.before);
-        let mut down = std::mem::take(&mut self.after);
-        let mut x = self.state.clone();
+        // A difference over a small part of the step (which resolves the
+        // forcing), and far above the ulps of t.
+        let dt = (f64::EPSILON.cbrt() * h).max(1e3 * f64::EPSILON * t.abs());
+        let (mut up, mut down) = std::mem::take(&mut self.rates);
+        let mut x = std::mem::take(&mut self.probe);
+        x.copy_from_slice(&self.state);
         x[c] = t + dt;
         model.rhs(mode, &x, &mut up);
         x[c] = t - dt;
@@ -918,7 +981,7 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
             .iter()
             .zip(&down[..bounded])
             .fold(0.0_f64, |m, (a, b)| m.max((a - b).abs() / (2.0 * dt)));
-        (self.before, self.after) = (up, down);
+        (self.rates, self.probe) = ((up, down), x);
         h * slope * f64::EPSILON * t.abs()
     }
 
@@ -974,13 +1037,7 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
                 self.queue.cancel(g);
                 Ok(())
             }
-            Some(tau) if tau >= 0.0 && self.queue.schedule(g, self.origin.after(tau)) => Ok(()),
-            Some(tau) => Err(End::failed(format!(
-                "the model predicted guard `{}` at an invalid elapsed time {tau} from state {:?} at t = {}",
-                self.model.guards(self.mode)[g].name,
-                self.state,
-                self.origin.value()
-            ))),
+            Some(tau) => self.schedule_exact(g, tau),
         }
     }
 
@@ -993,12 +1050,15 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
         self.exact_evaluations += 1;
         match model.next_crossing(mode, g, &self.state) {
             Some(tau) if tau > end_window(self.origin.value().abs().max(1.0)) => {
-                return self.predict_exact(g);
+                return self.schedule_exact(g, tau);
             }
-            None => return self.predict_exact(g),
+            None => {
+                self.queue.cancel(g);
+                return Ok(());
+            }
             Some(_) => {}
         }
-        let mut ahead = std::mem::take(&mut self.after);
+        let mut ahead = std::mem::take(&mut self.probe);
         let mut skip = 1e-12 * self.origin.value().abs().max(1.0);
         let mut predicted = None;
         for _ in 0..40 {
@@ -1006,26 +1066,44 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
             self.exact_evaluations += 2;
             match model.next_crossing(mode, g, &ahead) {
                 Some(tau) if tau > 0.0 => {
-                    predicted = Some(skip + tau);
+                    predicted = Some(Some(skip + tau));
                     break;
                 }
                 Some(_) => skip *= 4.0,
-                None => break,
+                None => {
+                    predicted = Some(None);
+                    break;
+                }
             }
         }
-        self.after = ahead;
+        self.probe = ahead;
         match predicted {
-            Some(tau) if self.queue.schedule(g, self.origin.after(tau)) => Ok(()),
-            Some(tau) => Err(End::failed(format!(
-                "the model predicted guard `{}` at an invalid elapsed time {tau} at t = {}",
-                model.guards(mode)[g].name,
-                self.origin.value()
-            ))),
-            None => {
+            Some(Some(tau)) => self.schedule_exact(g, tau),
+            Some(None) => {
                 self.queue.cancel(g);
                 Ok(())
             }
+            None => Err(End::failed(format!(
+                "guard `{}` stays on zero at t = {}: the model predicts its crossing at once from \
+                 every state up to {skip:.1e} further along the flow, so the next crossing cannot \
+                 be told from the one just fired",
+                model.guards(mode)[g].name,
+                self.origin.value()
+            ))),
         }
+    }
+
+    /// Queue guard `g` `tau` after the origin, as an exact flow predicted it.
+    fn schedule_exact(&mut self, g: usize, tau: f64) -> Result<(), End> {
+        if tau >= 0.0 && self.queue.schedule(g, self.origin.after(tau)) {
+            return Ok(());
+        }
+        Err(End::failed(format!(
+            "the model predicted guard `{}` at an invalid elapsed time {tau} from state {:?} at t = {}",
+            self.model.guards(self.mode)[g].name,
+            self.state,
+            self.origin.value()
+        )))
     }
 
     fn step_failed(&self, failure: StepFailure) -> End {
@@ -1104,18 +1182,63 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
 /// each stage's or term's sum.
 pub const STEP_ROUNDING_ULPS: f64 = 4.0;
 
+/// The gradient of guard `g` of `mode` at `x` into `out`: the model's, or
+/// central differences (`probe` is scratch of the state's length).
+fn normal<M: HybridModel + ?Sized>(
+    model: &M,
+    mode: Mode,
+    g: usize,
+    x: &[f64],
+    out: &mut [f64],
+    probe: &mut [f64],
+) {
+    if model.guard_gradient(mode, g, x, out) {
+        return;
+    }
+    probe.copy_from_slice(x);
+    for j in 0..x.len() {
+        let h = f64::EPSILON.cbrt() * x[j].abs().max(1.0);
+        probe[j] = x[j] + h;
+        let up = model.guard(mode, g, probe);
+        probe[j] = x[j] - h;
+        let down = model.guard(mode, g, probe);
+        probe[j] = x[j];
+        out[j] = (up - down) / (2.0 * h);
+    }
+}
+
+/// The largest component of `x` but the clock, and at least one: the
+/// scale differences and rounding are measured against.
+fn size_of(x: &[f64], clock: Option<usize>) -> f64 {
+    x.iter()
+        .enumerate()
+        .filter(|(i, _)| Some(*i) != clock)
+        .fold(1.0_f64, |m, (_, v)| m.max(v.abs()))
+}
+
 /// The rate of `guard` along the flow `rate` at `x`, by a central
-/// difference along the flow (errors about 1e-10 relative).
-fn guard_rate(guard: impl Fn(&[f64]) -> f64, x: &[f64], rate: &[f64]) -> f64 {
-    let size = x.iter().fold(1.0_f64, |m, v| m.max(v.abs()));
+/// difference along the flow (errors about 1e-10 relative), its step a
+/// cube root of eps of the state's size (the clock's aside) over the
+/// speed; `probe` is scratch of the state's length.
+fn guard_rate(
+    guard: impl Fn(&[f64]) -> f64,
+    x: &[f64],
+    rate: &[f64],
+    clock: Option<usize>,
+    probe: &mut [f64],
+) -> f64 {
     let speed = rate.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
     if speed == 0.0 || !speed.is_finite() {
         return 0.0;
     }
-    let h = f64::EPSILON.cbrt() * size / speed;
-    let shifted =
-        |sign: f64| -> Vec<f64> { x.iter().zip(rate).map(|(a, r)| a + sign * h * r).collect() };
-    (guard(&shifted(1.0)) - guard(&shifted(-1.0))) / (2.0 * h)
+    let h = f64::EPSILON.cbrt() * size_of(x, clock) / speed;
+    let mut at = |sign: f64| {
+        for ((p, a), r) in probe.iter_mut().zip(x).zip(rate) {
+            *p = a + sign * h * r;
+        }
+        guard(probe)
+    };
+    (at(1.0) - at(-1.0)) / (2.0 * h)
 }
 
 fn all_finite(x: &[f64]) -> bool {

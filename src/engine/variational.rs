@@ -264,12 +264,12 @@ impl<M: HybridModel + ?Sized> HybridModel for Variational<'_, M> {
         self.model.labels(mode, guard, &before[..self.n])
     }
 
-    /// The error bound is the model's state's, not its derivatives'.
     /// The model's own clock: its derivatives stay zero.
     fn clock(&self) -> Option<usize> {
         self.model.clock()
     }
 
+    /// The error bound is the model's state's, not its derivatives'.
     fn bounded_dimension(&self) -> usize {
         self.n
     }

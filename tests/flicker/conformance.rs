@@ -30,8 +30,8 @@
 //! or a time outside its bound fails the test, naming the case.
 
 use flicker::engine::{
-    Direction, Flow, Guard, HybridModel, Jump, Method, Mode, Options, Outcome, Status, Tolerances,
-    simulate,
+    Affects, Direction, Flow, Guard, HybridModel, Jump, Method, Mode, Options, Outcome, Status,
+    Tolerances, simulate,
 };
 use flicker::models::automaton::{AutomatonBuilder, TransitionBuilder};
 
@@ -309,6 +309,9 @@ struct ExactOscillator {
     threshold: f64,
     modes: usize,
     counts: bool,
+    /// Whether a reset re-predicts only the guards it names
+    /// (`Affects::Range`, as a chain's do), instead of all.
+    range: bool,
 }
 
 impl ExactOscillator {
@@ -329,6 +332,7 @@ impl ExactOscillator {
             threshold: case.threshold,
             modes: if case.kind == Kind::ModeChange { 2 } else { 1 },
             counts: case.kind == Kind::Reset,
+            range: false,
         }
     }
 }
@@ -398,7 +402,17 @@ impl HybridModel for ExactOscillator {
         if self.counts {
             x[1] += 1.0;
         }
-        Jump::to(if self.modes == 2 { 1 - mode } else { mode })
+        let to = if self.modes == 2 { 1 - mode } else { mode };
+        if self.range {
+            return Jump {
+                mode: to,
+                affects: Affects::Range {
+                    first: 0,
+                    count: self.guards.len(),
+                },
+            };
+        }
+        Jump::to(to)
     }
 }
 
@@ -607,5 +621,135 @@ fn every_method_fires_each_crossing_once_within_its_bounds() {
             "{way:?}: {} of {ran} cases completed, {stopped} refused",
             ran - stopped
         );
+    }
+}
+
+/// An exact flow whose resets re-predict only the guards they name
+/// (`Affects::Range`, the chain's way) keeps the same rules: a marker that
+/// fires is predicted past the crossing it sits on, not at once again.
+#[test]
+fn an_exact_marker_re_predicted_by_range_fires_once_per_crossing() {
+    for direction in [Direction::Rising, Direction::Falling, Direction::Either] {
+        let case = Case {
+            way: Way::Exact,
+            family: Family::Oscillator,
+            direction,
+            kind: Kind::Reset,
+            situation: Situation::Simultaneous,
+            start: (0.3, 0.8),
+            threshold: C,
+            t_end: HORIZON,
+        };
+        let model = ExactOscillator {
+            range: true,
+            ..ExactOscillator::new(&case)
+        };
+        let mut log = EventLog::default();
+        let outcome = simulate(
+            &model,
+            0,
+            &[0.3, 0.0, 0.8, 0.0],
+            &Options::until(HORIZON),
+            &mut log,
+        );
+        let want = expected(&case);
+        assert_eq!(
+            outcome.status,
+            Status::Completed,
+            "{direction:?}: {:?}",
+            outcome.reason
+        );
+        let seen: Vec<(f64, &str)> = log.0.iter().map(|e| (e.t, e.guard)).collect();
+        assert_eq!(seen.len(), want.len(), "{direction:?}: {seen:?}");
+        for (e, w) in seen.iter().zip(&want) {
+            assert_eq!(e.1, w.1, "{direction:?}: {seen:?}");
+            assert!((e.0 - w.0).abs() < 1e-12, "{direction:?}: {seen:?}");
+        }
+    }
+}
+
+/// An exact model that predicts its marker at once from every state (it
+/// can never tell the next crossing from the one just fired) stops with
+/// that reason instead of firing forever or dropping the guard.
+#[test]
+fn a_marker_predicted_at_once_forever_stops_the_run() {
+    struct Stuck;
+    const STUCK: [Guard; 1] = [Guard::affine("mark", Direction::Rising).as_crossing()];
+    impl HybridModel for Stuck {
+        fn dimension(&self) -> usize {
+            1
+        }
+        fn state_names(&self, _: Mode) -> &[&'static str] {
+            &["x"]
+        }
+        fn mode_name(&self, _: Mode) -> &'static str {
+            "m"
+        }
+        fn guards(&self, _: Mode) -> &[Guard] {
+            &STUCK
+        }
+        fn guard(&self, _: Mode, _: usize, x: &[f64]) -> f64 {
+            x[0]
+        }
+        fn flow(&self, _: Mode) -> Flow {
+            Flow::Exact
+        }
+        fn advance(&self, _: Mode, x0: &[f64], tau: f64, x: &mut [f64]) {
+            x[0] = x0[0] + tau;
+        }
+        fn next_crossing(&self, _: Mode, _: usize, _: &[f64]) -> Option<f64> {
+            Some(0.0)
+        }
+        fn reset(&self, mode: Mode, _: usize, _: &mut [f64]) -> Jump {
+            Jump::to(mode)
+        }
+    }
+    let outcome = simulate(&Stuck, 0, &[0.0], &Options::until(1.0), &mut ());
+    assert_eq!(outcome.status, Status::Failed, "{:?}", outcome.reason);
+    assert!(outcome.reason.unwrap().contains("stays on zero"));
+}
+
+/// Two surfaces through one point, crossed at one instant: the first
+/// takes mode `a` into `b`, whose own marker lies on another surface (a
+/// corner, not a copy of the first): it fires too, at the same time, and
+/// takes `b` into `c`. (A copy of the surface just crossed would count as
+/// crossed with it; see `expected`.)
+#[test]
+fn a_corner_fires_both_surfaces_at_once_by_every_method() {
+    let marker =
+        |name: &str, guard: &str, to: &str| TransitionBuilder::new(name, guard).rising().to(to);
+    let model = AutomatonBuilder::new()
+        .state("x", -1.0)
+        .state("y", -1.0)
+        .mode("a", [("x", "1"), ("y", "1")], [marker("first", "x", "b")])
+        .mode("b", [("x", "1"), ("y", "1")], [marker("second", "y", "c")])
+        .mode(
+            "c",
+            [("x", "1"), ("y", "1")],
+            Vec::<TransitionBuilder>::new(),
+        )
+        .initial_mode("a")
+        .build()
+        .unwrap();
+    for way in [Way::Linear, Way::Taylor, Way::Dopri5, Way::Dop853] {
+        let mut options = Options::until(3.0);
+        options.method = way.method();
+        let mut log = EventLog::default();
+        let outcome = simulate(
+            &model,
+            model.initial_mode(),
+            model.initial(),
+            &options,
+            &mut log,
+        );
+        assert_eq!(
+            outcome.status,
+            Status::Completed,
+            "{way:?}: {:?}",
+            outcome.reason
+        );
+        let seen: Vec<(&str, &str)> = log.0.iter().map(|e| (e.guard, e.mode_after)).collect();
+        assert_eq!(seen, [("first", "b"), ("second", "c")], "{way:?}");
+        assert!(log.0.iter().all(|e| (e.t - 1.0).abs() < 1e-12), "{way:?}");
     }
 }
