@@ -28,6 +28,17 @@ fn rows_of(folder: &str) -> Vec<Row> {
     rows
 }
 
+/// Neither another answer nor an error beyond the run's own bound.
+fn assert_honest(r: &Row) {
+    assert!(
+        matches!(r.verdict, Verdict::Passed | Verdict::Failed { .. }),
+        "{} with {}: {:?}",
+        r.case,
+        r.method,
+        r.verdict
+    );
+}
+
 fn verdict<'a>(rows: &'a [Row], case: &str, method: &str) -> &'a Verdict {
     &rows
         .iter()
@@ -45,14 +56,7 @@ fn no_method_is_silently_wrong_and_each_says_why_it_fails() {
         "8 cases: 7 strain cases x 5 methods + the angle case x 2"
     );
     for r in &rows {
-        // Neither another answer nor an error beyond the run's own bound.
-        assert!(
-            matches!(r.verdict, Verdict::Passed | Verdict::Failed { .. }),
-            "{} with {}: {:?}",
-            r.case,
-            r.method,
-            r.verdict
-        );
+        assert_honest(r);
         // The verdict is earned: a pass has its errors within its bounds,
         // checked here on the measured numbers themselves.
         if r.verdict == Verdict::Passed {
@@ -229,15 +233,7 @@ fn bounds_stay_within_ten_times_their_recorded_ratio() {
 #[test]
 fn no_automaton_is_silently_wrong_against_its_closed_form() {
     let rows = rows_of("models/automata");
-    for r in &rows {
-        assert!(
-            matches!(r.verdict, Verdict::Passed | Verdict::Failed { .. }),
-            "{} with {}: {:?}",
-            r.case,
-            r.method,
-            r.verdict
-        );
-    }
+    rows.iter().for_each(assert_honest);
     for case in [
         "mechanism",
         "rocking_block_linear",
