@@ -2,6 +2,9 @@
 //! rates, the guard, the reset, the energy and an initial value of a
 //! two-state, two-mode automaton. Each must be refused with an error or
 //! compiled and run briefly (every method that applies), never a panic.
+//! The default rate switches by `sign()` (dry friction), so that flows
+//! with switching surfaces, their sliding and their refusals are fuzzed
+//! from the first input on.
 #![no_main]
 
 use flicker::runner::Control;
@@ -17,7 +20,7 @@ fuzz_target!(|data: &[u8]| {
     let mut next = |default: &str| parts.next().unwrap_or(default).to_string();
     let (rate_x, rate_v, guard, reset, energy, initial) = (
         next("v"),
-        next("-x"),
+        next("-x - a * sign(v)"),
         next("x"),
         next("-v"),
         next("v^2 + x^2"),

@@ -116,3 +116,23 @@ def test_to_pandas_has_a_row_per_event_and_a_column_per_state():
     assert len(frame) == len(run.events["t"])
     assert {"t", "guard", "before.y", "before.v", "after.v"} <= set(frame.columns)
     assert np.allclose(frame["after.v"], -0.8 * frame["before.v"], rtol=1e-15, atol=0)
+
+
+def test_a_flow_that_reads_sign_slides_from_a_dict():
+    """Dry friction written as a dict: the block turns at atan(6/13) + k pi
+    and sticks at atan(6/13) + 7 pi, x = 15 - sqrt(205) (the closed form),
+    the events named after the surface."""
+    scene = {
+        "model": "automaton",
+        "states": ["x", "v"],
+        "initial": {"x": 12.0, "v": 6.0},
+        "modes": {"block": {"flow": {"x": "v", "v": "-x - sign(v)"}}},
+        "t_end": 30.0,
+    }
+    run = flicker.run(scene)
+    first = math.atan(6 / 13)
+    assert list(run.events["guard"]) == ["cross:v"] * 7 + ["slide:v"]
+    assert np.allclose(run.events["t"], [first + k * math.pi for k in range(8)], rtol=0, atol=1e-12)
+    assert run.events["mode_after"][-1] == "block[v=0]"
+    assert abs(run.summary["final_state"]["x"] - (15 - math.sqrt(205))) < 1e-12
+    assert run.summary["final_state"]["v"] == 0.0

@@ -40,6 +40,8 @@ pub(crate) struct Ledger<'o> {
     events: u64,
     /// Event counts per mode and guard.
     counts: Vec<Vec<u64>>,
+    /// Counts of the events a reset named (see `Jump::event`).
+    named: BTreeMap<&'static str, u64>,
     zeno: ZenoWatch,
     settles: u64,
     /// Set once the run has settled a Zeno accumulation and gone on.
@@ -66,6 +68,7 @@ impl<'o> Ledger<'o> {
             budget_check: (BUDGET_CHECK, 0, Time::new(0.0)),
             events: 0,
             counts: Vec::new(),
+            named: BTreeMap::new(),
             zeno: ZenoWatch::new(options.t_end),
             settles: 0,
             zeno_reason: None,
@@ -178,6 +181,11 @@ impl<'o> Ledger<'o> {
         }
         self.budget_check = (self.events + BUDGET_CHECK, self.events, t);
         Ok(())
+    }
+
+    /// Count an event the model named otherwise than its guard.
+    pub fn count_named(&mut self, name: &'static str) {
+        *self.named.entry(name).or_insert(0) += 1;
     }
 
     /// Count a non-internal event of guard `slot` in `mode`.
@@ -295,6 +303,9 @@ impl<'o> Ledger<'o> {
                     *events_by_guard.entry(guard_name(mode, slot)).or_insert(0) += n;
                 }
             }
+        }
+        for (name, n) in &self.named {
+            *events_by_guard.entry(*name).or_insert(0) += n;
         }
         if self.settles > 0 {
             events_by_guard.insert(SETTLE, self.settles);

@@ -125,14 +125,42 @@ pub struct Jump {
     pub mode: Mode,
     /// Which guards' predictions the reset spoiled.
     pub affects: Affects,
+    /// What the event is called in the log and the counts, where the
+    /// reset names it otherwise than its guard (a switching surface
+    /// reached: crossed, or slid on); `None` keeps the guard's name.
+    pub event: Option<&'static str>,
+    /// The guard of the new mode whose surface the state starts on, leaving
+    /// it along the flow (a sliding that ends where the flow turns
+    /// tangent): it neither fires there nor can be said to move its way,
+    /// so it starts spent, and fires when the state comes back.
+    pub leaves: Option<usize>,
 }
 
 impl Jump {
-    /// Stay in `mode` and re-predict every guard.
+    /// Go to `mode` and re-predict every guard.
     pub fn to(mode: Mode) -> Self {
         Jump {
             mode,
             affects: Affects::All,
+            event: None,
+            leaves: None,
+        }
+    }
+
+    /// The same, the event called `name` in the log.
+    pub fn named(self, name: &'static str) -> Self {
+        Jump {
+            event: Some(name),
+            ..self
+        }
+    }
+
+    /// The same, the state leaving the surface of guard `guard` of the new
+    /// mode (see [`Jump::leaves`]).
+    pub fn leaving(self, guard: usize) -> Self {
+        Jump {
+            leaves: Some(guard),
+            ..self
         }
     }
 }
@@ -253,6 +281,15 @@ pub trait HybridModel {
     fn terminal(&self, mode: Mode, guard: usize) -> bool {
         let _ = (mode, guard);
         false
+    }
+
+    /// Why a run that enters `mode` cannot go on, if it cannot: a mode
+    /// that stands for an answer the model does not have (a switching
+    /// surface both sides flow away from, where the solution is not
+    /// unique). The run stops there, `failed`, with this reason.
+    fn stop_reason(&self, mode: Mode) -> Option<String> {
+        let _ = mode;
+        None
     }
 
     /// The conserved (or monitored) energy at `x`, if the model has one.

@@ -153,6 +153,9 @@ impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
     }
 
     fn begin(&mut self, _: &mut Ledger) -> Result<(), End> {
+        if let Some(why) = self.model.stop_reason(self.mode) {
+            return Err(End::failed(format!("at the start: {why}")));
+        }
         self.arm(None);
         self.start_segment()
     }
@@ -212,10 +215,19 @@ impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
         } else if guard.internal {
             Ok(())
         } else {
-            ledger.count(mode, slot);
+            match jump.event {
+                Some(name) => ledger.count_named(name),
+                None => ledger.count(mode, slot),
+            }
             let labels = model.labels(mode, slot, &before);
             ledger.log(
-                self.event(guard.name, t, jump.mode, &before, &labels),
+                self.event(
+                    jump.event.unwrap_or(guard.name),
+                    t,
+                    jump.mode,
+                    &before,
+                    &labels,
+                ),
                 observer,
             )
         };
@@ -233,6 +245,9 @@ impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
                     t.value()
                 )),
             });
+        }
+        if let Some(why) = model.stop_reason(jump.mode) {
+            return Err(End::failed(format!("at t = {}: {why}", t.value())));
         }
         if jump.mode != mode && !guard.barrier && !guard.internal {
             self.slides(mode, slot, t).map_err(End::failed)?;
@@ -295,6 +310,9 @@ impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
                     let instant = t.after(end_window(t.value()));
                     self.queue.due_by(instant, &mut self.simultaneous);
                     self.arm(Some((mode, slot)));
+                    if let Some(g) = jump.leaves.filter(|&g| g < self.starts.len()) {
+                        self.starts[g] = Start::Spent;
+                    }
                 }
                 self.start_segment()
             }

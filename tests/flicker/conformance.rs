@@ -410,6 +410,8 @@ impl HybridModel for ExactOscillator {
                     first: 0,
                     count: self.guards.len(),
                 },
+                event: None,
+                leaves: None,
             };
         }
         Jump::to(to)

@@ -55,6 +55,8 @@ impl HybridModel for TwoRamps {
         Jump {
             mode,
             affects: Affects::Range { first: g, count: 1 },
+            event: None,
+            leaves: None,
         }
     }
 }

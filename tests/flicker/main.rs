@@ -18,6 +18,7 @@ mod convergence;
 mod engine_generic;
 mod error_bound;
 mod event_location;
+mod filippov;
 mod fuzz_regressions;
 mod golden;
 mod homogenized;

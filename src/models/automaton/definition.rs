@@ -12,9 +12,9 @@ use crate::scene::fields::{Fields, kind};
 
 /// Names an expression may not give a state or a parameter: the clock, the
 /// constant `pi` and the functions.
-const RESERVED: [&str; 20] = [
+const RESERVED: [&str; 21] = [
     "t", "pi", "sin", "cos", "tan", "asin", "acos", "atan", "atan2", "sinh", "cosh", "tanh", "exp",
-    "log", "sqrt", "abs", "min", "max", "pow", "hypot",
+    "log", "sqrt", "abs", "min", "max", "pow", "hypot", "sign",
 ];
 
 /// The most states, modes, or transitions of one mode a file may define.

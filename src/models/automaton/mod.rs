@@ -42,7 +42,8 @@
 //! - Expressions: numbers, names (states, parameters, `t` for time, `pi`),
 //!   `+ - * / ^`, unary minus (`-x^2` is `-(x^2)`), parentheses, and
 //!   `sin cos tan asin acos atan atan2 sinh cosh tanh exp log sqrt abs min
-//!   max pow hypot`. Time may appear anywhere (forced systems): the state
+//!   max pow hypot`; in a flow also `sign`, whose arguments are switching
+//!   surfaces run as Filippov defined them ([`filippov`]). Time may appear anywhere (forced systems): the state
 //!   then carries the clock `t` as its last component, which the engine
 //!   keeps equal to the run's time.
 //!
@@ -66,6 +67,7 @@ pub mod builder;
 pub mod definition;
 pub mod ensemble;
 pub mod expr;
+pub mod filippov;
 pub mod model;
 pub mod scene;
 pub mod sensitivities;

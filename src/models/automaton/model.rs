@@ -21,6 +21,7 @@ use crate::models::automaton::definition::{Definition, Source};
 use crate::models::automaton::expr::derivative::{jacobian, jacobian_into};
 use crate::models::automaton::expr::series::Series;
 use crate::models::automaton::expr::{Ast, Scope, Tape};
+use crate::models::automaton::filippov::{self, Target};
 use crate::scene::SceneError;
 
 /// A compiled automaton.
@@ -34,6 +35,14 @@ pub struct Automaton {
     energy: Option<Vec<Tape>>,
     initial: Vec<f64>,
     initial_mode: Mode,
+    /// The modes with switching surfaces (see [`filippov`]).
+    families: Vec<Surfaces>,
+    /// For each mode, the reason a run entering it stops with, where it
+    /// stands for an answer the model does not have.
+    stops: Vec<Option<String>>,
+    /// For each mode of the file, the modes it became (see
+    /// [`filippov::Expanded::origins`]).
+    origins: Vec<Vec<Mode>>,
 }
 
 #[derive(Debug, Clone)]
@@ -63,13 +72,73 @@ struct Reset {
     tape: Tape,
     targets: Vec<usize>,
     to: Mode,
+    /// How the mode after is picked: `to`, or by the signs of a family's
+    /// switching surfaces at the state after (see [`filippov`]).
+    pick: Target,
     terminal: bool,
+}
+
+/// A mode with switching surfaces, compiled (see [`filippov::Family`]).
+#[derive(Debug, Clone)]
+struct Surfaces {
+    /// Each surface `h`.
+    surfaces: Vec<Tape>,
+    /// The rate of each surface along each region's flow.
+    rates: Vec<Vec<Tape>>,
+    regions: Vec<Mode>,
+    sliding: Vec<Vec<Mode>>,
+    repelling: Vec<Mode>,
+    double: Mode,
+    /// What a slide onto each surface is called in the log.
+    slide_names: Vec<&'static str>,
+    /// The state each surface is, up to a constant, where it is one.
+    held: Vec<Option<usize>>,
+}
+
+impl Surfaces {
+    /// The mode of this family the state `x` lies in, with surface `on`
+    /// taken as reached (a crossing just located), and what the event that
+    /// brought it there is called if it slid: the region of the surfaces'
+    /// signs; on one surface, the side both flows carry it to, sliding
+    /// where both point into it, the refusal where both point away; on two
+    /// at once, the refusal.
+    fn pick(&self, x: &[f64], on: Option<usize>) -> (Mode, Option<&'static str>) {
+        let mut bits = 0;
+        let mut zero = None;
+        for (j, h) in self.surfaces.iter().enumerate() {
+            let value = if on == Some(j) { 0.0 } else { h.eval1(x) };
+            if value < 0.0 {
+                bits |= 1 << j;
+            } else if value == 0.0 {
+                if zero.is_some() {
+                    return (self.double, None);
+                }
+                zero = Some(j);
+            }
+        }
+        let Some(j) = zero else {
+            return (self.regions[bits], None);
+        };
+        let (plus, minus) = (bits & !(1 << j), bits | (1 << j));
+        // Into the surface: h falling on the positive side, rising on the
+        // negative (a tangent counts as in: the state stays on it).
+        let plus_in = self.rates[plus][j].eval1(x) <= 0.0;
+        let minus_in = self.rates[minus][j].eval1(x) >= 0.0;
+        match (plus_in, minus_in) {
+            (true, true) => (self.sliding[j][bits], Some(self.slide_names[j])),
+            (true, false) => (self.regions[minus], None),
+            (false, true) => (self.regions[plus], None),
+            (false, false) => (self.repelling[j], None),
+        }
+    }
 }
 
 impl Automaton {
     /// Compile `definition`; an expression naming what its scope does not
     /// know fails with its field, the character and the nearest name.
-    pub fn compile(definition: &Definition) -> Result<Automaton, SceneError> {
+    pub fn compile(file: &Definition) -> Result<Automaton, SceneError> {
+        let expanded = filippov::expand(file)?;
+        let definition = &expanded.definition;
         let clock = definition.reads_clock();
         let mut inputs = definition.states.clone();
         if clock {
@@ -102,7 +171,7 @@ impl Automaton {
             ast: Ast::Number(1.0),
         };
         let mut modes = Vec::new();
-        for mode in &definition.modes {
+        for (index, mode) in definition.modes.iter().enumerate() {
             let mut rates: Vec<&Source> = mode
                 .flow
                 .iter()
@@ -123,7 +192,7 @@ impl Automaton {
                     (t.guard.text.clone(), resets)
                 })
                 .collect();
-            for t in &mode.transitions {
+            for (t, &pick) in mode.transitions.iter().zip(&expanded.targets[index]) {
                 let tape = compile(&[&t.guard])?;
                 guards.push(Guard {
                     name: intern(&t.name),
@@ -145,6 +214,7 @@ impl Automaton {
                     },
                     targets: t.reset.iter().map(|(i, _)| *i).collect(),
                     to: t.to,
+                    pick,
                     terminal: t.terminal,
                 });
             }
@@ -187,13 +257,51 @@ impl Automaton {
         if clock {
             initial.push(0.0);
         }
+        let families = expanded
+            .families
+            .iter()
+            .map(|f| {
+                let one = |s: &Source| compile(&[s]);
+                Ok(Surfaces {
+                    surfaces: f
+                        .surfaces
+                        .iter()
+                        .map(one)
+                        .collect::<Result<_, SceneError>>()?,
+                    rates: f
+                        .rates
+                        .iter()
+                        .map(|r| r.iter().map(one).collect::<Result<Vec<_>, SceneError>>())
+                        .collect::<Result<_, SceneError>>()?,
+                    regions: f.regions.clone(),
+                    sliding: f.sliding.clone(),
+                    repelling: f.repelling.clone(),
+                    double: f.double,
+                    slide_names: f
+                        .surfaces
+                        .iter()
+                        .map(|h| intern(&filippov::event_name("slide", h)))
+                        .collect(),
+                    held: f.held.clone(),
+                })
+            })
+            .collect::<Result<Vec<_>, SceneError>>()?;
+        // The start: a mode with surfaces begins in the region (or on the
+        // surface) the initial state lies in.
+        let initial_mode = match expanded.start {
+            Target::Enter(f) => families[f].pick(&initial, None).0,
+            _ => definition.initial_mode,
+        };
         Ok(Automaton {
             states: inputs.iter().map(|s| intern(s)).collect(),
             clock,
             modes,
             energy,
             initial,
-            initial_mode: definition.initial_mode,
+            initial_mode,
+            families,
+            stops: expanded.stops,
+            origins: expanded.origins,
         })
     }
 
@@ -205,6 +313,12 @@ impl Automaton {
     /// The mode the file starts in.
     pub fn initial_mode(&self) -> Mode {
         self.initial_mode
+    }
+
+    /// The modes mode `file_mode` of the file became: itself, or the
+    /// regions and sliding modes of a flow that reads `sign()`.
+    pub fn modes_of(&self, file_mode: usize) -> &[Mode] {
+        &self.origins[file_mode]
     }
 
     /// Every mode.
@@ -337,7 +451,30 @@ impl HybridModel for Automaton {
         for (&i, v) in reset.targets.iter().zip(new) {
             x[i] = v;
         }
-        Jump::to(reset.to)
+        let (to, named) = match reset.pick {
+            Target::Fixed => (reset.to, None),
+            Target::Leave(guard) => return Jump::to(reset.to).leaving(guard),
+            Target::Enter(f) => self.families[f].pick(x, None),
+            Target::Across { family, surface } => {
+                let surfaces = &self.families[family];
+                let picked = surfaces.pick(x, Some(surface));
+                // Onto the surface exactly, where it is one state (the
+                // crossing was located a rounding off it): the sliding flow
+                // then holds it there.
+                if let (Some(_), Some(c)) = (picked.1, surfaces.held[surface]) {
+                    x[c] -= surfaces.surfaces[surface].eval1(x);
+                }
+                picked
+            }
+        };
+        match named {
+            Some(name) => Jump::to(to).named(name),
+            None => Jump::to(to),
+        }
+    }
+
+    fn stop_reason(&self, mode: Mode) -> Option<String> {
+        self.stops.get(mode).cloned().flatten()
     }
 
     fn terminal(&self, mode: Mode, guard: usize) -> bool {

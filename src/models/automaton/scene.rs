@@ -254,14 +254,23 @@ impl SceneModel for AutomatonScene {
             d.parameters.len(),
             self.t_end
         )];
-        for (i, mode) in d.modes.iter().enumerate() {
+        let traits_of = |m: crate::engine::Mode| {
             let mut traits = Vec::new();
-            if model.is_linear(i) {
+            if model.is_linear(m) {
                 traits.push("affine flow");
             }
-            if model.second_order(i) {
+            if model.second_order(m) {
                 traits.push("second order");
             }
+            traits
+        };
+        for (i, mode) in d.modes.iter().enumerate() {
+            let expanded = model.modes_of(i);
+            let traits = if expanded.len() == 1 {
+                traits_of(expanded[0])
+            } else {
+                Vec::new()
+            };
             let transitions: Vec<String> = mode
                 .transitions
                 .iter()
@@ -289,6 +298,24 @@ impl SceneModel for AutomatonScene {
                     transitions.join(", ")
                 }
             ));
+            // A flow that reads sign(): its regions and sliding modes.
+            if expanded.len() > 1 {
+                let parts: Vec<String> = expanded
+                    .iter()
+                    .map(|&m| {
+                        let traits = traits_of(m);
+                        if traits.is_empty() {
+                            model.mode_name(m).to_string()
+                        } else {
+                            format!("{} [{}]", model.mode_name(m), traits.join(", "))
+                        }
+                    })
+                    .collect();
+                lines.push(format!(
+                    "  switches its flow by sign(): as Filippov's regions and sliding modes {}",
+                    parts.join(", ")
+                ));
+            }
         }
         let (method, why) = self.resolved();
         lines.push(format!("method {}: {why}", method.name()));

@@ -110,6 +110,7 @@ fn slope(f: Fun, a: f64, fa: f64) -> f64 {
                 a.signum()
             }
         }
+        Fun::Sign => 0.0,
     }
 }
 

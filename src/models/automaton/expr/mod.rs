@@ -5,6 +5,7 @@
 pub mod derivative;
 pub mod parse;
 pub mod series;
+pub mod symbolic;
 pub mod tape;
 
 pub use parse::{Ast, ParseError, parse};

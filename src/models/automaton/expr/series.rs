@@ -248,6 +248,9 @@ impl Series {
                 let sign = if a0 < 0.0 { -1.0 } else { 1.0 };
                 sign * m[a + k]
             }
+            // Constant on each side of its switch (which a non-smooth tape
+            // never asks a series across).
+            Fun::Sign => 0.0,
         }
     }
 

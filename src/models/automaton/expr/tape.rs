@@ -46,6 +46,9 @@ pub enum Fun {
     Sqrt,
     /// `abs`
     Abs,
+    /// `sign`: -1, 0 or 1 (in a flow, a switching surface: see
+    /// `src/models/automaton/filippov.rs`)
+    Sign,
 }
 
 /// A function of two arguments.
@@ -61,7 +64,7 @@ pub enum Fun2 {
     Hypot,
 }
 
-const FUNS: [(&str, Fun); 13] = [
+const FUNS: [(&str, Fun); 14] = [
     ("sin", Fun::Sin),
     ("cos", Fun::Cos),
     ("tan", Fun::Tan),
@@ -75,6 +78,7 @@ const FUNS: [(&str, Fun); 13] = [
     ("log", Fun::Log),
     ("sqrt", Fun::Sqrt),
     ("abs", Fun::Abs),
+    ("sign", Fun::Sign),
 ];
 
 const FUNS2: [(&str, Fun2); 4] = [
@@ -101,6 +105,13 @@ impl Fun {
             Fun::Log => a.ln(),
             Fun::Sqrt => a.sqrt(),
             Fun::Abs => a.abs(),
+            Fun::Sign => {
+                if a == 0.0 || a.is_nan() {
+                    a
+                } else {
+                    a.signum()
+                }
+            }
         }
     }
 }
@@ -337,13 +348,13 @@ impl Tape {
         self.outputs.iter().all(|&r| degree[r as usize] <= 1)
     }
 
-    /// Whether every instruction is smooth: no `abs`, `min` or `max`, whose
-    /// branch a Taylor series cannot see switch.
+    /// Whether every instruction is smooth: no `abs`, `sign`, `min` or
+    /// `max`, whose branch a Taylor series cannot see switch.
     pub fn smooth(&self) -> bool {
         !self.ops.iter().any(|op| {
             matches!(
                 op,
-                Op::Call(Fun::Abs, _) | Op::Call2(Fun2::Min | Fun2::Max, _, _)
+                Op::Call(Fun::Abs | Fun::Sign, _) | Op::Call2(Fun2::Min | Fun2::Max, _, _)
             )
         })
     }
@@ -546,10 +557,16 @@ impl Builder<'_> {
 
 /// The known name closest to `name`, if any is close.
 fn nearest<'a>(name: &str, known: impl Iterator<Item = &'a str>) -> Option<&'a str> {
+    // Ties in edits go to the longer shared start (`sinn` is `sin`, not
+    // `sign`).
     known
         .map(|k| (strsim::damerau_levenshtein(name, k), k))
         .filter(|&(d, k)| d <= 2.max(k.len() / 3))
-        .min()
+        .min_by(|(d1, k1), (d2, k2)| {
+            d1.cmp(d2).then_with(|| {
+                strsim::jaro_winkler(name, k2).total_cmp(&strsim::jaro_winkler(name, k1))
+            })
+        })
         .map(|(_, k)| k)
 }
 

@@ -1,0 +1,285 @@
+//! Discontinuous flows (`sign()` in a flow) as Filippov defined them,
+//! against closed forms written here, to 1e-12 in time and state by the
+//! methods exact to round-off (the linear propagator where every region is
+//! affine, Taylor's method), and within their own stated bounds by the
+//! others:
+//!
+//! - dry friction on a spring, `x'' + x = -sign(x')` from `x = 12`, `x' =
+//!   6`: turning points at `atan(6/13) + k pi`, sticking at `atan(6/13) + 7
+//!   pi` with `x = 15 - sqrt(205)`, and resting there;
+//! - relay feedback `x'' + 2 zeta x' + x = -sign(x')`: each half swing about
+//!   `c = -sign(x')` takes `x` to `c - (x - c) q`, `q = exp(-zeta pi /
+//!   sqrt(1 - zeta^2))`, until a turning point falls within `[-1, 1]`;
+//! - a forced relay `x' = -sign(x) + A sin t`, `A = 2`: it slides on `x = 0`
+//!   from its first arrival and leaves where `A sin t` reaches 1;
+//!
+//! and what has no answer says so: a repelling surface, two surfaces at
+//! once, a surface that is not finite.
+
+use serde_json::{Value, json};
+
+use crate::automata::{automaton, f, run, run_value};
+
+/// Each method's arguments: the exact ones (to 1e-12), then the others
+/// (within their stated bounds).
+const EXACT: [&[&str]; 2] = [&[], &["--method", "taylor"]];
+const OTHERS: [&[&str]; 2] = [
+    &["--method", "dop853", "--rtol", "1e-13", "--atol", "1e-13"],
+    &["--method", "dopri5", "--rtol", "1e-12", "--atol", "1e-12"],
+];
+
+/// Events `(t, guard, mode after)` of a run against the closed form's,
+/// each time within `tolerance`.
+fn events_match(events: &[Value], want: &[(f64, &str, &str)], tolerance: f64, what: &str) {
+    let got: Vec<(f64, &str, &str)> = events
+        .iter()
+        .map(|e| {
+            (
+                f(&e["t"]),
+                e["guard"].as_str().unwrap(),
+                e["mode_after"].as_str().unwrap(),
+            )
+        })
+        .collect();
+    assert_eq!(got.len(), want.len(), "{what}: {got:?}");
+    for (g, w) in got.iter().zip(want) {
+        assert_eq!((g.1, g.2), (w.1, w.2), "{what}: {got:?}");
+        assert!(
+            (g.0 - w.0).abs() <= tolerance,
+            "{what}: {g:?} against {w:?}"
+        );
+    }
+}
+
+#[test]
+fn the_friction_oscillator_turns_and_sticks_where_its_closed_form_does() {
+    let first = (6.0f64 / 13.0).atan();
+    let pi = std::f64::consts::PI;
+    let mut want: Vec<(f64, &str, &str)> = (0..7)
+        .map(|k| {
+            let into = if k % 2 == 0 {
+                "block[v<0]"
+            } else {
+                "block[v>0]"
+            };
+            (first + k as f64 * pi, "cross:v", into)
+        })
+        .collect();
+    want.push((first + 7.0 * pi, "slide:v", "block[v=0]"));
+    let rest = 15.0 - 205f64.sqrt();
+    for args in EXACT.iter().chain(&OTHERS) {
+        let (summary, events) = run(&automaton("friction_oscillator.json"), args);
+        let what = format!("{args:?}");
+        let exact = EXACT.contains(args);
+        let (time, state) = if exact {
+            (1e-12, 1e-12)
+        } else {
+            (f(&summary["event_time_bound"]), f(&summary["error_bound"]))
+        };
+        assert_eq!(summary["status"], "completed", "{what}: {summary}");
+        events_match(&events, &want, time, &what);
+        // It rests there, exactly on the surface.
+        assert!(
+            (f(&summary["final_state"]["x"]) - rest).abs() <= state,
+            "{what}: {summary}"
+        );
+        assert_eq!(f(&summary["final_state"]["v"]), 0.0, "{what}");
+        assert_eq!(summary["final_mode"], "block[v=0]");
+        assert_eq!(summary["events_by_guard"]["slide:v"], 1);
+    }
+}
+
+#[test]
+fn relay_feedback_sticks_at_the_amplitude_its_half_swings_give() {
+    let zeta = 0.05f64;
+    let damped = (1.0 - zeta * zeta).sqrt();
+    let (q, half) = (
+        (-zeta * std::f64::consts::PI / damped).exp(),
+        std::f64::consts::PI / damped,
+    );
+    // Turning points from x = 5 at rest: about c = +1 going down, -1 up.
+    let (mut x, mut want, mut k) = (5.0f64, Vec::new(), 0);
+    while x.abs() > 1.0 {
+        let c = x.signum();
+        x = c - (x - c) * q;
+        k += 1;
+        let t = k as f64 * half;
+        if x.abs() > 1.0 {
+            let into = if x > 0.0 { "relay[v<0]" } else { "relay[v>0]" };
+            want.push((t, "cross:v", into));
+        } else {
+            want.push((t, "slide:v", "relay[v=0]"));
+        }
+    }
+    for args in EXACT.iter().chain(&OTHERS) {
+        let (summary, events) = run(&automaton("relay_feedback.json"), args);
+        let what = format!("{args:?}");
+        let (time, state) = if EXACT.contains(args) {
+            (1e-12, 1e-12)
+        } else {
+            (f(&summary["event_time_bound"]), f(&summary["error_bound"]))
+        };
+        assert_eq!(summary["status"], "completed", "{what}: {summary}");
+        events_match(&events, &want, time, &what);
+        assert!(
+            (f(&summary["final_state"]["x"]) - x).abs() <= state,
+            "{what}"
+        );
+        assert_eq!(f(&summary["final_state"]["v"]), 0.0, "{what}");
+    }
+}
+
+/// The forced relay's events by its closed form: in each region `x` is
+/// `x0 - s (t - t0) + A (cos t0 - cos t)`, its next zero found on a fine
+/// grid and bisected; on `x = 0` it slides while `|A sin t| < 1`, and
+/// leaves where `A sin t` reaches 1 (upwards) or -1 (downwards).
+fn forced_relay(a: f64, x0: f64, t_end: f64) -> (Vec<(f64, &'static str, &'static str)>, f64) {
+    let (mut t0, mut x, mut s) = (0.0f64, x0, x0.signum());
+    let mut want = Vec::new();
+    let zero_after = |t0: f64, x0: f64, s: f64| -> Option<f64> {
+        let g = |t: f64| x0 - s * (t - t0) + a * (t0.cos() - t.cos());
+        let grid = 1e-3;
+        let mut lo = t0;
+        while lo < t_end {
+            let hi = lo + grid;
+            if g(hi) * s <= 0.0 {
+                let (mut l, mut h) = (lo, hi);
+                for _ in 0..200 {
+                    let m = 0.5 * (l + h);
+                    if g(m) * s > 0.0 { l = m } else { h = m }
+                }
+                return Some(h);
+            }
+            lo = hi;
+        }
+        None
+    };
+    loop {
+        let Some(t) = zero_after(t0, x, s) else {
+            let xe = x - s * (t_end - t0) + a * (t0.cos() - t_end.cos());
+            return (want, xe);
+        };
+        if t > t_end {
+            let xe = x - s * (t_end - t0) + a * (t0.cos() - t_end.cos());
+            return (want, xe);
+        }
+        let forcing = a * t.sin();
+        if forcing.abs() < 1.0 {
+            want.push((t, "slide:x", "relay[x=0]"));
+            // Leaves where a sin t reaches +-1: the next such time.
+            let leave = (0..)
+                .map(|k| k as f64 * std::f64::consts::PI)
+                .flat_map(|base| {
+                    let r = (1.0 / a).asin();
+                    [base + r, base + std::f64::consts::PI - r]
+                })
+                .find(|&l| l > t)
+                .unwrap();
+            if leave > t_end {
+                return (want, 0.0);
+            }
+            let up = a * leave.sin() > 0.0;
+            want.push((
+                leave,
+                "leave:x",
+                if up { "relay[x>0]" } else { "relay[x<0]" },
+            ));
+            (t0, x, s) = (leave, 0.0, if up { 1.0 } else { -1.0 });
+        } else {
+            s = -s;
+            want.push((
+                t,
+                "cross:x",
+                if s > 0.0 { "relay[x>0]" } else { "relay[x<0]" },
+            ));
+            (t0, x) = (t, 0.0);
+        }
+    }
+}
+
+#[test]
+fn a_forced_relay_slides_and_leaves_where_its_forcing_reaches_the_relay() {
+    let (want, xe) = forced_relay(2.0, 0.1, 20.0);
+    assert_eq!(want[0].1, "slide:x");
+    assert!((want[1].0 - std::f64::consts::FRAC_PI_6).abs() < 1e-15);
+    for args in [&["--method", "taylor"][..]].iter().chain(&OTHERS) {
+        let (summary, events) = run(&automaton("forced_relay.json"), args);
+        let what = format!("{args:?}");
+        let (time, state) = if args.len() == 2 {
+            (1e-12, 1e-12)
+        } else {
+            (f(&summary["event_time_bound"]), f(&summary["error_bound"]))
+        };
+        assert_eq!(summary["status"], "completed", "{what}: {summary}");
+        events_match(&events, &want, time, &what);
+        assert!(
+            (f(&summary["final_state"]["x"]) - xe).abs() <= state.max(1e-12),
+            "{what}"
+        );
+    }
+}
+
+#[test]
+fn what_has_no_unique_answer_stops_and_says_why() {
+    // Both sides flow away from x = 0, where it starts.
+    let repelling = json!({"model": "automaton", "states": ["x"], "initial": {"x": 0.0},
+        "modes": {"m": {"flow": {"x": "sign(x)"}}}, "t_end": 1.0});
+    // Reached by a reset onto it.
+    let landed = json!({"model": "automaton", "states": ["x"], "initial": {"x": 1.0},
+        "initial_mode": "fall",
+        "modes": {
+            "fall": {"flow": {"x": "-1"},
+                     "transitions": [{"name": "land", "guard": "x - 0.5", "direction": "falling",
+                                      "reset": {"x": "0"}, "to": "away"}]},
+            "away": {"flow": {"x": "sign(x)"}}},
+        "t_end": 2.0});
+    // Sliding on x = 0 when y reaches 0.
+    let corner = json!({"model": "automaton", "states": ["x", "y"], "initial": {"x": 0.5, "y": 1.0},
+        "modes": {"m": {"flow": {"x": "-sign(x)", "y": "-1 + 0 * sign(y)"}}}, "t_end": 2.0});
+    // A surface that is not finite where the run goes.
+    let undefined = json!({"model": "automaton", "states": ["x"], "initial": {"x": 2.0},
+        "modes": {"m": {"flow": {"x": "-1 - sign(sqrt(x - 1))"}}}, "t_end": 2.0});
+    for (scene, want) in [
+        (&repelling, "point away"),
+        (&landed, "point away"),
+        (&corner, "two surfaces"),
+        (&undefined, "not finite"),
+    ] {
+        for args in [&[][..], &["--method", "taylor"], &["--method", "dop853"]] {
+            let (summary, _) = run_value(scene, args);
+            let reason = summary["reason"].as_str().unwrap_or("");
+            assert_eq!(summary["status"], "failed", "{want} {args:?}: {summary}");
+            // A surface undefined where the run goes stops where a method
+            // first meets it: a value that is not finite, or a step that
+            // collapses where it turns steep.
+            let undefined =
+                want == "not finite" && (reason.contains("NaN") || reason.contains("steep"));
+            assert!(
+                reason.contains(want) || undefined,
+                "{want} {args:?}: {reason}"
+            );
+        }
+    }
+}
+
+#[test]
+fn sign_belongs_in_flows_and_takes_one_argument() {
+    let with = |flow: &str, guard: &str| {
+        json!({"model": "automaton", "states": ["x"], "initial": {"x": 1.0},
+               "modes": {"m": {"flow": {"x": flow},
+                               "transitions": [{"name": "g", "guard": guard}]}}, "t_end": 1.0})
+    };
+    for (scene, field, want) in [
+        (with("-1", "sign(x)"), "transitions", "in a guard"),
+        (with("-sign(x, 1)", "x"), "flow.x", "1 argument"),
+        (with("-sign(sign(x))", "x"), "flow.x", "inside the argument"),
+    ] {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("bad.json");
+        std::fs::write(&path, scene.to_string()).unwrap();
+        let out = crate::support::flicker(&["check", path.to_str().unwrap()]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{err}");
+        assert!(err.contains(field) && err.contains(want), "{field}: {err}");
+    }
+}
