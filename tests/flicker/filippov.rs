@@ -283,3 +283,28 @@ fn sign_belongs_in_flows_and_takes_one_argument() {
         assert!(err.contains(field) && err.contains(want), "{field}: {err}");
     }
 }
+
+/// Derivatives through crossings and the slide (the saltation matrix of
+/// each, the general one: entering a sliding is a reset-free change of
+/// flow) against the closed form: the block sticks at `x = 15 - A`, `A =
+/// sqrt((x0 + 1)^2 + v0^2)`, at `t = atan(v0 / (x0 + 1)) + 7 pi`.
+#[test]
+fn sensitivities_through_the_slide_meet_the_closed_form() {
+    let (summary, _) = run(
+        &automaton("friction_oscillator.json"),
+        &["--sensitivities", "initial.x,initial.v"],
+    );
+    assert_eq!(summary["status"], "completed", "{summary}");
+    let (x0, v0) = (12.0f64, 6.0f64);
+    let a2 = (x0 + 1.0).powi(2) + v0 * v0;
+    let a = a2.sqrt();
+    let s = &summary["sensitivities"];
+    for (name, dx, dt) in [
+        ("initial.x", -(x0 + 1.0) / a, -v0 / a2),
+        ("initial.v", -v0 / a, (x0 + 1.0) / a2),
+    ] {
+        assert!((f(&s[name]["final_state"]["x"]) - dx).abs() < 1e-12, "{name}: {s}");
+        assert_eq!(f(&s[name]["final_state"]["v"]), 0.0, "{name}: {s}");
+        assert!((f(&s[name]["last_event_time"]) - dt).abs() < 1e-12, "{name}: {s}");
+    }
+}
