@@ -1,6 +1,8 @@
 //! Filtering and summarising an event log: counts per guard, first and last
-//! times, intervals between events, and the largest energy jump across a
-//! reset (where a perfectly elastic model should show round-off only).
+//! times, intervals between events, the largest energy jump across a reset
+//! (where a perfectly elastic model should show round-off only), and the
+//! time spent sliding on each switching surface of a discontinuous flow
+//! (its `slide:h` and `leave:h` events).
 
 use std::collections::BTreeMap;
 
@@ -79,6 +81,19 @@ pub struct EnergyJump {
     pub guard: String,
 }
 
+/// Sliding on one switching surface: from each `slide:h` to the `leave:h`
+/// after it.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct SlidingSummary {
+    /// Sliding intervals begun.
+    pub intervals: u64,
+    /// Time spent sliding in the intervals that ended.
+    pub time: f64,
+    /// When the interval still open at the last event began: the run went
+    /// on sliding past it.
+    pub since: Option<f64>,
+}
+
 /// A summary of the events a filter kept.
 #[derive(Debug, Clone, Default, Serialize)]
 pub struct Summary {
@@ -100,6 +115,10 @@ pub struct Summary {
     pub largest_energy_jump: Option<EnergyJump>,
     /// Events whose time is earlier than the one before (should be none).
     pub out_of_order: u64,
+    /// Sliding, by switching surface (the `h` of its events' names); absent
+    /// where nothing slid.
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    pub sliding: BTreeMap<String, SlidingSummary>,
 }
 
 impl Summary {
@@ -125,6 +144,16 @@ impl Summary {
         guard.count += 1;
         guard.first_t.get_or_insert(e.t);
         guard.last_t = Some(e.t);
+        if let Some(surface) = e.guard.strip_prefix("slide:") {
+            let sliding = self.sliding.entry(surface.to_string()).or_default();
+            sliding.intervals += 1;
+            sliding.since = Some(e.t);
+        } else if let Some(surface) = e.guard.strip_prefix("leave:") {
+            let sliding = self.sliding.entry(surface.to_string()).or_default();
+            if let Some(since) = sliding.since.take() {
+                sliding.time += e.t - since;
+            }
+        }
         if let (Some(before), Some(after)) = (e.energy_before, e.energy_after) {
             let jump = (after - before).abs();
             if self
@@ -192,6 +221,24 @@ mod tests {
         assert_eq!((jump.seq, jump.guard.as_str()), (2, "b"));
         assert_eq!(s.out_of_order, 0);
         assert_eq!(s.interval_histogram["1e0"], 2);
+    }
+
+    #[test]
+    fn sliding_time_adds_up_from_slide_to_leave() {
+        let mut s = Summary::default();
+        for (t, guard) in [
+            (1.0, "cross:v"),
+            (2.0, "slide:v"),
+            (2.5, "leave:v"),
+            (3.0, "slide:v"),
+            (4.25, "leave:v"),
+            (5.0, "slide:v"),
+        ] {
+            s.add(&event(0, t, guard, 0.0));
+        }
+        let v = &s.sliding["v"];
+        assert_eq!((v.intervals, v.time, v.since), (3, 1.75, Some(5.0)));
+        assert_eq!(s.sliding.len(), 1);
     }
 
     #[test]

@@ -303,8 +303,36 @@ fn sensitivities_through_the_slide_meet_the_closed_form() {
         ("initial.x", -(x0 + 1.0) / a, -v0 / a2),
         ("initial.v", -v0 / a, (x0 + 1.0) / a2),
     ] {
-        assert!((f(&s[name]["final_state"]["x"]) - dx).abs() < 1e-12, "{name}: {s}");
+        assert!(
+            (f(&s[name]["final_state"]["x"]) - dx).abs() < 1e-12,
+            "{name}: {s}"
+        );
         assert_eq!(f(&s[name]["final_state"]["v"]), 0.0, "{name}: {s}");
-        assert!((f(&s[name]["last_event_time"]) - dt).abs() < 1e-12, "{name}: {s}");
+        assert!(
+            (f(&s[name]["last_event_time"]) - dt).abs() < 1e-12,
+            "{name}: {s}"
+        );
     }
+}
+
+/// `events --summary` reports the time spent sliding on each surface: the
+/// forced relay's one interval, from its arrival to pi / 6.
+#[test]
+fn the_event_summary_reports_the_time_spent_sliding() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().to_str().unwrap();
+    let scene = automaton("forced_relay.json");
+    let done = crate::support::flicker(&["run", &scene, "--out", out, "--quiet"]);
+    assert!(done.status.success());
+    let log = dir.path().join("events.jsonl");
+    let summary = crate::support::flicker(&["events", log.to_str().unwrap(), "--summary"]);
+    let summary: Value = serde_json::from_slice(&summary.stdout).unwrap();
+    let (want, _) = forced_relay(2.0, 0.1, 20.0);
+    let sliding = &summary["sliding"]["x"];
+    assert_eq!(sliding["intervals"], 1, "{summary}");
+    assert!(
+        (f(&sliding["time"]) - (want[1].0 - want[0].0)).abs() < 1e-12,
+        "{summary}"
+    );
+    assert!(sliding["since"].is_null());
 }
