@@ -178,8 +178,10 @@ fn power_derivative(a: &Ast, b: &Ast, da: Ast, db: Ast) -> Ast {
     mul(pow(a.clone(), b.clone()), inner)
 }
 
-/// `ast` with every `sign(h)` replaced by the number `value(h)` gives
-/// (`None` leaves it).
+/// `ast` with every `sign(h)` replaced by the number `value(h)` gives, and
+/// every `abs(h)` of the same `h` by `value(h) h` (`None` leaves them): a
+/// region's flow, smooth in the region (`abs(v - vb)` of a friction law
+/// whose surface is `v - vb` is then no switch of its own).
 pub fn fix_signs(ast: &Ast, value: &dyn Fn(&Ast) -> Option<f64>) -> Ast {
     let fix = |a: &Ast| fix_signs(a, value);
     match ast {
@@ -188,6 +190,10 @@ pub fn fix_signs(ast: &Ast, value: &dyn Fn(&Ast) -> Option<f64>) -> Ast {
         Ast::Binary(op, a, b) => Ast::Binary(*op, Box::new(fix(a)), Box::new(fix(b))),
         Ast::Call(name, args, at) if name == "sign" && args.len() == 1 => match value(&args[0]) {
             Some(v) => Ast::Number(v),
+            None => Ast::Call(name.clone(), vec![fix(&args[0])], *at),
+        },
+        Ast::Call(name, args, at) if name == "abs" && args.len() == 1 => match value(&args[0]) {
+            Some(v) => mul(Ast::Number(v), fix(&args[0])),
             None => Ast::Call(name.clone(), vec![fix(&args[0])], *at),
         },
         Ast::Call(name, args, at) => Ast::Call(name.clone(), args.iter().map(fix).collect(), *at),
@@ -322,13 +328,13 @@ mod tests {
 
     #[test]
     fn signs_are_found_once_and_fixed() {
-        let ast = parse("-x - 0.1 * sign(v) + sign( v ) * sign(x - 1)").unwrap();
+        let ast = parse("-x - 0.1 * sign(v) + sign( v ) * sign(x - 1) + abs(x - 1)").unwrap();
         let mut found = Vec::new();
         sign_arguments(&ast, &mut found);
         let texts: Vec<String> = found.iter().map(|(h, _)| text(h)).collect();
         assert_eq!(texts, ["v", "x - 1"]);
         let fixed = fix_signs(&ast, &|h| Some(if text(h) == "v" { 1.0 } else { -1.0 }));
-        assert_eq!(text(&fixed), "-x - 0.1 * 1 + 1 * -1");
+        assert_eq!(text(&fixed), "-x - 0.1 * 1 + 1 * -1 + -1 * (x - 1)");
     }
 
     #[test]
