@@ -22,15 +22,15 @@ use crate::automata::{automaton, f, run, run_value};
 
 /// Each method's arguments: the exact ones (to 1e-12), then the others
 /// (within their stated bounds).
-const EXACT: [&[&str]; 2] = [&[], &["--method", "taylor"]];
-const OTHERS: [&[&str]; 2] = [
+pub const EXACT: [&[&str]; 2] = [&[], &["--method", "taylor"]];
+pub const OTHERS: [&[&str]; 2] = [
     &["--method", "dop853", "--rtol", "1e-13", "--atol", "1e-13"],
     &["--method", "dopri5", "--rtol", "1e-12", "--atol", "1e-12"],
 ];
 
 /// Events `(t, guard, mode after)` of a run against the closed form's,
 /// each time within `tolerance`.
-fn events_match(events: &[Value], want: &[(f64, &str, &str)], tolerance: f64, what: &str) {
+pub fn events_match(events: &[Value], want: &[(f64, &str, &str)], tolerance: f64, what: &str) {
     let got: Vec<(f64, &str, &str)> = events
         .iter()
         .map(|e| {

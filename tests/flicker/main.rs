@@ -34,6 +34,7 @@ mod reproducible;
 mod scenes;
 mod schemas;
 mod sensitivities;
+mod stick_slip;
 mod stress;
 mod support;
 mod sweep;
