@@ -233,7 +233,16 @@ pub fn shoot(section: &Section, unknowns: &Unknowns, mode: Mode, x: Vec<f64>) ->
         };
         singular |= rank_deficient;
         for (k, &i) in unknowns.free.iter().enumerate() {
-            x[i] += step[k];
+            // A component the section pins (its row of `DP` is zero: a
+            // sliding surface's state at a `leave`, the other state where
+            // a side turns tangent) takes Newton's step for that row
+            // exactly, `x_i = P(x)_i`: the least squares' rounding would
+            // start the next return off the surface.
+            if (0..back.jacobian.ncols()).all(|j| back.jacobian[(i, j)] == 0.0) {
+                x[i] = back.state[i];
+            } else {
+                x[i] += step[k];
+            }
         }
         unknowns.fold_clock(&mut x);
         if !x.iter().all(|v| v.is_finite()) {

@@ -4,10 +4,14 @@
 //! orbit: its phase, speed and the eigenvalues of the exact impact map),
 //! and the forced impact oscillator (its period-one impacting orbit from
 //! the linear oscillator's closed form, and its stability from the flow's
-//! fundamental matrix and the impact's saltation matrix).
+//! fundamental matrix and the impact's saltation matrix), and the sliding
+//! orbit of Piiroinen and Kuznetsov's relay feedback system (a fixed point
+//! of its piecewise closed form: matrix exponentials between the surface's
+//! events, the sliding flow's on it).
 
 use std::f64::consts::PI;
 
+use nalgebra::{DMatrix, DVector};
 use serde_json::{Value, json};
 
 use crate::automata::{automaton, forced_oscillator};
@@ -290,4 +294,113 @@ fn a_search_that_cannot_succeed_says_why() {
     ]);
     assert_eq!(unforced.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&unforced.stderr).contains("forcing"));
+}
+
+/// The relay feedback system `x' = A x - b sign(x1)`
+/// (`models/automata/relay_feedback_3d.json`) by its closed form: off the
+/// surface `x(t) = exp(M t) (x, 1)` with `M = [[A, -s b], [0, 0]]` on side
+/// `s`; on it (`x1 = 0`, the equivalent control `u = x2`) `x2' = 2 sigma x2
+/// + x3`, `x3' = -x2`, until `|x2|` reaches 1 and the run leaves to the
+/// side of `x2`. Events are found on a 1e-3 grid and bisected.
+struct Relay {
+    region: [DMatrix<f64>; 2],
+    sliding: DMatrix<f64>,
+}
+
+impl Relay {
+    fn new(p: &Value) -> Self {
+        let (w, xi, l, sigma) = (f(&p["w"]), f(&p["xi"]), f(&p["l"]), f(&p["sigma"]));
+        let side = |s: f64| {
+            let rows = [
+                [-(2.0 * xi * w + l), 1.0, 0.0, -s],
+                [-(2.0 * xi * w * l + w * w), 0.0, 1.0, 2.0 * sigma * s],
+                [-l * w * w, 0.0, 0.0, -s],
+                [0.0; 4],
+            ];
+            DMatrix::from_fn(4, 4, |i, j| rows[i][j])
+        };
+        Relay {
+            region: [side(1.0), side(-1.0)],
+            sliding: DMatrix::from_row_slice(2, 2, &[2.0 * sigma, 1.0, -1.0, 0.0]),
+        }
+    }
+
+    /// The first time `g` falls from positive to zero or below.
+    fn first(g: &dyn Fn(f64) -> f64) -> f64 {
+        let mut lo = 1e-3;
+        while g(lo + 1e-3) > 0.0 {
+            lo += 1e-3;
+            assert!(lo < 100.0, "no event");
+        }
+        let mut hi = lo + 1e-3;
+        for _ in 0..100 {
+            let m = 0.5 * (lo + hi);
+            if g(m) > 0.0 { lo = m } else { hi = m }
+        }
+        hi
+    }
+
+    /// From `(0, x2, x3)` just after a leave to side `s`, the state just
+    /// after the `k`-th next leave, its side and the time taken.
+    fn leaves(&self, mut s: f64, x3: f64, k: usize) -> (f64, f64, f64) {
+        let (mut x, mut t) = (DVector::from_vec(vec![0.0, s, x3, 1.0]), 0.0);
+        for _ in 0..k {
+            let m = &self.region[if s > 0.0 { 0 } else { 1 }];
+            let at = |tau: f64| (m * tau).exp() * &x;
+            let tau = Self::first(&|tau| s * at(tau)[0]);
+            x = at(tau);
+            assert!(x[1].abs() < 1.0, "it crosses, not slides: {x}");
+            t += tau;
+            let on = DVector::from_vec(vec![x[1], x[2]]);
+            let along = |tau: f64| (&self.sliding * tau).exp() * &on;
+            let tau = Self::first(&|tau| 1.0 - along(tau)[0].abs());
+            let y = along(tau);
+            s = y[0].signum();
+            x = DVector::from_vec(vec![0.0, s, y[1], 1.0]);
+            t += tau;
+        }
+        (x[2], s, t)
+    }
+}
+
+/// Piiroinen and Kuznetsov's relay feedback system slides on `x1 = 0`
+/// seven times each half period; the orbit `flicker orbit` finds is a
+/// fixed point of the closed-form map to 1e-12 (the matrix exponentials'
+/// rounding, 1e-15 a phase, over 28 phases), with its period, and its one nontrivial
+/// multiplier is the map's derivative (by central differences, to 1e-6).
+#[test]
+fn the_relay_feedback_systems_sliding_orbit_is_its_closed_forms_fixed_point() {
+    let scene = read("relay_feedback_3d.json");
+    let (code, o) = orbit(
+        &scene,
+        &["--section", "leave:x1", "--events", "14", "--settle", "20"],
+    );
+    assert_eq!(code, Some(0), "{o}");
+    assert_eq!(o["converged"], true, "{o}");
+    let at = &o["section_state"];
+    assert_eq!(f(&at["x1"]), 0.0, "{o}");
+    let side = f(&at["x2"]);
+    assert_eq!(side.abs(), 1.0, "{o}");
+    let relay = Relay::new(&scene["parameters"]);
+    let x3 = f(&at["x3"]);
+    let (back, back_side, period) = relay.leaves(side, x3, 14);
+    assert_eq!(back_side, side);
+    assert!((back - x3).abs() <= 1e-12, "{back} against {x3}");
+    assert!(
+        (period - f(&o["period"])).abs() <= 1e-12,
+        "{period} against {o}"
+    );
+    // Half a period on, the orbit's mirror image: the relay is odd.
+    let (half, half_side, half_period) = relay.leaves(side, x3, 7);
+    assert_eq!(half_side, -side);
+    assert!((half + x3).abs() <= 1e-12 && (2.0 * half_period - period).abs() <= 1e-12);
+    let d = 1e-5;
+    let slope = (relay.leaves(side, x3 + d, 14).0 - relay.leaves(side, x3 - d, 14).0) / (2.0 * d);
+    let found = nontrivial(&o);
+    let largest = found.iter().map(|z| z.0.hypot(z.1)).fold(0.0, f64::max);
+    assert!(
+        (largest - slope.abs()).abs() <= 1e-6,
+        "{found:?} against {slope}"
+    );
+    assert_eq!(o["stable"], true);
 }

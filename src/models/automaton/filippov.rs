@@ -34,7 +34,7 @@ use crate::engine::Direction;
 use crate::models::automaton::definition::{Definition, ModeDef, Source, Transition};
 use crate::models::automaton::expr::Ast;
 use crate::models::automaton::expr::symbolic::{
-    add, derivative, div, fix_signs, mul, same, sign_arguments, sub, text,
+    add, constant, derivative, div, fix_signs, mul, same, sign_arguments, sub, text,
 };
 use crate::scene::SceneError;
 
@@ -137,6 +137,9 @@ pub fn expand(definition: &Definition) -> Result<Expanded, SceneError> {
         };
     }
     let varies = |name: &str| definition.states.iter().any(|s| s == name) || name == "t";
+    let variables: Vec<&str> = (definition.states.iter().map(String::as_str))
+        .chain(["t"])
+        .collect();
     let mut modes = Vec::new();
     let mut targets = Vec::new();
     let mut stops = Vec::new();
@@ -337,7 +340,13 @@ pub fn expand(definition: &Definition) -> Result<Expanded, SceneError> {
                 let (f_plus, f_minus) = (flow_of(plus), flow_of(minus));
                 let (l_plus, l_minus) = (&rates[plus][j].ast, &rates[minus][j].ast);
                 // a = L- / (L- - L+), f_s = f- + a (f+ - f-).
-                let a = div(l_minus.clone(), sub(l_minus.clone(), l_plus.clone()));
+                // Where the sides' flows differ by a constant (a relay), the
+                // quotient is by a constant and the jump it scales is one:
+                // an affine region's sliding flow stays affine, for the
+                // exact propagator.
+                let gap = sub(l_minus.clone(), l_plus.clone());
+                let gap = constant(&gap, &variables).unwrap_or(gap);
+                let a = div(l_minus.clone(), gap);
                 let held = held_state(&found[j].0, &definition.states, &varies);
                 let flow: Vec<Option<Source>> = f_plus
                     .iter()
@@ -347,7 +356,9 @@ pub fn expand(definition: &Definition) -> Result<Expanded, SceneError> {
                         let rate = if Some(i) == held {
                             Ast::Number(0.0)
                         } else {
-                            add(m.clone(), mul(a.clone(), sub(p.clone(), m.clone())))
+                            let jump = sub(p.clone(), m.clone());
+                            let jump = constant(&jump, &variables).unwrap_or(jump);
+                            add(m.clone(), mul(a.clone(), jump))
                         };
                         Some(source(rate, "sliding flow"))
                     })

@@ -178,6 +178,49 @@ fn power_derivative(a: &Ast, b: &Ast, da: Ast, db: Ast) -> Ast {
     mul(pow(a.clone(), b.clone()), inner)
 }
 
+/// `ast` as an expression of the constants alone, where it is a polynomial
+/// whose variables cancel (`(x2 + 1) - (x2 - 1)`: the denominator of a
+/// sliding flow whose sides differ by a constant): its variables set to
+/// zero, which a polynomial that does not depend on them allows. `None`
+/// where a variable remains, or sits under a quotient or a function, whose
+/// value at zero need not be the expression's.
+pub fn constant(ast: &Ast, variables: &[&str]) -> Option<Ast> {
+    let varies = |name: &str| variables.contains(&name);
+    fn reads(ast: &Ast, varies: &dyn Fn(&str) -> bool) -> bool {
+        match ast {
+            Ast::Number(_) => false,
+            Ast::Name(name, _) => varies(name),
+            Ast::Neg(a) => reads(a, varies),
+            Ast::Binary(_, a, b) => reads(a, varies) || reads(b, varies),
+            Ast::Call(_, args, _) => args.iter().any(|a| reads(a, varies)),
+        }
+    }
+    fn at_zero(ast: &Ast, varies: &dyn Fn(&str) -> bool) -> Option<Ast> {
+        if !reads(ast, varies) {
+            return Some(ast.clone());
+        }
+        if let Ast::Binary(Binary::Sub, a, b) = ast
+            && same(a, b)
+        {
+            return Some(Ast::Number(0.0));
+        }
+        Some(match ast {
+            Ast::Name(..) => Ast::Number(0.0),
+            Ast::Neg(a) => neg(at_zero(a, varies)?),
+            Ast::Binary(Binary::Add, a, b) => add(at_zero(a, varies)?, at_zero(b, varies)?),
+            Ast::Binary(Binary::Sub, a, b) => sub(at_zero(a, varies)?, at_zero(b, varies)?),
+            Ast::Binary(Binary::Mul, a, b) => mul(at_zero(a, varies)?, at_zero(b, varies)?),
+            _ => return None,
+        })
+    }
+    for v in variables {
+        if !matches!(derivative(ast, v, &varies).ok()?, Ast::Number(z) if z == 0.0) {
+            return None;
+        }
+    }
+    at_zero(ast, &varies)
+}
+
 /// `ast` with every `sign(h)` replaced by the number `value(h)` gives, and
 /// every `abs(h)` of the same `h` by `value(h) h` (`None` leaves them): a
 /// region's flow, smooth in the region (`abs(v - vb)` of a friction law
@@ -292,6 +335,21 @@ mod tests {
         };
         let tape = crate::models::automaton::expr::Tape::compile(&[ast], &scope).unwrap();
         tape.eval1(&[x])
+    }
+
+    #[test]
+    fn a_polynomial_whose_variables_cancel_is_a_constant() {
+        let constant_of = |text: &str| constant(&parse(text).unwrap(), &["x", "t"]);
+        let two = constant_of("(c * x + 1 + t) - (c * x - 1 + t)").unwrap();
+        assert_eq!(eval(&two, 0.37), 2.0);
+        let scaled = constant_of("-(c * 2) * (x - x + 3)").unwrap();
+        assert_eq!(eval(&scaled, 5.0), -0.7 * 2.0 * 3.0);
+        // A variable that remains, or one under a quotient (x / x is 1, not
+        // its value at zero), is not taken.
+        assert!(constant_of("(x + 1) - (x - t)").is_none());
+        assert!(constant_of("x / x").is_none());
+        assert!(constant_of("sin(x) - sin(x) + 1").is_some());
+        assert!(constant_of("sin(x) + 1 - sin(x)").is_none());
     }
 
     #[test]
