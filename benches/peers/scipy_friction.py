@@ -74,7 +74,7 @@ def scipy_run(eps, method, repeat, rtol, atol):
         return [y[1], -y[0] - math.tanh(y[1] / eps)]
 
     def jac(_t, y):
-        return [[0.0, 1.0], [-1.0, -1.0 / (eps * math.cosh(y[1] / eps) ** 2)]]
+        return [[0.0, 1.0], [-1.0, -(1.0 - math.tanh(y[1] / eps) ** 2) / eps]]
 
     times = []
     for _ in range(repeat):

@@ -31,6 +31,7 @@ mod phase;
 mod random_impacts;
 mod registry;
 mod reproducible;
+mod saturated;
 mod scenes;
 mod schemas;
 mod sensitivities;
