@@ -1,8 +1,10 @@
 //! Any two states of a run against each other (`flicker plot phase SCENE
 //! --x A --y B`): the flow between events as lines through the state
 //! sampled along the way, each reset as a dashed jump from the state before
-//! it to the state after. A run with more than [`MAX_JUMPS`] events is
-//! drawn as dots at the samples, without its jumps.
+//! it to the state after, and the stretches a discontinuous flow slides
+//! along a switching surface (from its `slide:h` event to its `leave:h`)
+//! in red. A run with more than [`MAX_JUMPS`] events is drawn as dots at
+//! the samples, without its jumps.
 
 use crate::engine::Recorder;
 use crate::plot::draw::{Curve, Figure, Style};
@@ -58,10 +60,17 @@ pub fn state_plane(
     let mut curves = Vec::new();
     let title;
     if events.events.len() <= MAX_JUMPS {
-        title = format!("{y} against {x} (dashed: resets)");
+        let slides = events.events.iter().any(|e| sliding_after(e.guard));
+        title = if slides {
+            format!("{y} against {x} (dashed: resets; red: sliding)")
+        } else {
+            format!("{y} against {x} (dashed: resets)")
+        };
         let mut flight = Vec::new();
+        let mut sliding = false;
         let mut pending = events.events.iter().peekable();
         let jump = |flight: &mut Vec<(f64, f64)>,
+                    sliding: &mut bool,
                     curves: &mut Vec<Curve>,
                     e: &crate::engine::RecordedEvent| {
             // An event-local model's events carry no states.
@@ -72,29 +81,33 @@ pub fn state_plane(
             curves.push(Curve {
                 label: None,
                 points: std::mem::take(flight),
-                style: Style::Line(0),
+                style: flight_style(*sliding),
             });
-            curves.push(Curve {
-                label: None,
-                points: vec![point(&e.before), point(&e.after)],
-                style: Style::Jump,
-            });
+            // A switching surface's events move nothing: no jump to draw.
+            if point(&e.before) != point(&e.after) {
+                curves.push(Curve {
+                    label: None,
+                    points: vec![point(&e.before), point(&e.after)],
+                    style: Style::Jump,
+                });
+            }
+            *sliding = sliding_after(e.guard);
             flight.push(point(&e.after));
         };
         for (t, state) in &trajectory.samples {
             // A sample at an event's time holds the state before it.
             while let Some(e) = pending.next_if(|e| e.t < *t) {
-                jump(&mut flight, &mut curves, e);
+                jump(&mut flight, &mut sliding, &mut curves, e);
             }
             flight.push(point(state));
         }
         for e in pending {
-            jump(&mut flight, &mut curves, e);
+            jump(&mut flight, &mut sliding, &mut curves, e);
         }
         curves.push(Curve {
             label: None,
             points: flight,
-            style: Style::Line(0),
+            style: flight_style(sliding),
         });
     } else {
         title = format!(
@@ -116,4 +129,16 @@ pub fn state_plane(
         y_limit: None,
     };
     Ok((figure, trajectory.report))
+}
+
+/// Whether the run slides after an event of `guard`: a discontinuous
+/// flow's `slide:h` starts a slide, and any other event ends it (its
+/// `leave:h`, or a reset, which picks the region afresh).
+fn sliding_after(guard: &str) -> bool {
+    guard.starts_with("slide:")
+}
+
+/// How a stretch of flow between events is drawn.
+fn flight_style(sliding: bool) -> Style {
+    Style::Line(if sliding { 1 } else { 0 })
 }

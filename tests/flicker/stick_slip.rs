@@ -16,6 +16,7 @@ use serde_json::Value;
 
 use crate::automata::{automaton, f, run, run_value};
 use crate::filippov::{EXACT, OTHERS, events_match};
+use crate::support::{SvgChart, flicker};
 
 const STICK: &str = "block[v - vb=0]";
 const BELOW: &str = "block[v - vb<0]";
@@ -218,5 +219,61 @@ fn with_friction_falling_linearly_every_event_is_its_closed_form() {
             (f(&end["v"]) - ve).abs() <= state,
             "{what}: {end} against {ve}"
         );
+    }
+}
+
+/// `flicker plot phase` draws each stick in red: a segment along `v = vb`
+/// from where the belt caught the block to `x = ms` (or to where the run
+/// ends, stuck), one per slide.
+#[test]
+fn the_phase_plane_draws_each_stick_along_the_belt() {
+    let dir = tempfile::tempdir().unwrap();
+    let picture = dir.path().join("belt.svg");
+    let scene = automaton("stick_slip_belt.json");
+    let out = flicker(&[
+        "plot",
+        "phase",
+        &scene,
+        "--x",
+        "x",
+        "--y",
+        "v",
+        "--out",
+        picture.to_str().unwrap(),
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let (summary, events) = run(&scene, &[]);
+    let slides: Vec<&Value> = events
+        .iter()
+        .filter(|e| e["guard"] == "slide:v - vb")
+        .collect();
+    let p = &belt()["parameters"];
+    let (vb, ms) = (f(&p["vb"]), f(&p["ms"]));
+    let chart = SvgChart::read(&picture);
+    let (dx, dv) = chart.pixel_size();
+    let sticks = chart.polylines("#D62728", "2");
+    assert_eq!(sticks.len(), slides.len());
+    for (k, (stick, slide)) in sticks.iter().zip(&slides).enumerate() {
+        let stuck_at_the_end = k + 1 == slides.len() && events.last() == Some(*slide);
+        let end = if stuck_at_the_end {
+            f(&summary["final_state"]["x"])
+        } else {
+            ms
+        };
+        let ends = [chart.value(stick[0]), chart.value(*stick.last().unwrap())];
+        for point in stick {
+            let (_, v) = chart.value(*point);
+            assert!((v - vb).abs() <= 2.0 * dv, "off the belt: v {v}");
+        }
+        assert!(
+            (ends[0].0 - f(&slide["after"]["x"])).abs() <= 2.0 * dx,
+            "{ends:?}"
+        );
+        assert!((ends[1].0 - end).abs() <= 2.0 * dx, "{ends:?}");
     }
 }
