@@ -118,6 +118,7 @@ pub fn load(path: &Path, registry: &Registry) -> Result<Sweep, SceneError> {
         file: Some(path.to_path_buf()),
         field: None,
         reason: format!("cannot be read: {e}"),
+        untrusted: false,
     })?;
     let folder = path.parent().map(Path::to_path_buf).unwrap_or_default();
     parse_text(&text, &folder, registry).map_err(|e| e.in_path(path))
@@ -130,6 +131,7 @@ pub fn parse_text(text: &str, folder: &Path, registry: &Registry) -> Result<Swee
         file: None,
         field: None,
         reason: format!("is not valid JSON: {e}"),
+        untrusted: false,
     })?;
     parse(&value, folder, registry)
 }

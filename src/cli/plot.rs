@@ -30,6 +30,14 @@ pub enum PlotCommand {
         /// Sample times along the run (with a scene).
         #[arg(long, default_value_t = DEFAULT_SAMPLES, requires = "scene")]
         samples: usize,
+        /// Run the scene to this time instead of its own t_end.
+        #[arg(
+            long,
+            value_name = "T",
+            allow_negative_numbers = true,
+            requires = "scene"
+        )]
+        t_end: Option<f64>,
         /// Load ratio F / F_cr.
         #[arg(long, allow_negative_numbers = true, conflicts_with = "scene")]
         eta: Option<f64>,
@@ -65,6 +73,7 @@ pub fn plot(command: PlotCommand, registry: &Registry) -> Result<Code, Failure> 
         x,
         y,
         samples,
+        t_end,
         eta,
         omega,
         plane,
@@ -72,7 +81,7 @@ pub fn plot(command: PlotCommand, registry: &Registry) -> Result<Code, Failure> 
         out,
     } = command;
     if let Some(scene) = scene {
-        return scene_plane(registry, &scene, x, y, samples, &out);
+        return scene_plane(registry, &scene, (x, y), samples, t_end, &out);
     }
     let finite = |name: &str, x: f64| {
         if x.is_finite() {
@@ -125,12 +134,17 @@ pub fn plot(command: PlotCommand, registry: &Registry) -> Result<Code, Failure> 
 fn scene_plane(
     registry: &Registry,
     path: &Path,
-    x: Option<String>,
-    y: Option<String>,
+    (x, y): (Option<String>, Option<String>),
     samples: usize,
+    t_end: Option<f64>,
     out: &Path,
 ) -> Result<Code, Failure> {
-    let scene = registry.load(path).map_err(Failure::bad_input)?;
+    let mut scene = registry.load(path).map_err(Failure::bad_input)?;
+    if let Some(t) = t_end {
+        scene
+            .set_t_end(t)
+            .map_err(|e| Failure::bad_input(format!("--t-end: {}", e.reason)))?;
+    }
     let (Some(x), Some(y)) = (x, y) else {
         return Err(Failure::bad_input(
             "plot phase SCENE: name the two states to draw with --x and --y",

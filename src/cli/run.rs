@@ -1,8 +1,6 @@
 //! `flicker run`: validate the scene, run it with the log streamed to disk,
 //! write the summary, and say what happened.
 
-use std::fs::File;
-use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
 
@@ -10,9 +8,10 @@ use crate::engine::Status;
 use crate::log::JsonlWriter;
 use crate::log::field_files;
 use crate::log::summary::{summary, write_atomically};
+use crate::log::writer::LazyFile;
 use crate::runner::ensemble::EnsembleRequest;
 use crate::runner::{Control, Report};
-use crate::scene::solver::SolverSpec;
+use crate::scene::solver::{METHODS, SolverSpec};
 use crate::scene::{Registry, Scene};
 
 use crate::cli::exit::{Code, Failure};
@@ -76,14 +75,14 @@ pub struct EnsembleFlags {
 /// Flags that override a scene's `solver`.
 #[derive(Debug, clap::Args)]
 pub struct SolverFlags {
-    /// Method: exact, linear, dopri5, dop853 or verlet (default: the scene's, else
-    /// the cheapest exact description of the model).
-    #[arg(long, value_name = "M")]
+    /// Method (default: the scene's, else the cheapest exact description of
+    /// the model).
+    #[arg(long, value_name = "M", value_parser = clap::builder::PossibleValuesParser::new(METHODS))]
     method: Option<String>,
-    /// Relative tolerance (dopri5, dop853).
+    /// Relative tolerance (taylor, dopri5, dop853).
     #[arg(long, value_name = "R", allow_negative_numbers = true)]
     rtol: Option<f64>,
-    /// Absolute tolerance (dopri5, dop853).
+    /// Absolute tolerance (taylor, dopri5, dop853).
     #[arg(long, value_name = "A", allow_negative_numbers = true)]
     atol: Option<f64>,
     /// Fixed step (verlet).
@@ -158,11 +157,10 @@ pub fn run(args: RunArgs, registry: &Registry) -> Result<Code, Failure> {
 
     let log_path = out.join("events.jsonl");
     let report = if log_events {
-        let file = File::create(&log_path).map_err(|e| {
-            Failure::bad_input(format!("{}: cannot be created: {e}", log_path.display()))
-        })?;
-        let mut observer =
-            WithProgress::new(JsonlWriter::new(BufWriter::new(file)), scene.t_end(), quiet);
+        // Created with the first event or at the end: a run the scene
+        // refuses as it starts leaves no log, and an earlier one untouched.
+        let file = LazyFile::new(&log_path);
+        let mut observer = WithProgress::new(JsonlWriter::new(file), scene.t_end(), quiet);
         let report = scene.run(&control, &mut observer);
         observer.finish();
         let mut report = report.map_err(|e| Failure::bad_input(e.in_path(scene_path)))?;

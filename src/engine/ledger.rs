@@ -53,7 +53,13 @@ pub(crate) struct Ledger<'o> {
     /// Whether a reset's change of energy moves the reference.
     rebase_at_resets: bool,
     energy_scale: f64,
+    /// The largest distance of the energy from its reference so far: the
+    /// error, before it is made relative at the end.
     max_energy_error: Option<f64>,
+    /// The largest energy met, the scale where the initial energy is zero
+    /// (a forced system started at rest): relative to zero, any change
+    /// would be infinite.
+    energy_peak: f64,
 }
 
 impl<'o> Ledger<'o> {
@@ -77,6 +83,7 @@ impl<'o> Ledger<'o> {
             rebase_at_resets: false,
             energy_scale,
             max_energy_error: energy_initial.map(|_| 0.0),
+            energy_peak: energy_initial.map_or(0.0, f64::abs),
         }
     }
 
@@ -238,7 +245,18 @@ impl<'o> Ledger<'o> {
             self.energy_reference,
             self.max_energy_error.as_mut(),
         ) {
-            *max = max.max((e - e0).abs() / self.energy_scale);
+            *max = max.max((e - e0).abs());
+            self.energy_peak = self.energy_peak.max(e.abs());
+        }
+    }
+
+    /// What the energy error is relative to: the model's scale for the
+    /// initial energy, or, where that is zero, the largest energy met.
+    fn relative_to(&self) -> f64 {
+        if self.energy_scale > f64::MIN_POSITIVE {
+            self.energy_scale
+        } else {
+            self.energy_peak.max(f64::MIN_POSITIVE)
         }
     }
 
@@ -320,7 +338,9 @@ impl<'o> Ledger<'o> {
             events_by_guard,
             energy_initial: self.energy_initial,
             energy_final: last.energy,
-            max_energy_error: self.max_energy_error,
+            max_energy_error: self
+                .max_energy_error
+                .map(|error| error / self.relative_to()),
             final_mode: last.mode,
             final_mode_name: last.mode_name,
             final_state_names: last.state_names.to_vec(),

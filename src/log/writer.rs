@@ -155,10 +155,63 @@ pub fn cut_to_last_line(path: &std::path::Path) -> io::Result<()> {
     }
 }
 
+/// A file created at its first write or flush, not before: a run refused
+/// before it starts leaves no empty log behind, and the log of an earlier
+/// run in the same folder untouched.
+#[derive(Debug)]
+pub struct LazyFile {
+    path: std::path::PathBuf,
+    file: Option<std::fs::File>,
+}
+
+impl LazyFile {
+    /// The file at `path`, not yet created.
+    pub fn new(path: impl Into<std::path::PathBuf>) -> Self {
+        LazyFile {
+            path: path.into(),
+            file: None,
+        }
+    }
+
+    fn open(&mut self) -> io::Result<&mut std::fs::File> {
+        let file = match self.file.take() {
+            Some(file) => file,
+            None => std::fs::File::create(&self.path)?,
+        };
+        Ok(self.file.insert(file))
+    }
+}
+
+impl Write for LazyFile {
+    fn write(&mut self, bytes: &[u8]) -> io::Result<usize> {
+        self.open()?.write(bytes)
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
+        self.open()?.flush()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::engine::Labels;
+
+    #[test]
+    fn a_lazy_file_is_created_at_its_first_write_or_flush_only() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("events.jsonl");
+        std::fs::write(&path, "earlier\n").unwrap();
+        drop(LazyFile::new(&path));
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), "earlier\n");
+        let mut file = LazyFile::new(&path);
+        file.write_all(b"new\n").unwrap();
+        file.flush().unwrap();
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), "new\n");
+        let empty = dir.path().join("empty.jsonl");
+        LazyFile::new(&empty).flush().unwrap();
+        assert_eq!(std::fs::read_to_string(&empty).unwrap(), "");
+    }
 
     #[test]
     fn a_half_written_line_is_cut_off() {

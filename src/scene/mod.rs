@@ -34,6 +34,9 @@ pub struct SceneError {
     pub field: Option<String>,
     /// What is wrong, in one sentence.
     pub reason: String,
+    /// Whether the input was fine but a run it needed could not be trusted
+    /// (a reference run that failed): exit 3, not 2.
+    pub untrusted: bool,
 }
 
 impl SceneError {
@@ -43,7 +46,15 @@ impl SceneError {
             file: None,
             field: Some(path.to_string()),
             reason,
+            untrusted: false,
         }
+    }
+
+    /// The same error, said of a run that could not be trusted rather
+    /// than of bad input.
+    pub fn untrusted(mut self) -> Self {
+        self.untrusted = true;
+        self
     }
 
     /// The same error, said of the file `file`.

@@ -400,6 +400,7 @@ impl Registry {
             file: None,
             field: None,
             reason: format!("is not valid JSON: {e}"),
+            untrusted: false,
         })?;
         self.from_value(&value)
     }
@@ -411,6 +412,7 @@ impl Registry {
             file: Some(path.to_path_buf()),
             field: None,
             reason,
+            untrusted: false,
         };
         let file = std::fs::File::open(path).map_err(|e| refuse(format!("cannot be read: {e}")))?;
         // Read one byte past the limit to tell a file at the limit from a larger one.

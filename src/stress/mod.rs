@@ -132,6 +132,7 @@ pub fn cases(dir: &Path, registry: &Registry) -> Result<Vec<(String, Scene)>, Sc
         file: Some(dir.to_path_buf()),
         field: None,
         reason: format!("cannot be read: {e}"),
+        untrusted: false,
     })?;
     let mut paths: Vec<PathBuf> = entries
         .filter_map(|e| e.ok().map(|e| e.path()))

@@ -397,7 +397,7 @@ fn bad_automata_are_refused_with_the_field_and_the_reason() {
         (
             with(&["initial", "y"], json!("v + 1")),
             "initial.y",
-            vec!["parameters only"],
+            vec!["`v` is a state: an initial value may use parameters only"],
         ),
         (
             with(&["initial"], json!({"y": 1.0})),

@@ -31,6 +31,7 @@ mod phase;
 mod random_impacts;
 mod registry;
 mod reproducible;
+mod rough_edges;
 mod saturated;
 mod scenes;
 mod schemas;

@@ -460,10 +460,21 @@ fn initial(
             })?;
             let source = Source::read(value, &at)?;
             let tape = Tape::compile(&[&source.ast], &scope).map_err(|e| {
-                let message = if source.ast_mentions_state(states) {
-                    format!("{} (an initial value may use parameters only)", e.message)
+                // The name the compiler stopped at, if a state: no near
+                // miss among the parameters to suggest.
+                let word: String = (source.text.get(e.at..).unwrap_or_default().chars())
+                    .take_while(|c| c.is_alphanumeric() || *c == '_')
+                    .collect();
+                let what = if states.contains(&word) {
+                    Some("a state")
                 } else {
-                    e.message
+                    (word == "t").then_some("the time")
+                };
+                let message = match what {
+                    Some(what) => {
+                        format!("`{word}` is {what}: an initial value may use parameters only")
+                    }
+                    None => e.message,
                 };
                 source.error(e.at, &message)
             })?;
@@ -476,13 +487,6 @@ fn initial(
             }
         })
         .collect()
-}
-
-impl Source {
-    /// Whether the expression names one of `states`.
-    fn ast_mentions_state(&self, states: &[String]) -> bool {
-        states.iter().any(|s| mentions(&self.ast, s)) || mentions(&self.ast, "t")
-    }
 }
 
 fn mode(

@@ -450,7 +450,8 @@ impl SceneModel for AutomatonScene {
                         o.t_reached,
                         o.reason.unwrap_or_default()
                     ),
-                ));
+                )
+                .untrusted());
             }
         };
         let times = match o.status {

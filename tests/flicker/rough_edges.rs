@@ -1,0 +1,135 @@
+//! Rough edges a new user met, each pinned by a test that failed on the
+//! old behaviour: help that lists every method, an energy audit that
+//! starts from zero energy, a reference run that fails (a run that cannot
+//! be trusted, exit 3, not bad input), an initial value that names a state,
+//! and `plot phase --t-end`.
+
+use serde_json::json;
+
+use crate::automata::{f, run_value};
+use crate::support::flicker;
+
+/// `flicker run --help` names every method a scene's `solver` takes, and
+/// an unknown one is refused with the list.
+#[test]
+fn run_help_lists_every_method() {
+    let help = flicker(&["run", "--help"]);
+    let text = String::from_utf8_lossy(&help.stdout);
+    for method in flicker::scene::solver::METHODS {
+        assert!(text.contains(method), "{method} missing from:\n{text}");
+    }
+    let bad = flicker(&["run", "scene.json", "--method", "rk4"]);
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("taylor"));
+}
+
+/// A forced oscillator from rest, `x'' + x = sin(2 t)`, energy `(x'^2 +
+/// x^2) / 2`: it starts at zero, so its error is measured against the
+/// largest energy the run meets, and the forcing's whole work is an error
+/// of exactly 1 of it (it was 1.6e308, relative to zero).
+#[test]
+fn an_energy_that_starts_at_zero_is_measured_against_its_largest() {
+    let scene = json!({
+        "model": "automaton",
+        "states": ["x", "v"],
+        "initial": {"x": 0.0, "v": 0.0},
+        "modes": {"m": {"flow": {"x": "v", "v": "-x + sin(2 * t)"}}},
+        "energy": "0.5 * v^2 + 0.5 * x^2",
+        "t_end": 6.0
+    });
+    let (summary, _) = run_value(&scene, &[]);
+    assert_eq!(summary["status"], "completed", "{summary}");
+    let error = f(&summary["max_energy_error"]);
+    assert!((error - 1.0).abs() <= 1e-12, "{summary}");
+}
+
+/// `flicker compare` on a scene whose reference run fails (`x' = x^2`
+/// from 1 blows up at t = 1) exits 3, saying so.
+#[test]
+fn a_failed_reference_is_an_untrusted_run_not_bad_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("blow_up.json");
+    let scene = json!({
+        "model": "automaton",
+        "states": ["x"],
+        "initial": {"x": 1.0},
+        "modes": {"m": {"flow": {"x": "x^2"}}},
+        "t_end": 2.0
+    });
+    std::fs::write(&path, scene.to_string()).unwrap();
+    let out = dir.path().join("o");
+    let done = flicker(&[
+        "compare",
+        path.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let said = String::from_utf8_lossy(&done.stderr);
+    assert_eq!(done.status.code(), Some(3), "{said}");
+    assert!(said.contains("the reference run"), "{said}");
+}
+
+/// An initial value that reads a state says so, and suggests no
+/// parameter with a name one letter away (`w` for `x`).
+#[test]
+fn an_initial_value_naming_a_state_is_told_so_without_a_near_miss() {
+    let scene = json!({
+        "model": "automaton",
+        "parameters": {"w": 2.0},
+        "states": ["x", "v"],
+        "initial": {"x": 1.0, "v": "w * x"},
+        "modes": {"m": {"flow": {"x": "v", "v": "-w^2 * x"}}},
+        "t_end": 1.0
+    });
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("s.json");
+    std::fs::write(&path, scene.to_string()).unwrap();
+    let done = flicker(&["check", path.to_str().unwrap()]);
+    let said = String::from_utf8_lossy(&done.stderr);
+    assert_eq!(done.status.code(), Some(2), "{said}");
+    assert!(said.contains("initial.v"), "{said}");
+    assert!(
+        said.contains("`x` is a state: an initial value may use parameters only"),
+        "{said}"
+    );
+    assert!(!said.contains("did you mean"), "{said}");
+}
+
+/// `plot phase SCENE --t-end T` draws the run to T, not to the scene's end.
+#[test]
+fn plot_phase_takes_t_end() {
+    let dir = tempfile::tempdir().unwrap();
+    let picture = dir.path().join("p.svg");
+    let scene = crate::automata::automaton("bouncing_ball.json");
+    let done = flicker(&[
+        "plot",
+        "phase",
+        &scene,
+        "--x",
+        "y",
+        "--y",
+        "v",
+        "--t-end",
+        "0.25",
+        "--out",
+        picture.to_str().unwrap(),
+    ]);
+    let said = String::from_utf8_lossy(&done.stdout);
+    assert_eq!(done.status.code(), Some(0), "{said}");
+    assert!(said.contains("at t = 0.25 with 0 events"), "{said}");
+    let bad = flicker(&[
+        "plot",
+        "phase",
+        &scene,
+        "--x",
+        "y",
+        "--y",
+        "v",
+        "--t-end",
+        "-1",
+        "--out",
+        picture.to_str().unwrap(),
+    ]);
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("--t-end"));
+}
