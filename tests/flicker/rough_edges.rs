@@ -133,3 +133,58 @@ fn plot_phase_takes_t_end() {
     assert_eq!(bad.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&bad.stderr).contains("--t-end"));
 }
+
+/// `check` names the guard that reads `min` (in another mode than the
+/// non-affine flow), not "a mode's flow".
+#[test]
+fn check_names_the_expression_that_has_no_taylor_series() {
+    let scene = json!({
+        "model": "automaton",
+        "states": ["x", "v"],
+        "initial": {"x": 1.0, "v": 0.0},
+        "initial_mode": "a",
+        "modes": {
+            "a": {"flow": {"x": "v", "v": "-x^3"},
+                  "transitions": [{"name": "switch", "guard": "x", "direction": "falling", "to": "b"}]},
+            "b": {"flow": {"x": "v", "v": "-x"},
+                  "transitions": [{"name": "corner", "guard": "min(x, v) + 2", "direction": "falling"}]}},
+        "t_end": 1.0
+    });
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("s.json");
+    std::fs::write(&path, scene.to_string()).unwrap();
+    let done = flicker(&["check", path.to_str().unwrap()]);
+    let said = String::from_utf8_lossy(&done.stdout);
+    assert_eq!(done.status.code(), Some(0), "{said}");
+    assert!(
+        said.contains("the guard `corner` of mode `b` reads abs, min or max"),
+        "{said}"
+    );
+}
+
+/// A guard that does not change (`x - x`, a number) can never fire: it
+/// is refused, naming the field, where it was accepted silently.
+#[test]
+fn a_guard_that_never_changes_is_refused() {
+    for guard in ["x - x", "2", "k * (v - v) + 1"] {
+        let scene = json!({
+            "model": "automaton",
+            "parameters": {"k": 3.0},
+            "states": ["x", "v"],
+            "initial": {"x": 1.0, "v": 0.0},
+            "modes": {"m": {"flow": {"x": "v", "v": "-x"},
+                "transitions": [{"name": "never", "guard": guard}]}},
+            "t_end": 1.0
+        });
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("s.json");
+        std::fs::write(&path, scene.to_string()).unwrap();
+        let done = flicker(&["check", path.to_str().unwrap()]);
+        let said = String::from_utf8_lossy(&done.stderr);
+        assert_eq!(done.status.code(), Some(2), "{guard}: {said}");
+        assert!(
+            said.contains("modes.m.transitions[0].guard") && said.contains("never crosses zero"),
+            "{guard}: {said}"
+        );
+    }
+}

@@ -6,6 +6,7 @@
 use serde_json::{Map, Value};
 
 use crate::engine::Direction;
+use crate::models::automaton::expr::symbolic::constant;
 use crate::models::automaton::expr::{Ast, Scope, Tape, parse};
 use crate::scene::SceneError;
 use crate::scene::fields::{Fields, kind};
@@ -566,6 +567,17 @@ fn transition(
         ));
     }
     let guard = Source::read(f.required("guard")?, &f.path("guard"))?;
+    let variables: Vec<&str> = states.iter().copied().chain(["t"]).collect();
+    if constant(&guard.ast, &variables).is_some() {
+        return Err(SceneError::field(
+            &f.path("guard"),
+            format!(
+                "`{}` does not change with the state or the time: it never crosses zero, \
+                 so the transition could never fire",
+                guard.text
+            ),
+        ));
+    }
     let direction = match f.optional_string("direction")? {
         None | Some("either") => Direction::Either,
         Some("falling") => Direction::Falling,

@@ -61,9 +61,10 @@ struct CompiledMode {
     kind: Flow,
     linear: Option<(DMatrix<f64>, DVector<f64>)>,
     second_order: bool,
-    /// No `abs`, `min` or `max` in the flow or a guard: Taylor series hold
-    /// over a whole step.
-    smooth: bool,
+    /// Where the mode reads `abs`, `min` or `max` (its flow, or a guard by
+    /// name), if it does: no Taylor series there. `None`: they hold over
+    /// a whole step.
+    rough: Option<String>,
 }
 
 #[derive(Debug, Clone)]
@@ -233,9 +234,15 @@ impl Automaton {
                         == crate::models::automaton::expr::Op::Input((half + i) as u32)
                 })
                 && (half..n).all(|i| (half..n).all(|j| !flow.depends_on(i, j as u32)));
-            let smooth = flow.smooth() && guard_tapes.iter().all(Tape::smooth);
+            let rough = if flow.smooth() {
+                (guards.iter().zip(&guard_tapes))
+                    .find(|(_, tape)| !tape.smooth())
+                    .map(|(g, _)| format!("the guard `{}` of mode `{}`", g.name, mode.name))
+            } else {
+                Some(format!("the flow of mode `{}`", mode.name))
+            };
             modes.push(CompiledMode {
-                smooth,
+                rough,
                 name: intern(&mode.name),
                 flow,
                 rates: mode.flow.clone(),
@@ -331,6 +338,12 @@ impl Automaton {
         self.clock
     }
 
+    /// The first flow or guard that reads `abs`, `min` or `max`, where
+    /// Taylor series do not hold, if any: "the guard `wall` of mode `m`".
+    pub fn rough(&self) -> Option<&str> {
+        self.modes.iter().find_map(|m| m.rough.as_deref())
+    }
+
     /// Whether every mode's flow is affine (the linear propagator runs it).
     pub fn all_linear(&self) -> bool {
         self.modes
@@ -416,7 +429,7 @@ impl HybridModel for Automaton {
     }
 
     fn has_series(&self, mode: Mode) -> bool {
-        self.modes[mode].smooth
+        self.modes[mode].rough.is_none()
     }
 
     fn flow_series(&self, mode: Mode, x: &[f64], order: usize, series: &mut [f64]) {

@@ -105,9 +105,11 @@ impl AutomatonScene {
             Method::Auto => (
                 Method::Dopri5(tol),
                 format!(
-                    "a mode's flow is not affine and uses abs, min or max (no Taylor series): \
+                    "a mode's flow is not affine, and {} reads abs, min or max (no Taylor series): \
                      Dormand-Prince 5(4), rtol {:e}, atol {:e}",
-                    tol.rtol, tol.atol
+                    self.automaton.rough().unwrap_or("an expression"),
+                    tol.rtol,
+                    tol.atol
                 ),
             ),
             Method::Taylor(t) => (
@@ -425,9 +427,11 @@ impl SceneModel for AutomatonScene {
         } else {
             return Err(SceneError::field(
                 "modes",
-                "a flow or guard uses abs, min or max, where Taylor series do not hold: \
-                 no reference to measure methods against"
-                    .into(),
+                format!(
+                    "{} reads abs, min or max, where Taylor series do not hold: \
+                     no reference to measure methods against",
+                    self.automaton.rough().unwrap_or("an expression")
+                ),
             ));
         };
         let mut exact = self.clone();
