@@ -10,7 +10,7 @@ use crate::log::field_files;
 use crate::log::summary::{summary, write_atomically};
 use crate::log::writer::LazyFile;
 use crate::runner::ensemble::EnsembleRequest;
-use crate::runner::{Control, Report};
+use crate::runner::{Control, Report, Trajectory};
 use crate::scene::solver::{METHODS, SolverSpec};
 use crate::scene::{Registry, Scene};
 
@@ -53,6 +53,18 @@ pub struct RunArgs {
     /// states (automata).
     #[arg(long, value_name = "LIST", value_delimiter = ',')]
     sensitivities: Option<Vec<String>>,
+    /// Also write the state at N evenly spaced times from 0 to t_end, each
+    /// with its error bound, to samples.csv (automata, the mechanism).
+    #[arg(long, value_name = "N", conflicts_with = "at")]
+    samples: Option<usize>,
+    /// The same at these times (comma-separated).
+    #[arg(
+        long,
+        value_name = "LIST",
+        value_delimiter = ',',
+        allow_negative_numbers = true
+    )]
+    at: Option<Vec<f64>>,
 }
 
 /// A scene's reproducibility horizon.
@@ -105,6 +117,8 @@ pub fn run(args: RunArgs, registry: &Registry) -> Result<Code, Failure> {
         solver,
         ensemble,
         sensitivities,
+        samples,
+        at,
     } = args;
     let scene_path = scene_path.as_path();
     let log_events = !no_events;
@@ -148,6 +162,15 @@ pub fn run(args: RunArgs, registry: &Registry) -> Result<Code, Failure> {
             Some(request)
         }
     };
+    let times = crate::log::samples::times(samples, at.as_deref(), scene.t_end())
+        .map_err(Failure::bad_input)?;
+    let times = (samples.is_some() || at.is_some()).then_some(times);
+    if times.is_some() && !scene.offers_samples() {
+        return Err(Failure::bad_input(format!(
+            "--samples/--at: a {} scene offers no samples of its state",
+            scene.model()
+        )));
+    }
     let out = out.unwrap_or_else(|| default_out(scene_path));
     crate::cli::setup::output_folder(&out)?;
     let control = Control {
@@ -156,14 +179,16 @@ pub fn run(args: RunArgs, registry: &Registry) -> Result<Code, Failure> {
     };
 
     let log_path = out.join("events.jsonl");
+    let states;
     let report = if log_events {
         // Created with the first event or at the end: a run the scene
         // refuses as it starts leaves no log, and an earlier one untouched.
         let file = LazyFile::new(&log_path);
         let mut observer = WithProgress::new(JsonlWriter::new(file), scene.t_end(), quiet);
-        let report = scene.run(&control, &mut observer);
+        let ran = run_scene(&scene, &control, times.as_deref(), &mut observer);
         observer.finish();
-        let mut report = report.map_err(|e| Failure::bad_input(e.in_path(scene_path)))?;
+        let (mut report, sampled) = ran.map_err(|e| Failure::bad_input(e.in_path(scene_path)))?;
+        states = sampled;
         // A log that could not be written spoils the run, but its summary
         // still says how far it got and why it stopped.
         let flushed = observer.inner.flush();
@@ -184,9 +209,11 @@ pub fn run(args: RunArgs, registry: &Registry) -> Result<Code, Failure> {
         report
     } else {
         let mut observer = WithProgress::new((), scene.t_end(), quiet);
-        let report = scene.run(&control, &mut observer);
+        let ran = run_scene(&scene, &control, times.as_deref(), &mut observer);
         observer.finish();
-        report.map_err(|e| Failure::bad_input(e.in_path(scene_path)))?
+        let (report, sampled) = ran.map_err(|e| Failure::bad_input(e.in_path(scene_path)))?;
+        states = sampled;
+        report
     };
 
     let log = log_events.then_some(log_path.as_path());
@@ -202,6 +229,24 @@ pub fn run(args: RunArgs, registry: &Registry) -> Result<Code, Failure> {
         written.extend([profiles, trace]);
     }
     let mut summary = summary(&report, scene.model(), scene_path, log);
+    if let Some(trajectory) = &states {
+        let path = out.join("samples.csv");
+        let Trajectory {
+            names,
+            samples,
+            bounds,
+            ..
+        } = trajectory;
+        crate::log::samples::write_csv(&path, names, samples, bounds).map_err(|e| {
+            Failure::untrusted(format!("{}: cannot be written: {e}", path.display()))
+        })?;
+        summary["samples"] = serde_json::json!({
+            "file": path.display().to_string(),
+            "count": samples.len(),
+            "largest_bound": bounds.iter().copied().fold(0.0, f64::max),
+        });
+        written.push(path);
+    }
     let mut horizon = None;
     let mut ensemble_failed = None;
     // The copies run only after a run that completed: an interrupted or
@@ -279,6 +324,27 @@ pub fn run(args: RunArgs, registry: &Registry) -> Result<Code, Failure> {
         Status::Failed => Code::Untrusted,
         Status::Interrupted => Code::Interrupted,
     })
+}
+
+/// Run `scene`, sampled at `times` where asked: the report, and the
+/// samples with their bounds (the trajectory, its report moved out).
+fn run_scene(
+    scene: &Scene,
+    control: &Control,
+    times: Option<&[f64]>,
+    observer: &mut dyn crate::engine::Observer,
+) -> Result<(Report, Option<Trajectory>), crate::scene::SceneError> {
+    let Some(times) = times else {
+        return scene.run(control, observer).map(|report| (report, None));
+    };
+    match scene.sampled(control, times, observer) {
+        Some(Ok(trajectory)) => Ok((trajectory.report.clone(), Some(trajectory))),
+        Some(Err(e)) => Err(e),
+        None => Err(crate::scene::SceneError::field(
+            "samples",
+            format!("a {} scene offers no samples of its state", scene.model()),
+        )),
+    }
 }
 
 fn default_out(scene: &Path) -> PathBuf {

@@ -39,6 +39,10 @@ pub struct Sample<'a> {
     pub state: &'a [f64],
     /// Events logged before it.
     pub events: u64,
+    /// The bound on every state component's error there: the bound the
+    /// run carried to the start of the step the sample falls in, plus
+    /// that step's own local error.
+    pub bound: f64,
 }
 
 /// Run `model` from state `x0` in `mode` at `t = 0`, reporting events to
@@ -331,11 +335,17 @@ impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
         let mut x = std::mem::take(&mut self.before);
         self.state_at(Time::new(s).since(self.origin).max(0.0), &mut x);
         self.set_clock(Time::new(s), &mut x);
+        let step = if self.motion == Motion::Stepped {
+            self.integrator.local_error()
+        } else {
+            0.0
+        };
         (self.on_sample)(&Sample {
             t: s,
             mode: self.mode,
             state: &x,
             events: ledger.events(),
+            bound: self.bound.state_bound(ledger.events()) + step,
         });
         self.before = x;
     }

@@ -18,7 +18,8 @@
 //! | `rel_velocity` | chains: `y'_{n-1} - y'_n` just before the impact (`-y'_1` for unit 1), positive when closing; continua: the speed at which a shut stretch strikes the wall |
 //! | `x` | continua only: where the event happened (the wall at `-length / 2`, the loaded end at `+length / 2`) |
 //!
-//! A chain or continuum run also writes `profiles.json` and `trace.csv` ([`field_files`]).
+//! A chain or continuum run also writes `profiles.json` and `trace.csv` ([`field_files`]);
+//! a run asked for samples, `samples.csv` ([`samples`]).
 //! The same events held in memory as arrays: [`columns`].
 //!
 //! ```json
@@ -35,6 +36,7 @@ pub mod columns;
 pub mod field_files;
 pub mod inspect;
 pub mod reader;
+pub mod samples;
 pub mod summary;
 pub mod writer;
 

@@ -42,6 +42,10 @@ pub struct Trajectory {
     /// `(t, state)` at each sample time the run reached (the state before
     /// an event at the same time).
     pub samples: Vec<(f64, Vec<f64>)>,
+    /// Each sample's error bound (see [`Sample::bound`]).
+    ///
+    /// [`Sample::bound`]: crate::engine::Sample::bound
+    pub bounds: Vec<f64>,
     /// The run itself.
     pub report: Report,
 }

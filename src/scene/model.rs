@@ -158,6 +158,12 @@ pub trait SceneModel: fmt::Debug + Send + Sync + 'static {
         None
     }
 
+    /// Whether [`sampled`](SceneModel::sampled) gives samples, asked
+    /// before anything runs.
+    fn offers_samples(&self) -> bool {
+        false
+    }
+
     /// The release of a string this scene describes, as a continuum scene
     /// (a chain's with its units): what `compare-models` and `advise` weigh
     /// chains and continua on. `None` where the model describes no string.

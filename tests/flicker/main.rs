@@ -32,6 +32,7 @@ mod random_impacts;
 mod registry;
 mod reproducible;
 mod rough_edges;
+mod samples;
 mod saturated;
 mod scenes;
 mod schemas;

@@ -370,17 +370,24 @@ impl SceneModel for AutomatonScene {
         Ok(())
     }
 
+    fn offers_samples(&self) -> bool {
+        true
+    }
+
     fn sampled(
         &self,
         control: &Control,
         times: &[f64],
         observer: &mut dyn Observer,
     ) -> Option<Result<Trajectory, SceneError>> {
-        let mut samples = Vec::with_capacity(times.len());
+        let (mut samples, mut bounds) = (Vec::with_capacity(times.len()), Vec::new());
         let report = self.run_sampled(
             control,
             times,
-            &mut |s| samples.push((s.t, s.state.to_vec())),
+            &mut |s| {
+                samples.push((s.t, s.state.to_vec()));
+                bounds.push(s.bound);
+            },
             observer,
         );
         let report = match report {
@@ -390,6 +397,7 @@ impl SceneModel for AutomatonScene {
         Some(Ok(Trajectory {
             names: self.automaton.state_names(0).to_vec(),
             samples,
+            bounds,
             report,
         }))
     }

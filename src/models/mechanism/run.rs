@@ -1,6 +1,6 @@
 //! Running a mechanism scene in the formulation and method it asks for.
 
-use crate::engine::{Method, Observer, simulate};
+use crate::engine::{Method, Observer, Sample, simulate_sampled};
 use crate::models::mechanism::strain::FLIGHT;
 use crate::models::mechanism::{AngleMechanism, Charts, StrainMechanism};
 use crate::runner::{Control, Report};
@@ -9,6 +9,19 @@ use crate::scene::{Formulation, Initial, MechanismScene, SceneError};
 pub(crate) fn run(
     scene: &MechanismScene,
     control: &Control,
+    observer: &mut dyn Observer,
+) -> Result<Report, SceneError> {
+    run_sampled(scene, control, &[], &mut |_| {}, observer)
+}
+
+/// [`run`], the state at each of `times` passed to `on_sample`: the strain
+/// and its rate, whichever formulation runs (the angle's charts are
+/// mapped back to them).
+pub(crate) fn run_sampled(
+    scene: &MechanismScene,
+    control: &Control,
+    times: &[f64],
+    on_sample: &mut dyn FnMut(&Sample),
     observer: &mut dyn Observer,
 ) -> Result<Report, SceneError> {
     let options = control.options(
@@ -24,7 +37,15 @@ pub(crate) fn run(
             let model = StrainMechanism {
                 mechanism: scene.mechanism,
             };
-            let outcome = simulate(&model, FLIGHT, &[eps, rate], &options, observer);
+            let outcome = simulate_sampled(
+                &model,
+                FLIGHT,
+                &[eps, rate],
+                &options,
+                times,
+                on_sample,
+                observer,
+            );
             let final_state = strain_names
                 .into_iter()
                 .zip(outcome.final_state.iter().copied())
@@ -72,7 +93,15 @@ pub(crate) fn run(
                     .start_from_strain(eps, rate)
                     .map_err(|reason| SceneError::field("initial", reason))?,
             };
-            let outcome = simulate(&model, mode, &x0, &options, observer);
+            let mut in_strain = |s: &Sample| {
+                let (e, r) = model.strain(s.mode, s.state);
+                on_sample(&Sample {
+                    state: &[e, r],
+                    ..*s
+                });
+            };
+            let outcome =
+                simulate_sampled(&model, mode, &x0, &options, times, &mut in_strain, observer);
             let (e, r) = model.strain(outcome.final_mode, &outcome.final_state);
             let (method, integrator) = match scene.method {
                 Method::Dop853(_) => ("dop853", "DOP853"),

@@ -36,7 +36,7 @@ use crate::engine::{Method, Tolerances};
 use crate::models::mechanism::strain::{self, FLIGHT};
 use crate::models::mechanism::{AngleMechanism, ExactOrbit, StrainMechanism, angle};
 use crate::models::mechanism::{Charts, Mechanism, Phase};
-use crate::runner::{Control, Report};
+use crate::runner::{Control, Report, Trajectory};
 use crate::scene::fields::{Fields, kind};
 use crate::scene::solver::{SolverSpec, check_steps};
 use crate::scene::{Scene, SceneError, SceneModel};
@@ -345,6 +345,35 @@ impl SceneModel for MechanismScene {
 
     fn run(&self, control: &Control, observer: &mut dyn Observer) -> Result<Report, SceneError> {
         super::run::run(self, control, observer)
+    }
+
+    fn offers_samples(&self) -> bool {
+        true
+    }
+
+    fn sampled(
+        &self,
+        control: &Control,
+        times: &[f64],
+        observer: &mut dyn Observer,
+    ) -> Option<Result<Trajectory, SceneError>> {
+        let (mut samples, mut bounds) = (Vec::with_capacity(times.len()), Vec::new());
+        let report = super::run::run_sampled(
+            self,
+            control,
+            times,
+            &mut |s| {
+                samples.push((s.t, s.state.to_vec()));
+                bounds.push(s.bound);
+            },
+            observer,
+        );
+        Some(report.map(|report| Trajectory {
+            names: vec!["strain", "strain_rate"],
+            samples,
+            bounds,
+            report,
+        }))
     }
 
     /// The closed form (46) of the strain with impacts every `T_imp`,
