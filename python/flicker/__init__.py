@@ -73,6 +73,10 @@ class Run:
         profiles: for chains and continua, a list of dicts (`t`, and arrays
             `x`, `strain`, `displacement`, `velocity`) at the snapshot
             times; else None.
+        samples: for a run given `t_eval`, a dict of float64 arrays: `t`,
+            one per state, and `bound` (each sample's error bound), from
+            the method's own dense output; a sample at an event's time
+            holds the state before the reset. Else None.
         fields: everything a chain or continuum reports (the two above, the
             classical string beside them, the momentum), or None.
     """
@@ -82,6 +86,7 @@ class Run:
         self.fields: Optional[Dict[str, Any]] = raw["fields"]
         self.trace = self.fields["trace"] if self.fields else None
         self.profiles = self.fields["profiles"] if self.fields else None
+        self.samples: Optional[Dict[str, np.ndarray]] = raw["samples"]
         columns = raw["events"]
         if columns is None:
             self.events = None
@@ -110,11 +115,17 @@ class Run:
         """The run's status: `completed`, `zeno`, `failed` or `interrupted`."""
         return self.summary["status"]
 
-    def to_pandas(self):
+    def to_pandas(self, samples: bool = False):
         """The events as a pandas DataFrame: one row per event, one column
-        per field, `before.NAME` and `after.NAME` for each state. Needs
-        pandas."""
+        per field, `before.NAME` and `after.NAME` for each state; or with
+        `samples=True`, the samples (`t`, each state, `bound`), one row per
+        time. Needs pandas."""
         import pandas as pd
+
+        if samples:
+            if self.samples is None:
+                raise ValueError("this run took no samples (run it with t_eval=...)")
+            return pd.DataFrame(self.samples)
 
         if self.events is None:
             raise ValueError("this run kept no events (run it with events=True)")
@@ -146,6 +157,7 @@ def run(
     log: Optional[Union[str, "os.PathLike[str]"]] = None,
     events: bool = True,
     sensitivities: Optional[Sequence[str]] = None,
+    t_eval: Optional[Sequence[float]] = None,
 ) -> Run:
     """Run a scene and return its `Run`.
 
@@ -165,6 +177,9 @@ def run(
             along (automata): the summary's `sensitivities`, and
             `d{state}/d{direction}`, `dt/d{direction}` among the events'
             states.
+        t_eval: times (from 0 to t_end, any order) at which to keep the
+            state, with its error bound: `Run.samples` (automata and the
+            mechanism).
 
     Raises:
         SceneError: the scene or an argument is refused; `field` and
@@ -182,6 +197,9 @@ def run(
         log=None if log is None else os.fspath(log),
         events=events,
         sensitivities=None if sensitivities is None else list(sensitivities),
+        t_eval=None
+        if t_eval is None
+        else [float(t) for t in np.asarray(t_eval, dtype=np.float64).ravel()],
     )
     return Run(raw)
 

@@ -22,6 +22,7 @@ def run(
     log: Optional[str] = None,
     events: bool = True,
     sensitivities: Optional[List[str]] = None,
+    t_eval: Optional[List[float]] = None,
 ) -> Dict[str, Any]: ...
 def check(text: Optional[str] = None, path: Optional[str] = None) -> List[str]: ...
 def compare(

@@ -6,7 +6,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
 use flicker::log::columns::EventColumns;
-use flicker::runner::{FieldOutputs, Profile, TraceRow};
+use flicker::runner::{FieldOutputs, Profile, TraceRow, Trajectory};
 
 /// The events as a dict: `seq` (uint64), `t`, `energy_before`,
 /// `energy_after` (float64), `guard`, `mode_before`, `mode_after` (uint32
@@ -43,6 +43,23 @@ pub fn events<'py>(py: Python<'py>, columns: &mut EventColumns) -> PyResult<Boun
         labels.append((label.name, label.values.into_pyarray(py), label.counts))?;
     }
     out.set_item("labels", labels)?;
+    Ok(out)
+}
+
+/// A trajectory's samples as a dict of float64 arrays: `t`, one per state
+/// (a model's clock, `t` itself, once), and `bound`, each sample's error
+/// bound.
+pub fn samples<'py>(py: Python<'py>, trajectory: Trajectory) -> PyResult<Bound<'py, PyDict>> {
+    let out = PyDict::new(py);
+    let column = |k: usize| -> Vec<f64> { trajectory.samples.iter().map(|(_, x)| x[k]).collect() };
+    let times: Vec<f64> = trajectory.samples.iter().map(|(t, _)| *t).collect();
+    out.set_item("t", times.into_pyarray(py))?;
+    for (k, name) in trajectory.names.iter().enumerate() {
+        if *name != "t" {
+            out.set_item(*name, column(k).into_pyarray(py))?;
+        }
+    }
+    out.set_item("bound", trajectory.bounds.into_pyarray(py))?;
     Ok(out)
 }
 

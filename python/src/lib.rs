@@ -108,7 +108,7 @@ impl Observer for Keep {
 /// see `convert::events`), `fields` (a chain's or continuum's trace and
 /// profiles, or None).
 #[pyfunction]
-#[pyo3(signature = (text=None, path=None, t_end=None, method=None, rtol=None, atol=None, step=None, log=None, events=true, sensitivities=None))]
+#[pyo3(signature = (text=None, path=None, t_end=None, method=None, rtol=None, atol=None, step=None, log=None, events=true, sensitivities=None, t_eval=None))]
 #[allow(clippy::too_many_arguments)]
 fn run<'py>(
     py: Python<'py>,
@@ -122,6 +122,7 @@ fn run<'py>(
     log: Option<&str>,
     events: bool,
     sensitivities: Option<Vec<String>>,
+    t_eval: Option<Vec<f64>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (mut scene, label) = load(py, text, path)?;
     if let Some(t) = t_end {
@@ -146,6 +147,21 @@ fn run<'py>(
             .set_sensitivities(directions)
             .map_err(|e| override_error(py, "sensitivities", e.reason))?;
     }
+    let times = match &t_eval {
+        None => None,
+        Some(at) => {
+            let times = flicker::log::samples::times(None, Some(at), scene.t_end())
+                .map_err(|why| override_error(py, "t_eval", why))?;
+            if !scene.offers_samples() {
+                return Err(override_error(
+                    py,
+                    "t_eval",
+                    format!("a {} scene offers no samples of its state", scene.model()),
+                ));
+            }
+            Some(times)
+        }
+    };
     let writer = match log {
         None => None,
         Some(file) => Some(JsonlWriter::new(BufWriter::new(
@@ -170,8 +186,18 @@ fn run<'py>(
             // given before the caller waits is kept for it).
             let caller = std::thread::current();
             let (scene, control, keep, finished) = (&scene, &control, &mut keep, &done);
+            let times = times.as_deref();
             let worker = s.spawn(move || {
-                let report = scene.run(control, keep);
+                let report = match times {
+                    None => scene.run(control, keep).map(|report| (report, None)),
+                    Some(times) => match scene.sampled(control, times, keep) {
+                        Some(ran) => ran.map(|t| (t.report.clone(), Some(t))),
+                        None => Err(EngineSceneError::field(
+                            "t_eval",
+                            "the scene offers no samples of its state".into(),
+                        )),
+                    },
+                };
                 finished.store(true, Ordering::Release);
                 caller.unpark();
                 report
@@ -195,7 +221,7 @@ fn run<'py>(
             ));
         }
     };
-    let mut report = report;
+    let (mut report, trajectory) = report;
     if let Some(writer) = &mut keep.log
         && let Err(e) = writer.flush()
     {
@@ -217,6 +243,10 @@ fn run<'py>(
     match &report.fields {
         Some(fields) => out.set_item("fields", convert::fields(py, fields)?)?,
         None => out.set_item("fields", py.None())?,
+    }
+    match trajectory {
+        Some(trajectory) => out.set_item("samples", convert::samples(py, trajectory)?)?,
+        None => out.set_item("samples", py.None())?,
     }
     Ok(out)
 }

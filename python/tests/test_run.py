@@ -136,3 +136,39 @@ def test_a_flow_that_reads_sign_slides_from_a_dict():
     assert run.events["mode_after"][-1] == "block[v=0]"
     assert abs(run.summary["final_state"]["x"] - (15 - math.sqrt(205))) < 1e-12
     assert run.summary["final_state"]["v"] == 0.0
+
+
+def test_t_eval_samples_lie_on_the_closed_form_and_match_the_command_line(cli, tmp_path):
+    """The bouncing ball's first fall, y = 1 - g t^2 / 2, sampled from
+    Python at times in any order: within 1e-12 and each sample's bound, and
+    the same numbers, bit for bit, as `flicker run --at` writes."""
+    g = 9.81
+    times = [0.3, 0.0, 0.1, 0.2, 0.4]
+    run = flicker.run(MODELS / "automata/bouncing_ball.json", t_eval=times)
+    s = run.samples
+    assert list(s) == ["t", "y", "v", "bound"]
+    assert s["t"].dtype == np.float64
+    assert list(s["t"]) == sorted(times)
+    for t, y, v, bound in zip(s["t"], s["y"], s["v"], s["bound"]):
+        assert abs(y - (1.0 - 0.5 * g * t * t)) <= 1e-12 and abs(v + g * t) <= 1e-12
+        assert bound >= 0.0
+    done, out = cli(
+        "run", MODELS / "automata/bouncing_ball.json", "--out", tmp_path / "cli", "--quiet",
+        "--at", ",".join(str(t) for t in times),
+    )
+    assert done.returncode == 0, done.stderr
+    rows = (tmp_path / "cli" / "samples.csv").read_text().splitlines()
+    assert rows[0] == "t,y,v,bound"
+    for k, row in enumerate(rows[1:]):
+        values = [float(v) for v in row.split(",")]
+        assert values == [s["t"][k], s["y"][k], s["v"][k], s["bound"][k]]
+
+
+def test_t_eval_out_of_range_or_on_a_chain_is_refused():
+    with pytest.raises(flicker.SceneError) as bad:
+        flicker.run(MODELS / "automata/bouncing_ball.json", t_eval=[1e6])
+    assert bad.value.field == "t_eval"
+    with pytest.raises(flicker.SceneError) as chain:
+        flicker.run(MODELS / "chain_cradle.json", t_eval=[0.0, 1.0])
+    assert "offers no samples" in str(chain.value)
+    assert flicker.run(MODELS / "automata/bouncing_ball.json").samples is None

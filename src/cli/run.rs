@@ -162,8 +162,15 @@ pub fn run(args: RunArgs, registry: &Registry) -> Result<Code, Failure> {
             Some(request)
         }
     };
-    let times = crate::log::samples::times(samples, at.as_deref(), scene.t_end())
-        .map_err(Failure::bad_input)?;
+    let times =
+        crate::log::samples::times(samples, at.as_deref(), scene.t_end()).map_err(|why| {
+            let flag = if samples.is_some() {
+                "--samples"
+            } else {
+                "--at"
+            };
+            Failure::bad_input(format!("{flag}: {why}"))
+        })?;
     let times = (samples.is_some() || at.is_some()).then_some(times);
     if times.is_some() && !scene.offers_samples() {
         return Err(Failure::bad_input(format!(

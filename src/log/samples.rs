@@ -18,12 +18,13 @@ pub const MAX_SAMPLES: usize = 10_000_000;
 
 /// The sample times: `count` evenly spaced from 0 to `t_end` (both ends
 /// included), or the times `at` (in increasing order, repeats dropped),
-/// each within `[0, t_end]`. The error names the flag.
+/// each within `[0, t_end]`. The error says what is wrong with the one
+/// given.
 pub fn times(count: Option<usize>, at: Option<&[f64]>, t_end: f64) -> Result<Vec<f64>, String> {
     match (count, at) {
         (Some(n), _) => {
             if !(2..=MAX_SAMPLES).contains(&n) {
-                return Err(format!("--samples: from 2 to {MAX_SAMPLES} (got {n})"));
+                return Err(format!("from 2 to {MAX_SAMPLES} samples (got {n})"));
             }
             let last = (n - 1) as f64;
             Ok((0..n)
@@ -38,7 +39,7 @@ pub fn times(count: Option<usize>, at: Option<&[f64]>, t_end: f64) -> Result<Vec
         }
         (None, Some(at)) => {
             if at.len() > MAX_SAMPLES {
-                return Err(format!("--at: at most {MAX_SAMPLES} times"));
+                return Err(format!("at most {MAX_SAMPLES} times"));
             }
             if let Some(bad) = at.iter().find(|t| !(0.0..=t_end).contains(*t)) {
                 return Err(format!(
