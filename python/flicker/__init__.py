@@ -115,6 +115,15 @@ class Run:
         """The run's status: `completed`, `zeno`, `failed` or `interrupted`."""
         return self.summary["status"]
 
+    def plot(self, x: Optional[str] = None, y: Optional[str] = None, ax=None):
+        """Draw the run's samples (take them with `t_eval=`): every state
+        over time, events ticked on the time axis, or `y` against `x`, each
+        reset a dashed jump; sliding stretches in red. Returns the
+        matplotlib Axes (drawn into `ax` if given). Needs matplotlib."""
+        from .plotting import plot
+
+        return plot(self, x, y, ax)
+
     def to_pandas(self, samples: bool = False):
         """The events as a pandas DataFrame: one row per event, one column
         per field, `before.NAME` and `after.NAME` for each state; or with

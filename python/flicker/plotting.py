@@ -1,0 +1,94 @@
+"""Pictures of a run with matplotlib (an optional dependency): its states
+over time, or any two against each other, from the samples a run took
+(`flicker.run(scene, t_eval=...)`), split at its events.
+
+Between events the flow is drawn as a line through the samples, ending at
+the state just before the event and starting again from the state just
+after it; a reset that moves the state is a dashed jump; events are marked;
+a stretch a discontinuous flow slides along a switching surface (from its
+`slide:h` event to the next event) is drawn in red, as `flicker plot phase`
+draws it.
+"""
+
+from typing import Any, List, Optional, Tuple
+
+import numpy as np
+
+SLIDING = "tab:red"
+
+
+def _pieces(run) -> List[Tuple[np.ndarray, dict, bool]]:
+    """The samples split at the events: for each stretch between events,
+    its times, a dict of each state's values (the event's state before and
+    after added at the ends) and whether it slides."""
+    s = run.samples
+    names = [k for k in s if k not in ("t", "bound")]
+    ev = run.events
+    t = s["t"]
+    if ev is None or len(ev["t"]) == 0:
+        return [(t, {n: s[n] for n in names}, False)]
+    column = {n: run.state_names.index(n) for n in names if n in run.state_names}
+    pieces = []
+    start_t, start_state, sliding = None, None, False
+    lo = 0
+    for k, te in enumerate(ev["t"]):
+        hi = int(np.searchsorted(t, te, side="left"))
+        ts = list(t[lo:hi])
+        values = {n: list(s[n][lo:hi]) for n in names}
+        if start_t is not None:
+            ts.insert(0, start_t)
+            for n in names:
+                values[n].insert(0, start_state[n])
+        ts.append(te)
+        for n in names:
+            values[n].append(ev["before"][k, column[n]] if n in column else np.nan)
+        pieces.append((np.array(ts), {n: np.array(v) for n, v in values.items()}, sliding))
+        start_t = te
+        start_state = {n: ev["after"][k, column[n]] if n in column else np.nan for n in names}
+        sliding = str(ev["guard"][k]).startswith("slide:")
+        lo = hi
+    ts = [start_t] + list(t[lo:])
+    values = {n: np.array([start_state[n]] + list(s[n][lo:])) for n in names}
+    pieces.append((np.array(ts), values, sliding))
+    return pieces
+
+
+def plot(run, x: Optional[str] = None, y: Optional[str] = None, ax: Any = None):
+    """Draw `run`: every state over time, or `y` against `x` (a phase
+    plane). Returns the matplotlib Axes (a new figure's unless `ax`)."""
+    import matplotlib.pyplot as plt
+
+    if run.samples is None:
+        raise ValueError("this run took no samples: run it with t_eval=... to draw it")
+    if (x is None) != (y is None):
+        raise ValueError("give both x and y for a phase plane, or neither for states over time")
+    names = [k for k in run.samples if k not in ("t", "bound")]
+    for axis, name in (("x", x), ("y", y)):
+        if name is not None and name not in names:
+            raise ValueError(f"{axis}: the run has no state {name!r} (its states: {', '.join(names)})")
+    if ax is None:
+        _, ax = plt.subplots()
+    pieces = _pieces(run)
+    colours = {n: f"C{k}" for k, n in enumerate(names)}
+    if x is None:
+        for k, (ts, values, sliding) in enumerate(pieces):
+            for n in names:
+                ax.plot(ts, values[n], color=SLIDING if sliding else colours[n],
+                        label=n if k == 0 else None)
+        ax.set_xlabel("t")
+        ax.legend()
+    else:
+        for ts, values, sliding in pieces:
+            ax.plot(values[x], values[y], color=SLIDING if sliding else colours[y])
+        for (_, a, _), (_, b, _) in zip(pieces, pieces[1:]):
+            before, after = (a[x][-1], a[y][-1]), (b[x][0], b[y][0])
+            if before != after:
+                ax.plot([before[0], after[0]], [before[1], after[1]], "--", color="grey")
+        ax.set_xlabel(x)
+        ax.set_ylabel(y)
+    ev = run.events
+    if ev is not None and len(ev["t"]) and x is None:
+        # Each event a tick on the time axis.
+        ax.plot(ev["t"], np.zeros_like(ev["t"]), "|", color="black", markersize=8,
+                transform=ax.get_xaxis_transform())
+    return ax
