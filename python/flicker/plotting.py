@@ -79,7 +79,11 @@ def plot(run, x: Optional[str] = None, y: Optional[str] = None, ax: Any = None):
         ax.legend()
     else:
         for ts, values, sliding in pieces:
-            ax.plot(values[x], values[y], color=SLIDING if sliding else colours[y])
+            # A slide that holds the state (a block stuck on a fixed
+            # surface) is a point: a dot shows it.
+            still = sliding and np.ptp(values[x]) == 0 and np.ptp(values[y]) == 0
+            ax.plot(values[x], values[y], "o" if still else "-",
+                    color=SLIDING if sliding else colours[y])
         for (_, a, _), (_, b, _) in zip(pieces, pieces[1:]):
             before, after = (a[x][-1], a[y][-1]), (b[x][0], b[y][0])
             if before != after:
