@@ -276,7 +276,8 @@ impl<'o> Ledger<'o> {
     /// The Zeno accumulation `what` has no resting mode: the run stops.
     pub fn unsettled(what: &str) -> End {
         End::zeno(format!(
-            "{what}; the model has no resting mode, so the run stops here"
+            "{what}; the model has no resting mode (an automaton's mode names one with `rest`), \
+             so the run stops here"
         ))
     }
 

@@ -188,3 +188,76 @@ fn a_guard_that_never_changes_is_refused() {
         );
     }
 }
+
+/// A ball written as an automaton whose mode names a `rest`: at its Zeno
+/// point `t* = sqrt(2 h / g) (1 + e) / (1 - e)` it settles into the
+/// resting mode with the state the rest gives, and rests to t_end. Without
+/// one, the stop says how to name one. A `rest` where it cannot apply
+/// (a mode switched by sign(), or into one) is refused, naming the field.
+#[test]
+fn an_automaton_names_its_resting_mode_with_rest() {
+    let (g, e, h) = (9.81f64, 0.8, 1.0f64);
+    let ball = |rest: Option<serde_json::Value>| {
+        let mut flight = json!({
+            "flow": {"y": "v", "v": "-g"},
+            "transitions": [{"name": "bounce", "guard": "y", "direction": "falling",
+                             "barrier": true, "reset": {"v": "-e * v"}}]});
+        if let Some(rest) = rest {
+            flight["rest"] = rest;
+        }
+        json!({
+            "model": "automaton",
+            "parameters": {"g": g, "e": e},
+            "states": ["y", "v"],
+            "initial": {"y": h, "v": 0.0},
+            "initial_mode": "flight",
+            "modes": {"flight": flight, "resting": {}},
+            "t_end": 6.0
+        })
+    };
+    let zeno = (2.0 * h / g).sqrt() * (1.0 + e) / (1.0 - e);
+    let (summary, events) = run_value(
+        &ball(Some(
+            json!({"to": "resting", "reset": {"y": "0", "v": "0"}}),
+        )),
+        &[],
+    );
+    let settle = events.last().unwrap();
+    assert_eq!(settle["guard"], "settle", "{settle}");
+    assert_eq!(settle["mode_after"], "resting");
+    assert!(
+        (f(&settle["t"]) - zeno).abs() < 1e-9,
+        "{settle} against {zeno}"
+    );
+    assert_eq!(summary["t_reached"], 6.0);
+    assert_eq!(summary["final_mode"], "resting");
+    assert_eq!(summary["final_state"], json!({"y": 0.0, "v": 0.0}));
+    assert!(
+        summary["reason"]
+            .as_str()
+            .unwrap()
+            .contains("settled into `resting`")
+    );
+    let (stopped, _) = run_value(&ball(None), &[]);
+    assert_eq!(stopped["status"], "zeno");
+    assert!(
+        stopped["reason"]
+            .as_str()
+            .unwrap()
+            .contains("names one with `rest`"),
+        "{stopped}"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("s.json");
+    let mut bad = ball(Some(json!({"to": "floor"})));
+    std::fs::write(&path, bad.to_string()).unwrap();
+    let done = flicker(&["check", path.to_str().unwrap()]);
+    assert_eq!(done.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&done.stderr).contains("modes.flight.rest.to"));
+    bad = ball(Some(json!({"to": "resting"})));
+    bad["modes"]["flight"]["flow"]["v"] = json!("-g - 0.1 * sign(v)");
+    std::fs::write(&path, bad.to_string()).unwrap();
+    let done = flicker(&["check", path.to_str().unwrap()]);
+    assert_eq!(done.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&done.stderr).contains("modes.flight.rest"));
+}

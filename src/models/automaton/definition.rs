@@ -96,6 +96,18 @@ pub struct Transition {
     pub barrier: bool,
 }
 
+/// Where the events of a mode's barriers pile up (a Zeno point, such as
+/// a ball's bounces): the mode the run goes on in, resting, and the state
+/// there.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Rest {
+    /// The mode the run goes on in.
+    pub to: usize,
+    /// The new value of some states, each from the values at the Zeno
+    /// point.
+    pub reset: Vec<(usize, Source)>,
+}
+
 /// One mode.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ModeDef {
@@ -105,6 +117,8 @@ pub struct ModeDef {
     pub flow: Vec<Option<Source>>,
     /// Its transitions, highest priority first (ties in file order).
     pub transitions: Vec<Transition>,
+    /// Where its events pile up, the resting mode and state, if it has one.
+    pub rest: Option<Rest>,
 }
 
 /// An automaton file's definition of the model.
@@ -541,6 +555,10 @@ fn mode(
             transitions.push(transition);
         }
     }
+    let rest = match f.optional("rest") {
+        None => None,
+        Some(value) => Some(rest(value, &f.path("rest"), &names, modes, name)?),
+    };
     f.finish()?;
     // A stable sort keeps file order among equal priorities.
     transitions.sort_by(|a, b| b.priority.total_cmp(&a.priority));
@@ -548,7 +566,40 @@ fn mode(
         name: name.to_string(),
         flow,
         transitions,
+        rest,
     })
+}
+
+/// A mode's `rest`: `to` (default the mode itself) and `reset`.
+fn rest(
+    value: &Value,
+    path: &str,
+    states: &[&str],
+    modes: &[&str],
+    mode: &str,
+) -> Result<Rest, SceneError> {
+    let mut f = Fields::open(value, path)?;
+    let to = match f.optional_string("to")? {
+        Some(target) => index_of(target, modes, "mode", &f.path("to"))?,
+        None => modes.iter().position(|m| *m == mode).unwrap_or(0),
+    };
+    let reset = match f.optional("reset") {
+        None => Vec::new(),
+        Some(value) => resets(value, &f.path("reset"), states)?,
+    };
+    f.finish()?;
+    Ok(Rest { to, reset })
+}
+
+/// A `reset` object: each state it names, and its new value.
+fn resets(value: &Value, path: &str, states: &[&str]) -> Result<Vec<(usize, Source)>, SceneError> {
+    let mut reset = Vec::new();
+    for (state, expr) in object(value, path)? {
+        let at = format!("{path}.{state}");
+        let i = index_of(state, states, "state", &at)?;
+        reset.push((i, Source::read(expr, &at)?));
+    }
+    Ok(reset)
 }
 
 fn transition(
@@ -589,15 +640,10 @@ fn transition(
             ));
         }
     };
-    let mut reset = Vec::new();
-    if let Some(value) = f.optional("reset") {
-        let reset_path = f.path("reset");
-        for (state, expr) in object(value, &reset_path)? {
-            let at = format!("{reset_path}.{state}");
-            let i = index_of(state, states, "state", &at)?;
-            reset.push((i, Source::read(expr, &at)?));
-        }
-    }
+    let reset = match f.optional("reset") {
+        None => Vec::new(),
+        Some(value) => resets(value, &f.path("reset"), states)?,
+    };
     let to = match f.optional_string("to")? {
         Some(target) => index_of(target, modes, "mode", &f.path("to"))?,
         None => modes.iter().position(|m| *m == mode).unwrap_or(0),

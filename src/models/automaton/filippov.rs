@@ -31,7 +31,7 @@
 //! applied on the spot). So does the start.
 
 use crate::engine::Direction;
-use crate::models::automaton::definition::{Definition, ModeDef, Source, Transition};
+use crate::models::automaton::definition::{Definition, ModeDef, Rest, Source, Transition};
 use crate::models::automaton::expr::Ast;
 use crate::models::automaton::expr::symbolic::{
     add, constant, derivative, div, fix_signs, mul, same, sign_arguments, sub, text,
@@ -176,8 +176,26 @@ pub fn expand(definition: &Definition) -> Result<Expanded, SceneError> {
         let energy_of = definition.energy.as_ref().map(|e| e[index].clone());
         let (transitions, transition_targets) = own(mode);
         if found.is_empty() {
+            // A resting mode is one of the file's: entered as it is.
+            let rest = match &mode.rest {
+                Some(rest) if !surfaces[rest.to].is_empty() => {
+                    return Err(SceneError::field(
+                        &format!("modes.{}.rest.to", mode.name),
+                        format!(
+                            "mode `{}` switches its flow by sign(): a resting mode must not",
+                            definition.modes[rest.to].name
+                        ),
+                    ));
+                }
+                Some(rest) => Some(Rest {
+                    to: first[rest.to],
+                    reset: rest.reset.clone(),
+                }),
+                None => None,
+            };
             modes.push(ModeDef {
                 transitions,
+                rest,
                 ..mode.clone()
             });
             targets.push(transition_targets);
@@ -187,6 +205,14 @@ pub fn expand(definition: &Definition) -> Result<Expanded, SceneError> {
                 all.push(e);
             }
             continue;
+        }
+        if mode.rest.is_some() {
+            return Err(SceneError::field(
+                &format!("modes.{}.rest", mode.name),
+                "a mode whose flow switches by sign() slides rather than piles up impacts: \
+                 it takes no rest"
+                    .into(),
+            ));
         }
         let family = families.len();
         let k = found.len();
@@ -325,6 +351,7 @@ pub fn expand(definition: &Definition) -> Result<Expanded, SceneError> {
                     .map(|a| Some(source(a, "region's flow")))
                     .collect(),
                 transitions: region_transitions,
+                rest: None,
             });
             targets.push(region_targets);
             stops.push(None);
@@ -402,6 +429,7 @@ pub fn expand(definition: &Definition) -> Result<Expanded, SceneError> {
                     name: name_of(plus, Some(j)),
                     flow,
                     transitions: sliding_transitions,
+                    rest: None,
                 });
                 targets.push(sliding_targets);
                 stops.push(None);
@@ -413,6 +441,7 @@ pub fn expand(definition: &Definition) -> Result<Expanded, SceneError> {
                 name: format!("{}[{}: repelling]", mode.name, surface.text),
                 flow: vec![None; definition.states.len()],
                 transitions: Vec::new(),
+                rest: None,
             });
             targets.push(Vec::new());
             stops.push(Some(format!(
@@ -426,6 +455,7 @@ pub fn expand(definition: &Definition) -> Result<Expanded, SceneError> {
             name: format!("{}[two surfaces]", mode.name),
             flow: vec![None; definition.states.len()],
             transitions: Vec::new(),
+            rest: None,
         });
         targets.push(Vec::new());
         stops.push(Some(format!(

@@ -58,6 +58,8 @@ struct CompiledMode {
     /// diagnoses.
     texts: Vec<(String, Vec<String>)>,
     resets: Vec<Reset>,
+    /// Where its barriers' events pile up: the resting mode and state.
+    rest: Option<Reset>,
     kind: Flow,
     linear: Option<(DMatrix<f64>, DVector<f64>)>,
     second_order: bool,
@@ -77,6 +79,17 @@ struct Reset {
     /// switching surfaces at the state after (see [`filippov`]).
     pick: Target,
     terminal: bool,
+}
+
+impl Reset {
+    /// Every new value from the values before the event, all at once.
+    fn apply(&self, x: &mut [f64]) {
+        let mut new = vec![0.0; self.targets.len()];
+        self.tape.eval_scratch(x, &mut new);
+        for (&i, v) in self.targets.iter().zip(new) {
+            x[i] = v;
+        }
+    }
 }
 
 /// A mode with switching surfaces, compiled (see [`filippov::Family`]).
@@ -161,6 +174,18 @@ impl Automaton {
                 culprit.error(e.at, &e.message)
             })
         };
+        // A reset's new values, one tape (none for a reset of nothing).
+        let new_values = |reset: &[(usize, Source)]| -> Result<Tape, SceneError> {
+            let sources: Vec<&Source> = reset.iter().map(|(_, s)| s).collect();
+            if sources.is_empty() {
+                Ok(Tape {
+                    ops: Vec::new(),
+                    outputs: Vec::new(),
+                })
+            } else {
+                compile(&sources)
+            }
+        };
         let zero = Source {
             text: "0".into(),
             path: String::new(),
@@ -203,22 +228,24 @@ impl Automaton {
                     barrier: t.barrier,
                 });
                 guard_tapes.push(tape);
-                let sources: Vec<&Source> = t.reset.iter().map(|(_, s)| s).collect();
                 resets.push(Reset {
-                    tape: if sources.is_empty() {
-                        Tape {
-                            ops: Vec::new(),
-                            outputs: Vec::new(),
-                        }
-                    } else {
-                        compile(&sources)?
-                    },
+                    tape: new_values(&t.reset)?,
                     targets: t.reset.iter().map(|(i, _)| *i).collect(),
                     to: t.to,
                     pick,
                     terminal: t.terminal,
                 });
             }
+            let rest = match &mode.rest {
+                Some(r) => Some(Reset {
+                    tape: new_values(&r.reset)?,
+                    targets: r.reset.iter().map(|(i, _)| *i).collect(),
+                    to: r.to,
+                    pick: Target::Fixed,
+                    terminal: false,
+                }),
+                None => None,
+            };
             let still = flow.constant().is_some_and(|c| c.iter().all(|&r| r == 0.0));
             let linear = flow.affine().then(|| {
                 let a = jacobian(&flow, &vec![0.0; n]);
@@ -250,6 +277,7 @@ impl Automaton {
                 guard_tapes,
                 texts,
                 resets,
+                rest,
                 kind: if still { Flow::Frozen } else { Flow::Ode },
                 linear,
                 second_order,
@@ -458,12 +486,7 @@ impl HybridModel for Automaton {
 
     fn reset(&self, mode: Mode, guard: usize, x: &mut [f64]) -> Jump {
         let reset = &self.modes[mode].resets[guard];
-        // Every new value from the values before the event, all at once.
-        let mut new = vec![0.0; reset.targets.len()];
-        reset.tape.eval_scratch(x, &mut new);
-        for (&i, v) in reset.targets.iter().zip(new) {
-            x[i] = v;
-        }
+        reset.apply(x);
         let (to, named) = match reset.pick {
             Target::Fixed => (reset.to, None),
             Target::Leave(guard) => return Jump::to(reset.to).leaving(guard),
@@ -484,6 +507,13 @@ impl HybridModel for Automaton {
             Some(name) => Jump::to(to).named(name),
             None => Jump::to(to),
         }
+    }
+
+    /// The mode's `rest`, where its barriers' events pile up.
+    fn settle(&self, mode: Mode, x: &mut [f64]) -> Option<Mode> {
+        let rest = self.modes[mode].rest.as_ref()?;
+        rest.apply(x);
+        Some(rest.to)
     }
 
     fn stop_reason(&self, mode: Mode) -> Option<String> {
