@@ -156,9 +156,12 @@ impl Linear {
         }
         self.evaluations.set(self.evaluations.get() + 1);
         if model.has_series(mode) {
-            self.fit_guards(model, mode);
+            let shortened_by = self.fit_guards(model, mode);
             if self.h < h_min {
-                return Err(StepFailure::Collapsed { h: self.h });
+                return Err(match shortened_by {
+                    Some(guard) => StepFailure::GuardCollapsed { h: self.h, guard },
+                    None => StepFailure::Collapsed { h: self.h },
+                });
             }
         }
         let mut y1 = std::mem::take(&mut self.y1);
@@ -174,7 +177,9 @@ impl Linear {
     /// and the step shortened until every one of them is summed to
     /// round-off by its terms: the state's series converge over `|M| h <=
     /// 1`, but a guard may read the clock through a sine of any frequency.
-    fn fit_guards<M: HybridModel + ?Sized>(&mut self, model: &M, mode: Mode) {
+    /// Returns the guard that shortened the step last, if one did: the one
+    /// to blame where the step collapses (`sqrt(x)` near `x = 0`).
+    fn fit_guards<M: HybridModel + ?Sized>(&mut self, model: &M, mode: Mode) -> Option<usize> {
         let w = ORDER + 1;
         let guards = model.guards(mode).len();
         self.guards.resize(guards * w, 0.0);
@@ -182,6 +187,7 @@ impl Linear {
         // (a guard's own coefficients, which a fast sine makes large, would
         // excuse any step).
         let scale = self.y0.iter().fold(1.0_f64, |m, v| m.max(v.abs()));
+        let mut shortened_by = None;
         for g in 0..guards {
             let c = &mut self.guards[g * w..(g + 1) * w];
             model.guard_series(mode, g, &self.series, ORDER, c);
@@ -194,8 +200,10 @@ impl Linear {
                     > 1e-20 * scale
             {
                 self.h *= 0.5;
+                shortened_by = Some(g);
             }
         }
+        shortened_by
     }
 
     /// The exact state `tau` after the step's start: the step's series

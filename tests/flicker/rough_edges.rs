@@ -261,3 +261,27 @@ fn an_automaton_names_its_resting_mode_with_rest() {
     assert_eq!(done.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&done.stderr).contains("modes.flight.rest"));
 }
+
+/// A guard that turns steep and then NaN (`sqrt(x) + 0.5` as `x` falls
+/// through zero) is named by every method that stops on it; the linear
+/// propagator blamed "the rate of `x`", which is constant.
+#[test]
+fn a_guard_that_breaks_down_is_named_by_every_method() {
+    let scene = json!({
+        "model": "automaton",
+        "states": ["x"],
+        "initial": {"x": 1.0},
+        "modes": {"m": {"flow": {"x": "-1"},
+            "transitions": [{"name": "root", "guard": "sqrt(x) + 0.5", "direction": "falling"}]}},
+        "t_end": 3.0
+    });
+    for args in [&[][..], &["--method", "taylor"], &["--method", "dop853"]] {
+        let (summary, _) = run_value(&scene, args);
+        assert_eq!(summary["status"], "failed", "{args:?}: {summary}");
+        let reason = summary["reason"].as_str().unwrap();
+        assert!(
+            reason.contains("guard `root`") && reason.contains("sqrt(x) + 0.5"),
+            "{args:?}: {reason}"
+        );
+    }
+}
