@@ -1,6 +1,7 @@
 //! `flicker continue`: a periodic orbit followed in a parameter, its
 //! bifurcations labelled, written to `DIR/continuation.csv` and drawn over
-//! the brute-force diagram in `DIR/bifurcation.svg` and `.png`.
+//! the brute-force diagram (`DIR/brute_force.csv`) in
+//! `DIR/bifurcation.svg` and `.png`.
 
 use std::path::{Path, PathBuf};
 
@@ -108,12 +109,15 @@ pub fn continue_orbit(args: ContinueArgs, registry: &Registry) -> Result<Code, F
             })?,
         None => most_varied(&branch, names.len(), p),
     };
-    let columns = if args.brute_force > 0 {
-        let last = branch
+    let mut columns = if args.brute_force > 0 {
+        // The whole branch's span: one that turns back at a fold reaches
+        // past its last point.
+        let (lo, hi) = branch
             .points
-            .last()
-            .map_or(first.parameter, |q| q.parameter);
-        let (lo, hi) = (first.parameter.min(last), first.parameter.max(last));
+            .iter()
+            .fold((first.parameter, first.parameter), |(lo, hi), q| {
+                (lo.min(q.parameter), hi.max(q.parameter))
+            });
         let values: Vec<f64> = (0..args.brute_force)
             .map(|i| lo + (hi - lo) * i as f64 / (args.brute_force.max(2) - 1) as f64)
             .collect();
@@ -129,8 +133,29 @@ pub fn continue_orbit(args: ContinueArgs, registry: &Registry) -> Result<Code, F
     } else {
         Vec::new()
     };
-    let figure = chart(&branch, &columns, &args.param, names[plotted], plotted);
+    // A forced system's clock is drawn, as the branch holds it, as the
+    // forcing's phase: the brute-force runs' absolute times would climb
+    // the picture as a ladder.
+    if let (Some(period), Some(clock)) = (args.forcing_period, names.iter().position(|n| *n == "t"))
+    {
+        for x in columns.iter_mut().flat_map(|c| c.states.iter_mut()) {
+            x[clock] = x[clock].rem_euclid(period);
+        }
+    }
+    let label = if names[plotted] == "t" && args.forcing_period.is_some() {
+        "t mod T (the forcing's phase)"
+    } else {
+        names[plotted]
+    };
+    let figure = chart(&branch, &columns, &args.param, label, plotted);
     let mut written = vec![csv];
+    if !columns.is_empty() {
+        let path = out.join("brute_force.csv");
+        write_brute_force(&columns, &names, p, &path).map_err(|e| {
+            Failure::untrusted(format!("{}: cannot be written: {e}", path.display()))
+        })?;
+        written.push(path);
+    }
     for name in ["bifurcation.svg", "bifurcation.png"] {
         let path = out.join(name);
         figure
@@ -230,6 +255,36 @@ fn write_csv(branch: &Branch, names: &[&str], p: usize, path: &Path) -> csv::Res
             q.label.clone(),
         ]);
         w.write_record(&row)?;
+    }
+    w.flush()?;
+    Ok(())
+}
+
+/// `brute_force.csv`: parameter, then each state just after a section
+/// event (the parameter's own left out; a forced system's clock as the
+/// forcing's phase), a row per event recorded.
+fn write_brute_force(columns: &[Column], names: &[&str], p: usize, path: &Path) -> csv::Result<()> {
+    let mut w = csv::Writer::from_path(path)?;
+    let mut header = vec!["parameter"];
+    header.extend(
+        names
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| *i != p)
+            .map(|(_, n)| *n),
+    );
+    w.write_record(&header)?;
+    for c in columns {
+        for x in &c.states {
+            let mut row = vec![c.parameter.to_string()];
+            row.extend(
+                x.iter()
+                    .enumerate()
+                    .filter(|(i, _)| *i != p)
+                    .map(|(_, v)| v.to_string()),
+            );
+            w.write_record(&row)?;
+        }
     }
     w.flush()?;
     Ok(())

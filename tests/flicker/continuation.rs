@@ -116,6 +116,41 @@ fn the_table_branch_follows_the_closed_form_and_period_doubles_where_it_should()
     for picture in ["bifurcation.svg", "bifurcation.png"] {
         assert!(std::fs::metadata(dir.path().join(picture)).unwrap().len() > 1000);
     }
+    // The brute-force dots span the whole branch, hold the clock as the
+    // forcing's phase (they climbed as a ladder of absolute times), and
+    // where the orbit is stable, well inside its range, lie on it.
+    let dots: Vec<Vec<f64>> = csv::Reader::from_path(dir.path().join("brute_force.csv"))
+        .unwrap()
+        .records()
+        .map(|r| r.unwrap().iter().map(|v| v.parse().unwrap()).collect())
+        .collect();
+    let params: Vec<f64> = rows[1..].iter().map(|r| r[0].parse().unwrap()).collect();
+    let (lo, hi) = params
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &a| {
+            (l.min(a), h.max(a))
+        });
+    let (first, last) = (dots[0][0], dots[dots.len() - 1][0]);
+    assert!(
+        (first - lo).abs() < 1e-12 && (last - hi).abs() < 1e-12,
+        "{first}..{last} against {lo}..{hi}"
+    );
+    let a_fold = gamma_1 * G / (W * W);
+    let mut on_branch = 0;
+    for dot in &dots {
+        let (a, t) = (dot[0], dot[3]);
+        assert!((0.0..period).contains(&t), "A {a}: t {t} is not a phase");
+        if a > a_fold + 0.2 * (a_pd - a_fold) && a < a_pd - 0.2 * (a_pd - a_fold) {
+            let phi = (PI * (1.0 - R) / ((1.0 + R) * gamma(a))).acos();
+            assert!(
+                (W * t - phi).abs() < 1e-3,
+                "A {a}: phase {} against {phi}",
+                W * t
+            );
+            on_branch += 1;
+        }
+    }
+    assert!(on_branch > 10, "{on_branch}");
 }
 
 #[test]
