@@ -30,8 +30,20 @@ import numpy as np
 
 from . import _flicker
 from ._flicker import SceneError
+from .plotting import bifurcation, work_precision
 
-__all__ = ["Run", "SceneError", "check", "compare", "continuation", "orbit", "run", "sweep"]
+__all__ = [
+    "Run",
+    "SceneError",
+    "bifurcation",
+    "check",
+    "compare",
+    "continuation",
+    "orbit",
+    "run",
+    "sweep",
+    "work_precision",
+]
 
 Scene = Union[str, "os.PathLike[str]", Dict[str, Any]]
 

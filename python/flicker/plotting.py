@@ -96,3 +96,61 @@ def plot(run, x: Optional[str] = None, y: Optional[str] = None, ax: Any = None):
         ax.plot(ev["t"], np.zeros_like(ev["t"]), "|", color="black", markersize=8,
                 transform=ax.get_xaxis_transform())
     return ax
+
+
+def bifurcation(branch: dict, state: Optional[str] = None, ax: Any = None):
+    """Draw a branch `flicker.continuation` returned: `state` at the section
+    (default: the one that varies most) against the parameter, solid where
+    the orbit is stable and dashed where not, each bifurcation circled and
+    named. Returns the Axes."""
+    import matplotlib.pyplot as plt
+
+    fixed = {"parameter", "period", "largest_multiplier", "stable", "label", "ended"}
+    states = [k for k in branch if k not in fixed]
+    if state is None:
+        state = max(states, key=lambda k: np.ptp(branch[k]))
+    elif state not in states:
+        raise ValueError(f"state: the branch has no {state!r} (its states: {', '.join(states)})")
+    if ax is None:
+        _, ax = plt.subplots()
+    p, y, stable = np.asarray(branch["parameter"]), np.asarray(branch[state]), branch["stable"]
+    start = 0
+    for k in range(1, len(p) + 1):
+        if k == len(p) or stable[k] != stable[start]:
+            # Each stretch joins the next one's first point: no gap.
+            end = min(k + 1, len(p))
+            ax.plot(p[start:end], y[start:end], "-" if stable[start] else "--", color="C0")
+            start = k
+    for k, label in enumerate(branch["label"]):
+        if label and label != "end":
+            ax.plot(p[k], y[k], "o", mfc="none", color="C3")
+            ax.annotate(label, (p[k], y[k]), textcoords="offset points", xytext=(4, 4))
+    ax.set_xlabel("parameter")
+    ax.set_ylabel(state)
+    return ax
+
+
+def work_precision(compared: dict, ax: Any = None):
+    """Draw what `flicker.compare` returned: each method's error at the end
+    against its wall time, both logarithmic, a line per method through its
+    tolerances (or steps). Runs that did not complete are left out.
+    Returns the Axes."""
+    import matplotlib.pyplot as plt
+
+    rows = compared["rows"]
+    if ax is None:
+        _, ax = plt.subplots()
+    methods = list(dict.fromkeys(rows["method"]))
+    for k, method in enumerate(methods):
+        keep = [i for i, (m, s) in enumerate(zip(rows["method"], rows["status"]))
+                if m == method and s == "completed"]
+        seconds = np.asarray(rows["wall_seconds"])[keep]
+        # An exact answer's zero error drawn at the smallest positive double.
+        error = np.maximum(np.asarray(rows["final_error"])[keep], np.finfo(float).tiny)
+        order = np.argsort(seconds)
+        ax.loglog(seconds[order], error[order], "o-", color=f"C{k}", label=method)
+    ax.set_xlabel("wall seconds")
+    ax.set_ylabel("error at the end")
+    ax.set_title(f"against {compared['reference']}")
+    ax.legend()
+    return ax

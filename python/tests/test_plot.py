@@ -64,3 +64,41 @@ def test_sliding_is_red_and_bad_requests_say_why():
         run.plot("x", "w")
     with pytest.raises(ValueError, match="both"):
         run.plot("x")
+
+
+def test_a_bifurcation_diagram_is_solid_where_stable_and_names_its_bifurcations():
+    branch = flicker.continuation(MODELS / "automata/vibrating_table.json", "impact", "A", 0.16,
+                                  settle=2, forcing_period=2 * np.pi / 10)
+    ax = flicker.bifurcation(branch, "t")
+    p, t, stable = branch["parameter"], branch["t"], np.asarray(branch["stable"])
+    solid = [l for l in ax.get_lines() if l.get_linestyle() == "-"]
+    dashed = [l for l in ax.get_lines() if l.get_linestyle() == "--"]
+    assert solid and dashed
+    # Every drawn point is a branch point, and a solid stretch's points are
+    # stable orbits but perhaps its last (the next stretch's first).
+    for line in solid:
+        x, y = line.get_data()
+        for a, b in zip(x[:-1], y[:-1]):
+            k = int(np.flatnonzero(p == a)[0])
+            assert t[k] == b and stable[k]
+    names = [c.get_text() for c in ax.texts]
+    assert "period doubling" in names
+    k = list(branch["label"]).index("period doubling")
+    assert ax.texts[names.index("period doubling")].xy == (p[k], t[k])
+    with pytest.raises(ValueError, match="no 'w'"):
+        flicker.bifurcation(branch, "w")
+
+
+def test_a_work_precision_chart_has_a_line_per_method_through_its_runs():
+    compared = flicker.compare(MODELS / "automata/impact_oscillator.json",
+                               methods=["taylor", "dop853"], tolerances=[1e-6, 1e-9, 1e-12])
+    ax = flicker.work_precision(compared)
+    lines = {l.get_label(): l for l in ax.get_lines()}
+    assert set(lines) == {"taylor", "dop853"}
+    rows = compared["rows"]
+    for method, line in lines.items():
+        x, y = line.get_data()
+        mine = [i for i, m in enumerate(rows["method"]) if m == method]
+        assert sorted(x) == sorted(rows["wall_seconds"][mine])
+        assert sorted(y) == sorted(rows["final_error"][mine])
+    assert ax.get_xscale() == ax.get_yscale() == "log"
