@@ -285,3 +285,29 @@ fn a_guard_that_breaks_down_is_named_by_every_method() {
         );
     }
 }
+
+/// `check` names an automaton's regime, as it does the mechanism's: forced
+/// or autonomous, its impacts and markers, switching surfaces, whether
+/// every flow is affine.
+#[test]
+fn check_names_an_automatons_regime() {
+    for (file, regime) in [
+        (
+            "bouncing_ball.json",
+            "regime: autonomous, impacting (`bounce`), every flow affine",
+        ),
+        (
+            "vibrating_table.json",
+            "regime: forced (reads the clock t), impacting (`impact`), every flow affine",
+        ),
+        (
+            "stick_slip_belt.json",
+            "regime: autonomous, impacting (`wall`), discontinuous (sign() in 1 mode(s): \
+             Filippov sliding), nonlinear",
+        ),
+    ] {
+        let done = flicker(&["check", &crate::automata::automaton(file)]);
+        let said = String::from_utf8_lossy(&done.stdout);
+        assert!(said.contains(regime), "{file}: {said}");
+    }
+}

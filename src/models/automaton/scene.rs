@@ -9,7 +9,7 @@ use crate::engine::zeno;
 use crate::engine::{
     EventTimes, HybridModel, Method, Observer, Sample, Status, Tolerances, simulate_sampled, taylor,
 };
-use crate::models::automaton::definition::Definition;
+use crate::models::automaton::definition::{Definition, Transition};
 use crate::models::automaton::model::Automaton;
 use crate::orbit::diagram::Column;
 use crate::orbit::{ContinuedBranch, Orbit, OrbitRequest};
@@ -74,6 +74,59 @@ pub fn scene(mut f: Fields) -> Result<Scene, SceneError> {
 }
 
 impl AutomatonScene {
+    /// What kind of hybrid system the file describes, in a few words:
+    /// forced or autonomous, its impacts, markers, mode changes and
+    /// terminal transitions, its switching surfaces and resting modes, and
+    /// whether every flow is affine.
+    fn regime(&self) -> String {
+        let d = &self.definition;
+        let mut said = vec![if d.reads_clock() {
+            "forced (reads the clock t)".to_string()
+        } else {
+            "autonomous".to_string()
+        }];
+        let named = |keep: &dyn Fn(&Transition, usize) -> bool| -> Vec<String> {
+            let mut names: Vec<String> = (d.modes.iter().enumerate())
+                .flat_map(|(i, m)| m.transitions.iter().map(move |t| (i, t)))
+                .filter(|(i, t)| keep(t, *i))
+                .map(|(_, t)| format!("`{}`", t.name))
+                .collect();
+            names.sort();
+            names.dedup();
+            names
+        };
+        for (what, names) in [
+            ("impacting", named(&|t, _| t.barrier)),
+            (
+                "markers",
+                named(&|t, i| !t.barrier && !t.terminal && t.to == i),
+            ),
+            ("mode changes", named(&|t, i| !t.barrier && t.to != i)),
+            ("terminal", named(&|t, _| t.terminal)),
+        ] {
+            if !names.is_empty() {
+                said.push(format!("{what} ({})", names.join(", ")));
+            }
+        }
+        let switched = (0..d.modes.len())
+            .filter(|&i| self.automaton.modes_of(i).len() > 1)
+            .count();
+        if switched > 0 {
+            said.push(format!(
+                "discontinuous (sign() in {switched} mode(s): Filippov sliding)"
+            ));
+        }
+        if d.modes.iter().any(|m| m.rest.is_some()) {
+            said.push("with resting modes".into());
+        }
+        said.push(if self.automaton.all_linear() {
+            "every flow affine".into()
+        } else {
+            "nonlinear".into()
+        });
+        said.join(", ")
+    }
+
     /// The method a run uses, and why: `Auto` resolves to the exact linear
     /// propagator where every flow is affine, else to Taylor's method at
     /// machine precision (unless told `rtol`/`atol`), else (a flow or guard
@@ -319,6 +372,7 @@ impl SceneModel for AutomatonScene {
                 ));
             }
         }
+        lines.push(format!("regime: {}", self.regime()));
         let (method, why) = self.resolved();
         lines.push(format!("method {}: {why}", method.name()));
         lines.push(format!(
