@@ -235,6 +235,13 @@ impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
                 observer,
             )
         };
+        if recorded.is_err() && all_finite(&before) {
+            // The run fails at the event: it reached its time, with the
+            // state just before it (a failure was reported at the last
+            // step's start, before the event it named).
+            self.origin = t;
+            self.state.copy_from_slice(&before);
+        }
         self.before = before;
         recorded?;
         std::mem::swap(&mut self.state, &mut self.after);

@@ -311,3 +311,35 @@ fn check_names_an_automatons_regime() {
         assert!(said.contains(regime), "{file}: {said}");
     }
 }
+
+/// A run that fails at an event (a reset that turns the state NaN) says it
+/// failed at that event's time, with the state just before it; it said
+/// the time its last step started, earlier than the event it named.
+#[test]
+fn a_run_that_fails_at_an_event_reached_that_event() {
+    let scene = json!({
+        "model": "automaton",
+        "states": ["y", "v"],
+        "initial": {"y": 1.0, "v": 0.0},
+        "modes": {"m": {"flow": {"y": "v", "v": "-9.81"},
+            "transitions": [{"name": "bounce", "guard": "y", "direction": "falling",
+                             "barrier": true, "reset": {"v": "sqrt(v)"}}]}},
+        "t_end": 3.0
+    });
+    let fall = (2.0f64 / 9.81).sqrt();
+    for args in [&[][..], &["--method", "taylor"], &["--method", "dop853"]] {
+        let (summary, _) = run_value(&scene, args);
+        assert_eq!(summary["status"], "failed", "{args:?}: {summary}");
+        let reason = summary["reason"].as_str().unwrap();
+        let at: f64 = reason
+            .split("event at t = ")
+            .nth(1)
+            .and_then(|s| s.split(' ').next())
+            .and_then(|s| s.parse().ok())
+            .unwrap_or_else(|| panic!("{reason}"));
+        assert_eq!(f(&summary["t_reached"]), at, "{args:?}: {summary}");
+        assert!((at - fall).abs() < 1e-9, "{args:?}: {at}");
+        let v = f(&summary["final_state"]["v"]);
+        assert!((v + 9.81 * fall).abs() < 1e-8, "{args:?}: {summary}");
+    }
+}
