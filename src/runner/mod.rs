@@ -50,6 +50,27 @@ pub struct Trajectory {
     pub report: Report,
 }
 
+impl Trajectory {
+    /// The trajectory of a run `run` makes, handing each sample it takes
+    /// to the callback it is given; `names` head the state's components.
+    pub fn record<E>(
+        names: Vec<&'static str>,
+        run: impl FnOnce(&mut dyn FnMut(&crate::engine::Sample)) -> Result<Report, E>,
+    ) -> Result<Trajectory, E> {
+        let (mut samples, mut bounds) = (Vec::new(), Vec::new());
+        let report = run(&mut |s| {
+            samples.push((s.t, s.state.to_vec()));
+            bounds.push(s.bound);
+        })?;
+        Ok(Trajectory {
+            names,
+            samples,
+            bounds,
+            report,
+        })
+    }
+}
+
 /// What may stop a run from outside the scene.
 #[derive(Debug, Clone, Default)]
 pub struct Control {

@@ -6,8 +6,20 @@
 
 use serde_json::json;
 
+use std::process::Output;
+
+use serde_json::Value;
+
 use crate::automata::{f, run_value};
 use crate::support::flicker;
+
+/// `flicker check` of `scene`, written to a file of its own.
+fn check(scene: &Value) -> Output {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("scene.json");
+    std::fs::write(&path, scene.to_string()).unwrap();
+    flicker(&["check", path.to_str().unwrap()])
+}
 
 /// `flicker run --help` names every method a scene's `solver` takes, and
 /// an unknown one is refused with the list.
@@ -81,10 +93,7 @@ fn an_initial_value_naming_a_state_is_told_so_without_a_near_miss() {
         "modes": {"m": {"flow": {"x": "v", "v": "-w^2 * x"}}},
         "t_end": 1.0
     });
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("s.json");
-    std::fs::write(&path, scene.to_string()).unwrap();
-    let done = flicker(&["check", path.to_str().unwrap()]);
+    let done = check(&scene);
     let said = String::from_utf8_lossy(&done.stderr);
     assert_eq!(done.status.code(), Some(2), "{said}");
     assert!(said.contains("initial.v"), "{said}");
@@ -150,10 +159,7 @@ fn check_names_the_expression_that_has_no_taylor_series() {
                   "transitions": [{"name": "corner", "guard": "min(x, v) + 2", "direction": "falling"}]}},
         "t_end": 1.0
     });
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("s.json");
-    std::fs::write(&path, scene.to_string()).unwrap();
-    let done = flicker(&["check", path.to_str().unwrap()]);
+    let done = check(&scene);
     let said = String::from_utf8_lossy(&done.stdout);
     assert_eq!(done.status.code(), Some(0), "{said}");
     assert!(
@@ -176,10 +182,7 @@ fn a_guard_that_never_changes_is_refused() {
                 "transitions": [{"name": "never", "guard": guard}]}},
             "t_end": 1.0
         });
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("s.json");
-        std::fs::write(&path, scene.to_string()).unwrap();
-        let done = flicker(&["check", path.to_str().unwrap()]);
+        let done = check(&scene);
         let said = String::from_utf8_lossy(&done.stderr);
         assert_eq!(done.status.code(), Some(2), "{guard}: {said}");
         assert!(
@@ -247,17 +250,13 @@ fn an_automaton_names_its_resting_mode_with_rest() {
             .contains("names one with `rest`"),
         "{stopped}"
     );
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("s.json");
     let mut bad = ball(Some(json!({"to": "floor"})));
-    std::fs::write(&path, bad.to_string()).unwrap();
-    let done = flicker(&["check", path.to_str().unwrap()]);
+    let done = check(&bad);
     assert_eq!(done.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&done.stderr).contains("modes.flight.rest.to"));
     bad = ball(Some(json!({"to": "resting"})));
     bad["modes"]["flight"]["flow"]["v"] = json!("-g - 0.1 * sign(v)");
-    std::fs::write(&path, bad.to_string()).unwrap();
-    let done = flicker(&["check", path.to_str().unwrap()]);
+    let done = check(&bad);
     assert_eq!(done.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&done.stderr).contains("modes.flight.rest"));
 }

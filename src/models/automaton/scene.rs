@@ -434,25 +434,9 @@ impl SceneModel for AutomatonScene {
         times: &[f64],
         observer: &mut dyn Observer,
     ) -> Option<Result<Trajectory, SceneError>> {
-        let (mut samples, mut bounds) = (Vec::with_capacity(times.len()), Vec::new());
-        let report = self.run_sampled(
-            control,
-            times,
-            &mut |s| {
-                samples.push((s.t, s.state.to_vec()));
-                bounds.push(s.bound);
-            },
-            observer,
-        );
-        let report = match report {
-            Ok(report) => report,
-            Err(e) => return Some(Err(e)),
-        };
-        Some(Ok(Trajectory {
-            names: self.automaton.state_names(0).to_vec(),
-            samples,
-            bounds,
-            report,
+        let names = self.automaton.state_names(0).to_vec();
+        Some(Trajectory::record(names, |on_sample| {
+            self.run_sampled(control, times, on_sample, observer)
         }))
     }
 

@@ -357,23 +357,10 @@ impl SceneModel for MechanismScene {
         times: &[f64],
         observer: &mut dyn Observer,
     ) -> Option<Result<Trajectory, SceneError>> {
-        let (mut samples, mut bounds) = (Vec::with_capacity(times.len()), Vec::new());
-        let report = super::run::run_sampled(
-            self,
-            control,
-            times,
-            &mut |s| {
-                samples.push((s.t, s.state.to_vec()));
-                bounds.push(s.bound);
-            },
-            observer,
-        );
-        Some(report.map(|report| Trajectory {
-            names: vec!["strain", "strain_rate"],
-            samples,
-            bounds,
-            report,
-        }))
+        Some(Trajectory::record(
+            vec!["strain", "strain_rate"],
+            |on_sample| super::run::run_sampled(self, control, times, on_sample, observer),
+        ))
     }
 
     /// The closed form (46) of the strain with impacts every `T_imp`,
