@@ -576,3 +576,52 @@ fn a_closed_stdout_is_not_a_crash() {
     );
     assert_eq!(read_json(&out.join("summary.json"))["status"], "completed");
 }
+
+/// `events --csv` gives every number of the log back bit for bit: each
+/// value's text in the log and in the CSV parse (by Rust's correctly
+/// rounded `str::parse`, not through the JSON reader under test) to the
+/// same double, over thousands of impacts of the forced impact oscillator.
+#[test]
+fn events_csv_keeps_every_number_of_the_log_bit_for_bit() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("run");
+    let done = flicker(&[
+        "run",
+        &crate::automata::automaton("impact_oscillator.json"),
+        "--out",
+        out.to_str().unwrap(),
+        "--t-end",
+        "20000",
+        "--quiet",
+    ]);
+    assert_eq!(done.status.code(), Some(0));
+    let log = out.join("events.jsonl");
+    let text = std::fs::read_to_string(&log).unwrap();
+    let csv_out = flicker(&["events", log.to_str().unwrap(), "--csv"]);
+    let mut reader = csv::Reader::from_reader(csv_out.stdout.as_slice());
+    let headers = reader.headers().unwrap().clone();
+    let rows: Vec<csv::StringRecord> = reader.records().map(|r| r.unwrap()).collect();
+    assert_eq!(rows.len(), text.lines().count());
+    assert!(rows.len() > 4000, "{} impacts", rows.len());
+    // The text after `"key":` (searched from `from`) up to the next , or }.
+    let raw = |line: &str, from: &str, key: &str| -> f64 {
+        let start = line.find(from).unwrap_or(0);
+        let at = start + line[start..].find(&format!("\"{key}\":")).unwrap() + key.len() + 3;
+        let end = at + line[at..].find([',', '}']).unwrap();
+        line[at..end].parse().unwrap()
+    };
+    let mut compared = 0;
+    for (line, row) in text.lines().zip(&rows) {
+        for (column, value) in headers.iter().zip(row.iter()) {
+            let want = match column.split_once('.') {
+                Some((side, state)) => raw(line, &format!("\"{side}\":"), state),
+                None if column == "t" => raw(line, "", "t"),
+                None => continue,
+            };
+            let got: f64 = value.parse().unwrap();
+            assert_eq!(got.to_bits(), want.to_bits(), "{column}: {value} in {line}");
+            compared += 1;
+        }
+    }
+    assert!(compared > 20_000, "{compared}");
+}
