@@ -10,7 +10,9 @@
 //! exp(-0.7 / (p - 1))`, where `rho` estimates the series' radius of
 //! convergence from its last two coefficients (relative to the state's
 //! size where `rtol` governs, absolute where `atol` does). The first term
-//! left out is then about `eps` of the state.
+//! left out is then about `eps` of the state. A step whose series no
+//! longer solves the flow at its end (a switch ahead in a saturated
+//! function, which no coefficient shows) is halved until it does.
 //!
 //! A guard's series on the step is a polynomial of degree `p`; its first
 //! crossing in the guard's direction is found by the certified search of
