@@ -305,24 +305,26 @@ impl Sweep {
         Ok(scene)
     }
 
-    /// Run the points of `shard`, in parallel, in point order.
-    pub fn run(&self, shard: Shard) -> Vec<Row> {
+    /// Run the points of `shard`, in parallel, in point order, under
+    /// `control`: once its stop flag is set, the runs under way end
+    /// `interrupted` and the points not begun are marked so.
+    pub fn run(&self, shard: Shard, control: &Control) -> Vec<Row> {
         let points: Vec<usize> = (shard.index..self.points()).step_by(shard.count).collect();
         // Points differ in cost by orders of magnitude (chattering orbits
         // make thousands of impacts): small pieces keep both cores busy.
         points
             .par_iter()
             .with_max_len(4)
-            .map(|&point| self.run_point(point))
+            .map(|&point| self.run_point(point, control))
             .collect()
     }
 
-    fn run_point(&self, point: usize) -> Row {
+    fn run_point(&self, point: usize, control: &Control) -> Row {
         let values = self.values_at(point);
         let failed = |reason: String| Row {
             point,
             values: values.clone(),
-            status: format!("invalid: {reason}"),
+            status: reason,
             events: 0,
             first_impact: None,
             impact_period: None,
@@ -336,12 +338,15 @@ impl Sweep {
             .and_then(|v| self.registry.from_value(&v))
         {
             Ok(scene) => scene,
-            Err(e) => return failed(e.to_string()),
+            Err(e) => return failed(format!("invalid: {e}")),
         };
+        if control.stopped() {
+            return failed("interrupted: not begun".into());
+        }
         let mut times = FirstAndLast::default();
-        let report = match scene.run(&Control::default(), &mut times) {
+        let report = match scene.run(control, &mut times) {
             Ok(report) => report,
-            Err(e) => return failed(e.to_string()),
+            Err(e) => return failed(format!("invalid: {e}")),
         };
         let o = &report.outcome;
         let impact_period = match times.span {

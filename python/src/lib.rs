@@ -12,6 +12,7 @@
 //! `interrupted`, within a fraction of a second.
 
 mod convert;
+mod interrupt;
 mod tools;
 
 use std::fs::File;
@@ -42,7 +43,7 @@ create_exception!(
 );
 
 /// How often the calling thread looks for a signal while a run goes on.
-const POLL: Duration = Duration::from_millis(50);
+pub(crate) const POLL: Duration = Duration::from_millis(50);
 
 /// The Python exception for an engine's refusal, with its parts.
 fn scene_error(py: Python<'_>, e: &EngineSceneError) -> PyErr {

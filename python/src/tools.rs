@@ -1,6 +1,6 @@
 //! `check`, `compare` and `sweep` as the command line runs them, their
 //! results as lists and NumPy columns instead of printed lines and CSV
-//! files. Long ones release the GIL.
+//! files. Long ones release the GIL and stop on Ctrl-C ([`interruptible`]).
 
 use std::path::{Path, PathBuf};
 
@@ -11,9 +11,11 @@ use serde_json::Value;
 
 use flicker::compare::{Plan, compare as run_compare};
 use flicker::orbit::OrbitRequest;
+use flicker::runner::Control;
 use flicker::scene::Registry;
 use flicker::sweep::{Row as SweepRow, Shard, Sweep, is_sweep, parse_text};
 
+use crate::interrupt::interruptible;
 use crate::{load, override_error, scene_error};
 
 /// The sweep given as JSON text or a file, if it is one (an object with
@@ -77,7 +79,13 @@ pub fn compare<'py>(
     let (scene, _) = load(py, text, path)?;
     let plan = Plan::new(&scene, methods, tolerances, steps)
         .map_err(|e| override_error(py, e.field.as_deref().unwrap_or("methods"), e.reason))?;
-    let compared = py.detach(|| run_compare(&scene, &plan, &mut |_| {}));
+    let compared = interruptible(py, |stop| {
+        let control = Control {
+            stop: Some(stop.clone()),
+            max_wall_seconds: None,
+        };
+        run_compare(&scene, &plan, &control, &mut |_| {})
+    })?;
     let (reference, rows) = compared.map_err(|e| scene_error(py, &e))?;
     let out = PyDict::new(py);
     out.set_item("reference", reference.kind)?;
@@ -135,7 +143,13 @@ pub fn sweep<'py>(
         });
     };
     let pool = rayon_pool(threads).map_err(|e| override_error(py, "threads", e))?;
-    let rows = py.detach(|| pool.install(|| spec.run(Shard::WHOLE)));
+    let rows = interruptible(py, |stop| {
+        let control = Control {
+            stop: Some(stop.clone()),
+            max_wall_seconds: None,
+        };
+        pool.install(|| spec.run(Shard::WHOLE, &control))
+    })?;
     let out = PyDict::new(py);
     let header = spec.header();
     let axes = &header[1..1 + spec.axes.len()];
@@ -197,6 +211,7 @@ fn request(
         events,
         settle,
         forcing_period,
+        stop: None,
     }
 }
 
@@ -216,7 +231,12 @@ pub fn orbit(
     let (scene, label) = load(py, text, path)?;
     let request = request(section.clone(), events, settle, forcing_period);
     let started = std::time::Instant::now();
-    let found = py.detach(|| scene.orbit(&request));
+    let found = interruptible(py, |stop| {
+        scene.orbit(&OrbitRequest {
+            stop: Some(stop.clone()),
+            ..request.clone()
+        })
+    })?;
     let found =
         found.map_err(|e| override_error(py, e.field.as_deref().unwrap_or("section"), e.reason))?;
     let json = flicker::cli::orbit::orbit_json(
@@ -249,7 +269,13 @@ pub fn continuation<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let (scene, _) = load(py, text, path)?;
     let request = request(section, events, settle, forcing_period);
-    let followed = py.detach(|| scene.continue_orbit(&request, &param, to, (points, max_step)));
+    let followed = interruptible(py, |stop| {
+        let request = OrbitRequest {
+            stop: Some(stop.clone()),
+            ..request.clone()
+        };
+        scene.continue_orbit(&request, &param, to, (points, max_step))
+    })?;
     let (branch, names, p) = followed
         .map_err(|e| override_error(py, e.field.as_deref().unwrap_or("param"), e.reason))?;
     let out = PyDict::new(py);

@@ -10,6 +10,7 @@ import time
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
+import pytest
 
 import flicker
 from conftest import MODELS
@@ -50,3 +51,54 @@ def test_ctrl_c_stops_a_long_run_within_a_second():
     assert run.status == "interrupted", run.summary
     assert returned - sent[0] < 1.0
     assert 0 < run.summary["t_reached"] < 1e12
+
+
+def _interrupted_within_a_second(call):
+    """Send SIGINT 0.5 s into `call()`: it must raise KeyboardInterrupt
+    within a second of the signal (it ignored Ctrl-C until done)."""
+    sent = []
+
+    def interrupt():
+        time.sleep(0.5)
+        sent.append(time.perf_counter())
+        os.kill(os.getpid(), signal.SIGINT)
+
+    threading.Thread(target=interrupt, daemon=True).start()
+    with pytest.raises(KeyboardInterrupt):
+        call()
+    returned = time.perf_counter()
+    assert sent, "the call ended before the signal"
+    assert returned - sent[0] < 1.0
+
+
+def _endless_mechanism():
+    scene = json.loads((MODELS / "mechanism_impacting.json").read_text())
+    scene["t_end"] = 1e12
+    scene["max_events"] = 10**15
+    return scene
+
+
+def test_ctrl_c_stops_a_sweep():
+    sweep = {"scene": _endless_mechanism(),
+             "grid": [{"key": "eta", "from": 1.1, "to": 1.3, "count": 4}]}
+    _interrupted_within_a_second(lambda: flicker.sweep(sweep))
+
+
+def test_ctrl_c_stops_a_comparison():
+    _interrupted_within_a_second(
+        lambda: flicker.compare(_endless_mechanism(), methods=["exact", "dop853"]))
+
+
+def test_ctrl_c_stops_an_orbit_search_and_a_continuation():
+    """Long transients (seconds here before their own errors stop them):
+    the transient is what Ctrl-C ends."""
+    mechanism = json.loads((MODELS / "automata/mechanism.json").read_text())
+    mechanism["t_end"] = 1e13
+    mechanism["max_events"] = 10**15
+    _interrupted_within_a_second(lambda: flicker.orbit(mechanism, "impact", settle=1e8))
+    table = json.loads((MODELS / "automata/vibrating_table.json").read_text())
+    table["t_end"] = 1e9
+    table["max_events"] = 10**15
+    _interrupted_within_a_second(
+        lambda: flicker.continuation(table, "impact", "A", 0.16, settle=1e7,
+                                     forcing_period=2 * np.pi / 10))

@@ -34,14 +34,17 @@ pub fn compare(
         "{:<8} {:>9} {:>9} {:>10} {:>10} {:>9} {:>10}  status",
         "method", "tol", "step", "seconds", "evals", "events", "error"
     );
-    let (reference, rows) = run_compare(&scene, &plan, &mut |row| eprintln!("{}", line(row)))
-        .map_err(|e| {
-            if e.untrusted {
-                Failure::untrusted(e.in_path(scene_path).to_string())
-            } else {
-                Failure::bad_input(e.in_path(scene_path))
-            }
-        })?;
+    let control = crate::runner::Control::default();
+    let (reference, rows) = run_compare(&scene, &plan, &control, &mut |row| {
+        eprintln!("{}", line(row))
+    })
+    .map_err(|e| {
+        if e.untrusted {
+            Failure::untrusted(e.in_path(scene_path).to_string())
+        } else {
+            Failure::bad_input(e.in_path(scene_path))
+        }
+    })?;
     crate::cli::setup::output_folder(&out)?;
     let csv = out.join("compare.csv");
     write_csv(&rows, &csv).map_err(|e| Failure::untrusted(format!("{}: {e}", csv.display())))?;

@@ -69,6 +69,7 @@ pub fn continue_orbit(args: ContinueArgs, registry: &Registry) -> Result<Code, F
         events: args.events,
         settle: args.settle,
         forcing_period: args.forcing_period,
+        stop: None,
     };
     let flag = |e: crate::scene::SceneError| {
         Failure::bad_input(format!(

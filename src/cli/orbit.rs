@@ -77,6 +77,7 @@ pub fn orbit(args: OrbitArgs, registry: &Registry) -> Result<Code, Failure> {
         events: args.events,
         settle: args.settle,
         forcing_period: args.forcing_period,
+        stop: None,
     };
     let out = args.out.unwrap_or_else(|| {
         let stem = args

@@ -53,7 +53,7 @@ pub fn sweep(
         })?;
     }
     let started = Instant::now();
-    let rows = pool.install(|| spec.run(shard));
+    let rows = pool.install(|| spec.run(shard, &crate::runner::Control::default()));
     let seconds = started.elapsed().as_secs_f64();
     let file = File::create(&out)
         .map_err(|e| Failure::bad_input(format!("{}: cannot be created: {e}", out.display())))?;

@@ -113,10 +113,13 @@ impl Plan {
     }
 }
 
-/// Run every method of `plan` on `scene` and measure it against the reference.
+/// Run every method of `plan` on `scene` and measure it against the
+/// reference; `control`'s stop flag ends the comparison between runs and
+/// interrupts the one under way.
 pub fn compare(
     scene: &Scene,
     plan: &Plan,
+    control: &runner::Control,
     progress: &mut dyn FnMut(&Row),
 ) -> Result<(Reference, Vec<Row>), SceneError> {
     let reference = scene.reference()?;
@@ -143,9 +146,17 @@ pub fn compare(
             _ => vec![spec(method, None, None)],
         };
         for setting in settings {
+            if control.stopped() {
+                return Err(SceneError {
+                    file: None,
+                    field: None,
+                    reason: "interrupted: the stop flag was set".into(),
+                    untrusted: true,
+                });
+            }
             let mut run_scene = scene.clone();
             run_scene.set_solver(setting.clone())?;
-            let row = measure(&run_scene, &setting, &reference)?;
+            let row = measure(&run_scene, &setting, &reference, control)?;
             progress(&row);
             rows.push(row);
         }
@@ -178,14 +189,21 @@ fn spec(method: &str, tolerance: Option<f64>, step: Option<f64>) -> SolverSpec {
 }
 
 /// Repeats of a run for its timing: at least 3, and until 50 ms have passed.
-fn measure(scene: &Scene, setting: &SolverSpec, reference: &Reference) -> Result<Row, SceneError> {
+fn measure(
+    scene: &Scene,
+    setting: &SolverSpec,
+    reference: &Reference,
+    control: &runner::Control,
+) -> Result<Row, SceneError> {
     let mut times = EventTimes::default();
     let start = Instant::now();
-    let report = scene.run(&runner::Control::default(), &mut times)?;
+    let report = scene.run(control, &mut times)?;
     let mut walls = vec![start.elapsed().as_secs_f64()];
-    while walls.len() < 3 || (walls.iter().sum::<f64>() < 0.05 && walls.len() < 1000) {
+    while !control.stopped()
+        && (walls.len() < 3 || (walls.iter().sum::<f64>() < 0.05 && walls.len() < 1000))
+    {
         let start = Instant::now();
-        scene.run(&runner::Control::default(), &mut ())?;
+        scene.run(control, &mut ())?;
         walls.push(start.elapsed().as_secs_f64());
     }
     walls.sort_by(f64::total_cmp);

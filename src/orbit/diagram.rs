@@ -37,6 +37,7 @@ pub fn brute_force(
         guard,
         events: 1,
         t_max,
+        stop: None,
     };
     Ok(values
         .par_iter()

@@ -74,7 +74,11 @@ pub fn start(
 ) -> Result<(Mode, Vec<f64>), String> {
     let (mut mode, mut x) = (mode, x0.to_vec());
     if settle > 0.0 {
-        let outcome = simulate(section.model, mode, &x, &Options::until(settle), &mut ());
+        let options = Options {
+            stop: section.stop.cloned(),
+            ..Options::until(settle)
+        };
+        let outcome = simulate(section.model, mode, &x, &options, &mut ());
         if outcome.status != Status::Completed {
             return Err(format!(
                 "the transient stopped at t = {}: {}",
@@ -102,6 +106,7 @@ pub fn search(model: &Automaton, request: &OrbitRequest, t_max: f64) -> Result<O
         guard: &request.guard,
         events: request.events,
         t_max,
+        stop: request.stop.as_ref(),
     };
     let n = model.dimension();
     let unknowns = Unknowns {
@@ -182,6 +187,7 @@ pub fn follow(
         guard: &request.guard,
         events: request.events,
         t_max,
+        stop: request.stop.as_ref(),
     };
     let unknowns = Unknowns {
         free: (0..n).filter(|&i| i != p).collect(),

@@ -37,6 +37,9 @@ pub struct Section<'a> {
     pub events: usize,
     /// The longest a return may take.
     pub t_max: f64,
+    /// Set from outside (Ctrl-C) to end the search: the run under way
+    /// ends at its next event, and the next map refuses.
+    pub stop: Option<&'a Arc<AtomicBool>>,
 }
 
 /// One return of the map.
@@ -65,10 +68,16 @@ struct Counter<'a> {
     modes: Vec<&'static str>,
     hit: Option<(f64, Mode, Vec<f64>)>,
     stop: Arc<AtomicBool>,
+    /// The section's stop from outside: a long transient ends at the next
+    /// event once it is set.
+    outside: Option<&'a Arc<AtomicBool>>,
 }
 
 impl Observer for Counter<'_> {
     fn on_event(&mut self, e: &EventRecord) -> std::io::Result<()> {
+        if self.outside.is_some_and(|s| s.load(Ordering::Relaxed)) {
+            self.stop.store(true, Ordering::Relaxed);
+        }
         if e.guard == self.guard && self.hit.is_none() {
             self.seen += 1;
             if self.seen == self.wanted {
@@ -108,6 +117,9 @@ impl Section<'_> {
         mode: Mode,
         x0: &[f64],
     ) -> Result<(f64, Mode, Vec<f64>), String> {
+        if self.stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
+            return Err("interrupted: the stop flag was set".into());
+        }
         let stop = Arc::new(AtomicBool::new(false));
         let options = Options {
             t_end: self.t_max,
@@ -129,10 +141,14 @@ impl Section<'_> {
                 .collect(),
             hit: None,
             stop,
+            outside: self.stop,
         };
         let outcome = simulate(model, mode, x0, &options, &mut counter);
         match counter.hit {
             Some(hit) => Ok(hit),
+            None if self.stop.is_some_and(|s| s.load(Ordering::Relaxed)) => {
+                Err("interrupted: the stop flag was set".into())
+            }
             None => Err(match outcome.status {
                 Status::Completed | Status::Interrupted => format!(
                     "only {} of {} `{}` events before t = {} (no return to the section)",

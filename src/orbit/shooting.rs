@@ -24,7 +24,7 @@ pub const TOLERANCE: f64 = 1e-12;
 /// What a search asks: the section guard, the events per period, a
 /// transient to let die out first, and the period of a forcing (for an
 /// automaton that reads the clock).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone)]
 pub struct OrbitRequest {
     /// The guard whose events are the section.
     pub guard: String,
@@ -35,6 +35,9 @@ pub struct OrbitRequest {
     /// The forcing's period, where the automaton reads the clock: the
     /// orbit's period is a whole number of them.
     pub forcing_period: Option<f64>,
+    /// Set from outside (Ctrl-C) to end the search or the branch at the
+    /// next return of the section map.
+    pub stop: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
 }
 
 /// A periodic orbit found (or why not).

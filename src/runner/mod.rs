@@ -81,6 +81,14 @@ pub struct Control {
 }
 
 impl Control {
+    /// Whether the stop flag is set: a tool that runs many scenes stops
+    /// between them.
+    pub fn stopped(&self) -> bool {
+        self.stop
+            .as_ref()
+            .is_some_and(|s| s.load(std::sync::atomic::Ordering::Relaxed))
+    }
+
     /// The engine's options for a scene's run under this control.
     pub fn options(
         &self,

@@ -152,7 +152,8 @@ fn dop853_event_times_fall_with_its_tolerance() {
         tolerances: vec![1e-9, 1e-10, 1e-11, 1e-12, 1e-13],
         steps: None,
     };
-    let (_, rows) = flicker::compare::compare(&scene, &plan, &mut |_| {}).unwrap();
+    let (_, rows) =
+        flicker::compare::compare(&scene, &plan, &Default::default(), &mut |_| {}).unwrap();
     let errors: Vec<f64> = rows
         .iter()
         .map(|r| r.max_event_time_error.unwrap())
