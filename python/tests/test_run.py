@@ -172,3 +172,28 @@ def test_t_eval_out_of_range_or_on_a_chain_is_refused():
         flicker.run(MODELS / "chain_cradle.json", t_eval=[0.0, 1.0])
     assert "offers no samples" in str(chain.value)
     assert flicker.run(MODELS / "automata/bouncing_ball.json").samples is None
+
+
+@pytest.mark.parametrize("name, states", [
+    ("mechanism_impacting.json", ["strain", "strain_rate"]),
+    ("automata/impact_oscillator.json", ["x", "v"]),
+])
+def test_samples_are_the_command_lines_bit_for_bit(name, states, cli, tmp_path):
+    """The mechanism's and the forced impact oscillator's samples, which
+    tests/flicker/samples.rs holds to their closed forms (1e-12, 1e-11),
+    are the same from Python as from the command line."""
+    times = np.linspace(0.0, 100.0, 501)
+    run = flicker.run(MODELS / name, t_eval=times)
+    done, out = cli("run", MODELS / name, "--out", tmp_path / "cli", "--quiet", "--samples", "2",
+                    "--at", ",".join(repr(float(t)) for t in times))
+    assert done.returncode == 2, "--samples and --at together are refused"
+    done, out = cli("run", MODELS / name, "--out", tmp_path / "cli", "--quiet",
+                    "--at", ",".join(repr(float(t)) for t in times))
+    assert done.returncode == 0, done.stderr
+    lines = (tmp_path / "cli" / "samples.csv").read_text().splitlines()
+    assert lines[0] == ",".join(["t", *states, "bound"])
+    table = np.array([[float(v) for v in line.split(",")] for line in lines[1:]])
+    assert np.array_equal(table[:, 0], run.samples["t"])
+    for k, state in enumerate(states):
+        assert np.array_equal(table[:, k + 1], run.samples[state])
+    assert np.array_equal(table[:, -1], run.samples["bound"])

@@ -6,7 +6,7 @@
 use serde_json::{Map, Value};
 
 use crate::engine::Direction;
-use crate::models::automaton::expr::symbolic::constant;
+use crate::models::automaton::expr::symbolic::{constant, never_zero};
 use crate::models::automaton::expr::{Ast, Scope, Tape, parse};
 use crate::scene::SceneError;
 use crate::scene::fields::{Fields, kind};
@@ -619,12 +619,12 @@ fn transition(
     }
     let guard = Source::read(f.required("guard")?, &f.path("guard"))?;
     let variables: Vec<&str> = states.iter().copied().chain(["t"]).collect();
-    if constant(&guard.ast, &variables).is_some() {
+    if constant(&guard.ast, &variables).is_some() || never_zero(&guard.ast) {
         return Err(SceneError::field(
             &f.path("guard"),
             format!(
-                "`{}` does not change with the state or the time: it never crosses zero, \
-                 so the transition could never fire",
+                "`{}` never crosses zero (it does not change with the state or the time, \
+                 or its form keeps one sign), so the transition could never fire",
                 guard.text
             ),
         ));

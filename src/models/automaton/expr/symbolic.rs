@@ -178,6 +178,93 @@ fn power_derivative(a: &Ast, b: &Ast, da: Ast, db: Ast) -> Ast {
     mul(pow(a.clone(), b.clone()), inner)
 }
 
+/// What can be told of an expression's sign from its form alone, whatever
+/// its names' values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Sign {
+    Positive,
+    NonNegative,
+    Negative,
+    NonPositive,
+    Unknown,
+}
+
+impl Sign {
+    fn flip(self) -> Sign {
+        match self {
+            Sign::Positive => Sign::Negative,
+            Sign::NonNegative => Sign::NonPositive,
+            Sign::Negative => Sign::Positive,
+            Sign::NonPositive => Sign::NonNegative,
+            Sign::Unknown => Sign::Unknown,
+        }
+    }
+
+    fn add(self, other: Sign) -> Sign {
+        use Sign::*;
+        match (self, other) {
+            (Positive, Positive | NonNegative) | (NonNegative, Positive) => Positive,
+            (NonNegative, NonNegative) => NonNegative,
+            (Negative, Negative | NonPositive) | (NonPositive, Negative) => Negative,
+            (NonPositive, NonPositive) => NonPositive,
+            _ => Unknown,
+        }
+    }
+
+    fn mul(self, other: Sign) -> Sign {
+        use Sign::*;
+        let strict = |s: Sign| matches!(s, Positive | Negative);
+        let positive = |s: Sign| matches!(s, Positive | NonNegative);
+        let negative = |s: Sign| matches!(s, Negative | NonPositive);
+        if self == Unknown || other == Unknown {
+            return Unknown;
+        }
+        let same = (positive(self) && positive(other)) || (negative(self) && negative(other));
+        match (same, strict(self) && strict(other)) {
+            (true, true) => Positive,
+            (true, false) => NonNegative,
+            (false, true) => Negative,
+            (false, false) => NonPositive,
+        }
+    }
+}
+
+fn sign(ast: &Ast) -> Sign {
+    match ast {
+        Ast::Number(x) if *x > 0.0 => Sign::Positive,
+        Ast::Number(x) if *x < 0.0 => Sign::Negative,
+        Ast::Number(x) if *x == 0.0 => Sign::NonNegative,
+        Ast::Neg(a) => sign(a).flip(),
+        Ast::Binary(Binary::Add, a, b) => sign(a).add(sign(b)),
+        Ast::Binary(Binary::Sub, a, b) => sign(a).add(sign(b).flip()),
+        Ast::Binary(Binary::Mul, a, b) => sign(a).mul(sign(b)),
+        // An even whole power is never negative.
+        Ast::Binary(Binary::Pow, a, b) => match b.as_ref() {
+            Ast::Number(n) if n.fract() == 0.0 && n.rem_euclid(2.0) == 0.0 => {
+                if matches!(sign(a), Sign::Positive | Sign::Negative) {
+                    Sign::Positive
+                } else {
+                    Sign::NonNegative
+                }
+            }
+            _ => Sign::Unknown,
+        },
+        Ast::Call(f, _, _) => match f.as_str() {
+            "exp" | "cosh" => Sign::Positive,
+            "abs" | "sqrt" | "hypot" => Sign::NonNegative,
+            _ => Sign::Unknown,
+        },
+        _ => Sign::Unknown,
+    }
+}
+
+/// Whether `ast` can never be zero, whatever its names' values, by its
+/// form alone (`x^2 + 1`, `exp(v) + 2`, `-(x^2) - 1`): a guard that never
+/// crosses zero.
+pub fn never_zero(ast: &Ast) -> bool {
+    matches!(sign(ast), Sign::Positive | Sign::Negative)
+}
+
 /// `ast` as an expression of the constants alone, where it is a polynomial
 /// whose variables cancel (`(x2 + 1) - (x2 - 1)`: the denominator of a
 /// sliding flow whose sides differ by a constant): its variables set to
@@ -335,6 +422,29 @@ mod tests {
         };
         let tape = crate::models::automaton::expr::Tape::compile(&[ast], &scope).unwrap();
         tape.eval1(&[x])
+    }
+
+    #[test]
+    fn a_sign_fixed_by_its_form_is_told() {
+        for text in [
+            "x^2 + 1",
+            "exp(v) + 2",
+            "-(x^2) - 1",
+            "abs(x) + 0.5",
+            "x^4 * 3 + cosh(t)",
+        ] {
+            assert!(never_zero(&parse(text).unwrap()), "{text}");
+        }
+        for text in [
+            "x^2 - 1",
+            "x + 1",
+            "sqrt(x)",
+            "x^3 + 1",
+            "c * x^2 + 1",
+            "x^2 * y^2",
+        ] {
+            assert!(!never_zero(&parse(text).unwrap()), "{text}");
+        }
     }
 
     #[test]
