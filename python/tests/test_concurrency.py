@@ -33,19 +33,23 @@ def test_runs_in_threads_give_the_results_of_runs_one_after_another():
         assert np.array_equal(a.events["after"], b.events["after"])
 
 
-def test_ctrl_c_stops_a_long_run_within_a_second():
-    scene = json.loads((MODELS / "mechanism_impacting.json").read_text())
-    scene["t_end"] = 1e12
-    scene["max_events"] = 10**15
+def _sigint_in(seconds):
+    """Send this process SIGINT `seconds` from now; the list gets the time
+    it was sent."""
     sent = []
 
     def interrupt():
-        time.sleep(0.5)
+        time.sleep(seconds)
         sent.append(time.perf_counter())
         os.kill(os.getpid(), signal.SIGINT)
 
     threading.Thread(target=interrupt, daemon=True).start()
-    run = flicker.run(scene, events=False)
+    return sent
+
+
+def test_ctrl_c_stops_a_long_run_within_a_second():
+    sent = _sigint_in(0.5)
+    run = flicker.run(_endless_mechanism(), events=False)
     returned = time.perf_counter()
     assert sent, "the run ended before the signal"
     assert run.status == "interrupted", run.summary
@@ -56,14 +60,7 @@ def test_ctrl_c_stops_a_long_run_within_a_second():
 def _interrupted_within_a_second(call):
     """Send SIGINT 0.5 s into `call()`: it must raise KeyboardInterrupt
     within a second of the signal (it ignored Ctrl-C until done)."""
-    sent = []
-
-    def interrupt():
-        time.sleep(0.5)
-        sent.append(time.perf_counter())
-        os.kill(os.getpid(), signal.SIGINT)
-
-    threading.Thread(target=interrupt, daemon=True).start()
+    sent = _sigint_in(0.5)
     with pytest.raises(KeyboardInterrupt):
         call()
     returned = time.perf_counter()

@@ -28,6 +28,17 @@ pub const OTHERS: [&[&str]; 2] = [
     &["--method", "dopri5", "--rtol", "1e-12", "--atol", "1e-12"],
 ];
 
+/// What a run by `args` is held to against a closed form, `(event time,
+/// state)`: 1e-12 for the exact methods (the propagator, Taylor's at
+/// machine precision), the run's own stated bounds for the others.
+pub fn allowance(args: &[&str], summary: &Value) -> (f64, f64) {
+    if EXACT.contains(&args) {
+        (1e-12, 1e-12)
+    } else {
+        (f(&summary["event_time_bound"]), f(&summary["error_bound"]))
+    }
+}
+
 /// Events `(t, guard, mode after)` of a run against the closed form's,
 /// each time within `tolerance`.
 pub fn events_match(events: &[Value], want: &[(f64, &str, &str)], tolerance: f64, what: &str) {
@@ -70,12 +81,7 @@ fn the_friction_oscillator_turns_and_sticks_where_its_closed_form_does() {
     for args in EXACT.iter().chain(&OTHERS) {
         let (summary, events) = run(&automaton("friction_oscillator.json"), args);
         let what = format!("{args:?}");
-        let exact = EXACT.contains(args);
-        let (time, state) = if exact {
-            (1e-12, 1e-12)
-        } else {
-            (f(&summary["event_time_bound"]), f(&summary["error_bound"]))
-        };
+        let (time, state) = allowance(args, &summary);
         assert_eq!(summary["status"], "completed", "{what}: {summary}");
         events_match(&events, &want, time, &what);
         // It rests there, exactly on the surface.
@@ -114,11 +120,7 @@ fn relay_feedback_sticks_at_the_amplitude_its_half_swings_give() {
     for args in EXACT.iter().chain(&OTHERS) {
         let (summary, events) = run(&automaton("relay_feedback.json"), args);
         let what = format!("{args:?}");
-        let (time, state) = if EXACT.contains(args) {
-            (1e-12, 1e-12)
-        } else {
-            (f(&summary["event_time_bound"]), f(&summary["error_bound"]))
-        };
+        let (time, state) = allowance(args, &summary);
         assert_eq!(summary["status"], "completed", "{what}: {summary}");
         events_match(&events, &want, time, &what);
         assert!(
@@ -205,11 +207,7 @@ fn a_forced_relay_slides_and_leaves_where_its_forcing_reaches_the_relay() {
     for args in [&["--method", "taylor"][..]].iter().chain(&OTHERS) {
         let (summary, events) = run(&automaton("forced_relay.json"), args);
         let what = format!("{args:?}");
-        let (time, state) = if args.len() == 2 {
-            (1e-12, 1e-12)
-        } else {
-            (f(&summary["event_time_bound"]), f(&summary["error_bound"]))
-        };
+        let (time, state) = allowance(args, &summary);
         assert_eq!(summary["status"], "completed", "{what}: {summary}");
         events_match(&events, &want, time, &what);
         assert!(

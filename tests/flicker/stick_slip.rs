@@ -15,7 +15,7 @@
 use serde_json::Value;
 
 use crate::automata::{automaton, f, run, run_value};
-use crate::filippov::{EXACT, OTHERS, events_match};
+use crate::filippov::{EXACT, OTHERS, allowance, events_match};
 use crate::support::{SvgChart, flicker};
 
 const STICK: &str = "block[v - vb=0]";
@@ -199,11 +199,7 @@ fn with_friction_falling_linearly_every_event_is_its_closed_form() {
     for args in EXACT.iter().chain(&OTHERS) {
         let (summary, events) = run_value(&scene, args);
         let what = format!("{args:?}");
-        let (time, state) = if EXACT.contains(args) {
-            (1e-12, 1e-12)
-        } else {
-            (f(&summary["event_time_bound"]), f(&summary["error_bound"]))
-        };
+        let (time, state) = allowance(args, &summary);
         if args.is_empty() {
             // Every region is affine: the exact propagator runs it.
             assert_eq!(summary["method"], "linear", "{summary}");

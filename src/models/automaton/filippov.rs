@@ -214,15 +214,16 @@ pub fn expand(definition: &Definition) -> Result<Expanded, SceneError> {
                     .into(),
             ));
         }
+        // The flow the surfaces were read from: errors point into it.
+        let Some(source) = mode.flow.iter().flatten().next() else {
+            return Err(SceneError::field(
+                &format!("modes.{}.flow", mode.name),
+                "reads sign() but has no rate to read it from".into(),
+            ));
+        };
         let family = families.len();
         let k = found.len();
         if k > MAX_SURFACES {
-            let source = mode
-                .flow
-                .iter()
-                .flatten()
-                .next()
-                .expect("a flow reads sign()");
             return Err(source.error(
                 found[MAX_SURFACES].1,
                 &format!(
@@ -274,15 +275,7 @@ pub fn expand(definition: &Definition) -> Result<Expanded, SceneError> {
         // The rate of surface j along the flow `flow`: dh/dx . flow (+ dh/dt).
         let lie = |j: usize, flow: &[Ast]| -> Result<Ast, SceneError> {
             let (h, at) = &found[j];
-            let fail = |why: String| {
-                let source = mode
-                    .flow
-                    .iter()
-                    .flatten()
-                    .next()
-                    .expect("a flow reads sign()");
-                source.error(*at, &why)
-            };
+            let fail = |why: String| source.error(*at, &why);
             let mut rate = derivative(h, "t", &varies).map_err(fail)?;
             for (state, f) in definition.states.iter().zip(flow) {
                 let d = derivative(h, state, &varies).map_err(fail)?;
