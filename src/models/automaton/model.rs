@@ -84,9 +84,18 @@ struct Reset {
 impl Reset {
     /// Every new value from the values before the event, all at once.
     fn apply(&self, x: &mut [f64]) {
-        let mut new = vec![0.0; self.targets.len()];
-        self.tape.eval_scratch(x, &mut new);
-        for (&i, v) in self.targets.iter().zip(new) {
+        // On the stack for the few states a reset names: no allocation per
+        // event.
+        let (mut small, mut large) = ([0.0; 8], Vec::new());
+        let new: &mut [f64] = match self.targets.len() {
+            n if n <= small.len() => &mut small[..n],
+            n => {
+                large.resize(n, 0.0);
+                &mut large
+            }
+        };
+        self.tape.eval_scratch(x, new);
+        for (&i, &v) in self.targets.iter().zip(new.iter()) {
             x[i] = v;
         }
     }
