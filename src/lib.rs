@@ -71,6 +71,8 @@ pub mod orbit;
 pub mod plot;
 pub mod runner;
 pub mod scene;
+pub mod sensitivities;
+pub mod session;
 pub mod stress;
 pub mod sweep;
 pub mod time;

@@ -34,6 +34,7 @@ use flicker::log::summary::summary;
 use flicker::runner::Control;
 use flicker::scene::solver::SolverSpec;
 use flicker::scene::{Registry, Scene, SceneError as EngineSceneError};
+use flicker::session::RunRequest;
 
 create_exception!(
     _flicker,
@@ -144,8 +145,7 @@ fn run<'py>(
     }
     // After the method: whether it can carry the derivatives depends on it.
     if let Some(directions) = &sensitivities {
-        scene
-            .set_sensitivities(directions)
+        flicker::sensitivities::check(&scene, directions)
             .map_err(|e| override_error(py, "sensitivities", e.reason))?;
     }
     let times = match &t_eval {
@@ -187,18 +187,12 @@ fn run<'py>(
             // given before the caller waits is kept for it).
             let caller = std::thread::current();
             let (scene, control, keep, finished) = (&scene, &control, &mut keep, &done);
-            let times = times.as_deref();
+            let request = RunRequest {
+                sensitivities: sensitivities.clone(),
+                times: times.clone(),
+            };
             let worker = s.spawn(move || {
-                let report = match times {
-                    None => scene.run(control, keep).map(|report| (report, None)),
-                    Some(times) => match scene.sampled(control, times, keep) {
-                        Some(ran) => ran.map(|t| (t.report.clone(), Some(t))),
-                        None => Err(EngineSceneError::field(
-                            "t_eval",
-                            "the scene offers no samples of its state".into(),
-                        )),
-                    },
-                };
+                let report = request.run(scene, control, keep);
                 finished.store(true, Ordering::Release);
                 caller.unpark();
                 report

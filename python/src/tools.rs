@@ -231,11 +231,15 @@ pub fn orbit(
     let (scene, label) = load(py, text, path)?;
     let request = request(section.clone(), events, settle, forcing_period);
     let started = std::time::Instant::now();
+    let family = scene
+        .family()
+        .map_err(|e| override_error(py, "section", e.reason))?;
     let found = interruptible(py, |stop| {
-        scene.orbit(&OrbitRequest {
+        let request = OrbitRequest {
             stop: Some(stop.clone()),
             ..request.clone()
-        })
+        };
+        flicker::orbit::search(&*family, &request, scene.t_end())
     })?;
     let found =
         found.map_err(|e| override_error(py, e.field.as_deref().unwrap_or("section"), e.reason))?;
@@ -269,12 +273,22 @@ pub fn continuation<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let (scene, _) = load(py, text, path)?;
     let request = request(section, events, settle, forcing_period);
+    let family = scene
+        .family()
+        .map_err(|e| override_error(py, "param", e.reason))?;
     let followed = interruptible(py, |stop| {
         let request = OrbitRequest {
             stop: Some(stop.clone()),
             ..request.clone()
         };
-        scene.continue_orbit(&request, &param, to, (points, max_step))
+        flicker::orbit::follow(
+            &*family,
+            &request,
+            &param,
+            to,
+            (points, max_step),
+            scene.t_end(),
+        )
     })?;
     let (branch, names, p) = followed
         .map_err(|e| override_error(py, e.field.as_deref().unwrap_or("param"), e.reason))?;

@@ -98,3 +98,26 @@ def test_the_table_branch_period_doubles_where_the_closed_form_says():
     assert abs(branch["parameter"][k] - gamma_pd * G / W**2) < 1e-8
     assert branch["parameter"].dtype == np.float64
     assert all(branch["stable"][:k]) and not any(branch["stable"][k + 1 :])
+
+
+def test_the_built_in_mechanism_has_orbits_and_sensitivities_too():
+    """The paper's own model (not an automaton): its impacting orbit's period
+    is T_imp = 2 atan2(sqrt(2 H0), 1 - eta), both multipliers 1, and its
+    sensitivity along initial.strain meets a central difference of the
+    closed form."""
+    scene = MODELS / "mechanism_impacting.json"
+    found = flicker.orbit(scene, "impact")
+    assert found["converged"], found
+    t_imp = 2 * math.atan2(math.sqrt(0.1), 1 - 1.2)
+    assert abs(found["period"] - t_imp) < 1e-12 * t_imp
+    assert all(abs(re - 1) < 1e-8 and abs(im) < 1e-8 for re, im in found["multipliers"])
+
+    run = flicker.run(scene, t_end=20.0, sensitivities=["initial.strain"])
+    got = run.summary["sensitivities"]["initial.strain"]["final_state"]["strain"]
+    # From the apex of H0 = 0.05 at eta 1.2: strain0 = c + sqrt(c^2 + 2 H0).
+    c = 0.2
+    strain0 = c + math.sqrt(c * c + 0.1)
+    h = 1e-6
+    up = mechanism_closed_form(1.2, strain0 + h, 20.0)[1][0]
+    down = mechanism_closed_form(1.2, strain0 - h, 20.0)[1][0]
+    assert abs(got - (up - down) / (2 * h)) < 1e-6

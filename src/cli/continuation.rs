@@ -78,9 +78,18 @@ pub fn continue_orbit(args: ContinueArgs, registry: &Registry) -> Result<Code, F
             e.reason
         ))
     };
-    let (branch, names, p) = scene
-        .continue_orbit(&request, &args.param, args.to, (args.points, args.max_step))
-        .map_err(flag)?;
+    let family = scene
+        .family()
+        .map_err(|e| Failure::bad_input(format!("{}: {}", args.scene.display(), e.reason)))?;
+    let (branch, names, p) = crate::orbit::follow(
+        &*family,
+        &request,
+        &args.param,
+        args.to,
+        (args.points, args.max_step),
+        scene.t_end(),
+    )
+    .map_err(flag)?;
     let out = args.out.clone().unwrap_or_else(|| {
         let stem = args
             .scene
@@ -122,15 +131,14 @@ pub fn continue_orbit(args: ContinueArgs, registry: &Registry) -> Result<Code, F
         let values: Vec<f64> = (0..args.brute_force)
             .map(|i| lo + (hi - lo) * i as f64 / (args.brute_force.max(2) - 1) as f64)
             .collect();
-        scene
-            .brute_force(
-                &args.param,
-                &values,
-                &args.section,
-                scene.t_end() / 2.0,
-                args.brute_force_events,
-            )
-            .map_err(flag)?
+        crate::orbit::diagram::brute_force(
+            &*family,
+            &args.param,
+            &values,
+            &args.section,
+            (scene.t_end() / 2.0, args.brute_force_events, scene.t_end()),
+        )
+        .map_err(flag)?
     } else {
         Vec::new()
     };

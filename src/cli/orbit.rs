@@ -15,7 +15,7 @@ use crate::cli::exit::{Code, Failure};
 /// `flicker orbit`'s arguments.
 #[derive(Debug, clap::Args)]
 pub struct OrbitArgs {
-    /// The scene file (an automaton).
+    /// The scene file (any model with a finite state).
     scene: PathBuf,
     /// The transition whose events are the section (an impact).
     #[arg(long, value_name = "GUARD")]
@@ -87,7 +87,10 @@ pub fn orbit(args: OrbitArgs, registry: &Registry) -> Result<Code, Failure> {
         Path::new("out").join(format!("{stem}-orbit"))
     });
     let started = Instant::now();
-    let orbit = scene.orbit(&request).map_err(|e| {
+    let family = scene
+        .family()
+        .map_err(|e| Failure::bad_input(format!("{}: {}", args.scene.display(), e.reason)))?;
+    let orbit = crate::orbit::search(&*family, &request, scene.t_end()).map_err(|e| {
         Failure::bad_input(format!(
             "--{}: {}",
             e.field.clone().unwrap_or_default().replace('_', "-"),

@@ -13,6 +13,7 @@ use crate::runner::ensemble::EnsembleRequest;
 use crate::runner::{Control, Report, Trajectory};
 use crate::scene::solver::{METHODS, SolverSpec};
 use crate::scene::{Registry, Scene};
+use crate::session::RunRequest;
 
 use crate::cli::exit::{Code, Failure};
 use crate::cli::progress::WithProgress;
@@ -144,8 +145,7 @@ pub fn run(args: RunArgs, registry: &Registry) -> Result<Code, Failure> {
         })?;
     }
     if let Some(directions) = &sensitivities {
-        scene
-            .set_sensitivities(directions)
+        crate::sensitivities::check(&scene, directions)
             .map_err(|e| Failure::bad_input(format!("--sensitivities: {}", e.reason)))?;
     }
     let ensemble = match ensemble.ensemble {
@@ -178,6 +178,10 @@ pub fn run(args: RunArgs, registry: &Registry) -> Result<Code, Failure> {
             scene.model()
         )));
     }
+    let request = RunRequest {
+        sensitivities,
+        times,
+    };
     let out = out.unwrap_or_else(|| default_out(scene_path));
     crate::cli::setup::output_folder(&out)?;
     let control = Control {
@@ -192,7 +196,7 @@ pub fn run(args: RunArgs, registry: &Registry) -> Result<Code, Failure> {
         // refuses as it starts leaves no log, and an earlier one untouched.
         let file = LazyFile::new(&log_path);
         let mut observer = WithProgress::new(JsonlWriter::new(file), scene.t_end(), quiet);
-        let ran = run_scene(&scene, &control, times.as_deref(), &mut observer);
+        let ran = request.run(&scene, &control, &mut observer);
         observer.finish();
         let (mut report, sampled) = ran.map_err(|e| Failure::bad_input(e.in_path(scene_path)))?;
         states = sampled;
@@ -216,7 +220,7 @@ pub fn run(args: RunArgs, registry: &Registry) -> Result<Code, Failure> {
         report
     } else {
         let mut observer = WithProgress::new((), scene.t_end(), quiet);
-        let ran = run_scene(&scene, &control, times.as_deref(), &mut observer);
+        let ran = request.run(&scene, &control, &mut observer);
         observer.finish();
         let (report, sampled) = ran.map_err(|e| Failure::bad_input(e.in_path(scene_path)))?;
         states = sampled;
@@ -331,27 +335,6 @@ pub fn run(args: RunArgs, registry: &Registry) -> Result<Code, Failure> {
         Status::Failed => Code::Untrusted,
         Status::Interrupted => Code::Interrupted,
     })
-}
-
-/// Run `scene`, sampled at `times` where asked: the report, and the
-/// samples with their bounds (the trajectory, its report moved out).
-fn run_scene(
-    scene: &Scene,
-    control: &Control,
-    times: Option<&[f64]>,
-    observer: &mut dyn crate::engine::Observer,
-) -> Result<(Report, Option<Trajectory>), crate::scene::SceneError> {
-    let Some(times) = times else {
-        return scene.run(control, observer).map(|report| (report, None));
-    };
-    match scene.sampled(control, times, observer) {
-        Some(Ok(trajectory)) => Ok((trajectory.report.clone(), Some(trajectory))),
-        Some(Err(e)) => Err(e),
-        None => Err(crate::scene::SceneError::field(
-            "samples",
-            format!("a {} scene offers no samples of its state", scene.model()),
-        )),
-    }
 }
 
 fn default_out(scene: &Path) -> PathBuf {

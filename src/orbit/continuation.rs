@@ -30,7 +30,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use crate::engine::{HybridModel, Mode};
+use crate::engine::Mode;
 use crate::orbit::section::{Return, Section};
 use crate::orbit::shooting::{Unknowns, least_squares, multipliers};
 
@@ -191,7 +191,7 @@ fn correct(
     let mut x = x;
     for _ in 0..CORRECTOR_ITERATIONS {
         let back = section.map(mode, &x)?;
-        if back.mode != mode {
+        if !section.family.same_motion(mode, back.mode) {
             return Err(format!(
                 "the orbit returns in mode `{}`, not `{}`",
                 section.model.mode_name(back.mode),

@@ -5,7 +5,7 @@
 
 use rayon::prelude::*;
 
-use crate::models::automaton::{Automaton, Definition};
+use crate::engine::Family;
 use crate::orbit::{Section, start};
 use crate::scene::SceneError;
 
@@ -19,21 +19,23 @@ pub struct Column {
     pub states: Vec<Vec<f64>>,
 }
 
-/// At each of `values` of `parameter`, from the scene's initial state:
-/// `settle` run through, then the states after the next `events` events of
-/// `guard`, each within `t_max` of the one before.
+/// At each of `values` of `parameter` of `family`, from the scene's
+/// start: `settle` run through, then the states after the next `events`
+/// events of `guard`, each within `t_max` of the one before.
 pub fn brute_force(
-    definition: &Definition,
+    family: &dyn Family,
     parameter: &str,
     values: &[f64],
     guard: &str,
     (settle, events, t_max): (f64, usize, f64),
 ) -> Result<Vec<Column>, SceneError> {
-    let (promoted, _) = definition.with_parameters_as_states(&[parameter.to_string()], "param")?;
-    let model = Automaton::compile(&promoted)?;
-    let p = definition.states.len();
+    let promoted = family
+        .promoted(&[parameter.to_string()])
+        .map_err(|why| SceneError::field("param", why))?;
+    let p = promoted.parameters[0];
     let section = Section {
-        model: &model,
+        family,
+        model: &*promoted.model,
         guard,
         events: 1,
         t_max,
@@ -43,13 +45,21 @@ pub fn brute_force(
         .par_iter()
         .map(|&value| {
             // The start at this value: initial values may depend on it.
-            let mut x0 = model.initial().to_vec();
-            if let Ok(initial) = definition.initial_with(parameter, value) {
-                x0[..p].copy_from_slice(&initial);
-            }
-            x0[p] = value;
+            let (mode, own) = family
+                .start_with(parameter, value)
+                .unwrap_or_else(|_| family.start());
+            let mut rest = own.into_iter();
+            let x0: Vec<f64> = (0..promoted.start.len())
+                .map(|i| {
+                    if i == p {
+                        value
+                    } else {
+                        rest.next().unwrap_or(0.0)
+                    }
+                })
+                .collect();
             let mut states = Vec::with_capacity(events);
-            if let Ok((mut mode, mut x)) = start(&section, model.initial_mode(), &x0, settle) {
+            if let Ok((mut mode, mut x)) = start(&section, mode, &x0, settle) {
                 states.push(x.clone());
                 while states.len() < events {
                     match section.plain(mode, &x) {

@@ -1,4 +1,5 @@
-//! Periodic orbits of automata: found by Newton shooting through a
+//! Periodic orbits of any model that gives a [`Family`]: found by Newton
+//! shooting through a
 //! Poincare section ([`shooting`]), from the section map and its Jacobian
 //! ([`section`]: saltation matrices included), and followed in a parameter
 //! ([`continuation`]), drawn over the brute-force diagram ([`diagram`]).
@@ -14,20 +15,27 @@ pub mod diagram;
 pub mod section;
 pub mod shooting;
 
-use crate::engine::{HybridModel, Mode, Options, Status, simulate};
-use crate::models::automaton::{Automaton, Definition};
+use crate::engine::{Family, HybridModel, Mode, Options, Status, simulate};
 use crate::scene::SceneError;
 pub use section::Section;
 pub use shooting::{Orbit, OrbitRequest, Unknowns};
 
-/// Check `request` against `model` (the guard exists, at least one event
-/// per period, a forcing period exactly where the clock is read).
-pub fn check(model: &Automaton, request: &OrbitRequest) -> Result<(), SceneError> {
-    let known: Vec<&str> = model
-        .modes()
-        .into_iter()
-        .flat_map(|m| model.guards(m).iter().map(|g| g.name))
-        .collect();
+/// Check `request` against `model` over `modes` modes (the guard exists,
+/// at least one event per period, a forcing period exactly where the clock
+/// is read).
+pub fn check(
+    model: &dyn HybridModel,
+    modes: usize,
+    request: &OrbitRequest,
+) -> Result<(), SceneError> {
+    let mut known: Vec<&str> = Vec::new();
+    for m in 0..modes {
+        for g in model.guards(m) {
+            if !known.contains(&g.name) {
+                known.push(g.name);
+            }
+        }
+    }
     if !known.contains(&request.guard.as_str()) {
         return Err(SceneError::field(
             "section",
@@ -47,14 +55,14 @@ pub fn check(model: &Automaton, request: &OrbitRequest) -> Result<(), SceneError
     if !(request.settle.is_finite() && request.settle >= 0.0) {
         return Err(SceneError::field("settle", "a time >= 0".into()));
     }
-    match (model.has_clock(), request.forcing_period) {
+    match (model.clock().is_some(), request.forcing_period) {
         (true, None) => Err(SceneError::field(
             "forcing_period",
-            "the automaton reads the clock t: give the forcing's period (--forcing-period), of which the orbit's is a whole number".into(),
+            "the model reads the clock t: give the forcing's period (--forcing-period), of which the orbit's is a whole number".into(),
         )),
         (false, Some(_)) => Err(SceneError::field(
             "forcing_period",
-            "the automaton does not read the clock: an autonomous orbit has no forcing period".into(),
+            "the model does not read the clock: an autonomous orbit has no forcing period".into(),
         )),
         (_, Some(p)) if !(p.is_finite() && p > 0.0) => Err(SceneError::field(
             "forcing_period",
@@ -96,12 +104,18 @@ pub fn start(
     Ok((mode, x))
 }
 
-/// The periodic orbit of `model` (from its initial state, after
+/// The periodic orbit of `family`'s model (from its start, after
 /// `request.settle`) through the section `request` names; every return
 /// within `t_max`.
-pub fn search(model: &Automaton, request: &OrbitRequest, t_max: f64) -> Result<Orbit, SceneError> {
-    check(model, request)?;
+pub fn search(
+    family: &dyn Family,
+    request: &OrbitRequest,
+    t_max: f64,
+) -> Result<Orbit, SceneError> {
+    let model = family.model();
+    check(model, family.modes(), request)?;
     let section = Section {
+        family,
         model,
         guard: &request.guard,
         events: request.events,
@@ -111,14 +125,13 @@ pub fn search(model: &Automaton, request: &OrbitRequest, t_max: f64) -> Result<O
     let n = model.dimension();
     let unknowns = Unknowns {
         free: (0..n).collect(),
-        clock: request.forcing_period.map(|p| (n - 1, p)),
+        clock: request
+            .forcing_period
+            .zip(model.clock())
+            .map(|(p, c)| (c, p)),
     };
-    let (mode, x) = match start(
-        &section,
-        model.initial_mode(),
-        model.initial(),
-        request.settle,
-    ) {
+    let (mode0, x0) = family.start();
+    let (mode, x) = match start(&section, mode0, &x0, request.settle) {
         Ok(start) => start,
         Err(why) => {
             return Ok(Orbit {
@@ -126,7 +139,7 @@ pub fn search(model: &Automaton, request: &OrbitRequest, t_max: f64) -> Result<O
                 status: format!("no start on the section: {why}"),
                 period: f64::NAN,
                 events_per_period: request.events,
-                mode: model.mode_name(model.initial_mode()),
+                mode: model.mode_name(mode0),
                 section_state: Vec::new(),
                 multipliers: Vec::new(),
                 stable: false,
@@ -143,12 +156,12 @@ pub fn search(model: &Automaton, request: &OrbitRequest, t_max: f64) -> Result<O
 /// parameter's component among them.
 pub type ContinuedBranch = (continuation::Branch, Vec<&'static str>, usize);
 
-/// A branch of orbits followed in the parameter `parameter` of
-/// `definition` to `to` (at most `points` orbits, the longest step
+/// A branch of orbits of `family`'s model followed in its parameter
+/// `parameter` to `to` (at most `points` orbits, the longest step
 /// `max_step` of the way), from the orbit found as `request` asks; every
 /// return within `t_max`.
 pub fn follow(
-    definition: &Definition,
+    family: &dyn Family,
     request: &OrbitRequest,
     parameter: &str,
     to: f64,
@@ -167,7 +180,7 @@ pub fn follow(
             format!("a finite number (got {to})"),
         ));
     }
-    if request.forcing_period.is_some() && definition.sets_the_forcing(parameter) {
+    if request.forcing_period.is_some() && family.moves_the_forcing(parameter) {
         return Err(SceneError::field(
             "param",
             format!(
@@ -177,13 +190,16 @@ pub fn follow(
             ),
         ));
     }
-    let (promoted, _) = definition.with_parameters_as_states(&[parameter.to_string()], "param")?;
-    let model = Automaton::compile(&promoted)?;
-    check(&model, request)?;
+    let promoted = family
+        .promoted(&[parameter.to_string()])
+        .map_err(|why| SceneError::field("param", why))?;
+    let model = &*promoted.model;
+    check(model, family.modes(), request)?;
     let n = model.dimension();
-    let p = definition.states.len();
+    let p = promoted.parameters[0];
     let section = Section {
-        model: &model,
+        family,
+        model,
         guard: &request.guard,
         events: request.events,
         t_max,
@@ -191,15 +207,13 @@ pub fn follow(
     };
     let unknowns = Unknowns {
         free: (0..n).filter(|&i| i != p).collect(),
-        clock: request.forcing_period.map(|period| (n - 1, period)),
+        clock: request
+            .forcing_period
+            .zip(model.clock())
+            .map(|(period, c)| (c, period)),
     };
-    let names = model.state_names(0).to_vec();
-    let (mode, x) = match start(
-        &section,
-        model.initial_mode(),
-        model.initial(),
-        request.settle,
-    ) {
+    let names = model.state_names(promoted.mode).to_vec();
+    let (mode, x) = match start(&section, promoted.mode, &promoted.start, request.settle) {
         Ok(start) => start,
         Err(why) => {
             let branch = continuation::Branch {

@@ -1,4 +1,4 @@
-//! The Poincare map of an automaton at the events of one guard, with its
+//! The Poincare map of a model at the events of one guard, with its
 //! Jacobian: from a state just after a section event, the state just after
 //! the `K`-th next one, how long that took, and the derivatives of both
 //! with respect to every component of the starting state.
@@ -18,19 +18,21 @@ use nalgebra::DMatrix;
 
 use crate::engine::variational::Variational;
 use crate::engine::{
-    EventRecord, HybridModel, Method, Mode, Observer, Options, Status, Tolerances, simulate,
+    EventRecord, Family, Flow, HybridModel, Method, Mode, Observer, Options, Status, Tolerances,
+    simulate,
 };
-use crate::models::automaton::Automaton;
 
 /// Tolerance of the section map's runs (DOP853) where the modes are not
 /// all linear.
 const TOLERANCE: f64 = 1e-13;
 
-/// The events of one guard of an automaton, `K` of them per return.
-#[derive(Debug)]
+/// The events of one guard of a model, `K` of them per return.
 pub struct Section<'a> {
-    /// The automaton, its parameters of interest held as states.
-    pub model: &'a Automaton,
+    /// The model's family: its modes, and which of them move alike.
+    pub family: &'a dyn Family,
+    /// The model run: the family's, or the same with parameters held as
+    /// states.
+    pub model: &'a (dyn HybridModel + Sync),
     /// The guard's name.
     pub guard: &'a str,
     /// Section events per return of the map.
@@ -94,12 +96,23 @@ impl Observer for Counter<'_> {
     }
 }
 
+impl std::fmt::Debug for Section<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Section")
+            .field("guard", &self.guard)
+            .field("events", &self.events)
+            .field("t_max", &self.t_max)
+            .finish()
+    }
+}
+
 impl Section<'_> {
     /// The method the section's runs take: the exact linear propagator
-    /// where every mode (with its derivatives) is linear, DOP853 at 1e-13
-    /// otherwise.
+    /// where every mode (with its derivatives) is linear or frozen, DOP853
+    /// at 1e-13 otherwise.
     fn method<M: HybridModel + ?Sized>(&self, model: &M) -> Method {
-        if self.model.modes().into_iter().all(|m| model.is_linear(m)) {
+        let modes = self.family.modes();
+        if (0..modes).all(|m| model.flow(m) == Flow::Frozen || model.is_linear(m)) {
             Method::Linear
         } else {
             Method::Dop853(Tolerances {
@@ -133,10 +146,7 @@ impl Section<'_> {
             guard: self.guard,
             wanted: self.events,
             seen: 0,
-            modes: self
-                .model
-                .modes()
-                .into_iter()
+            modes: (0..self.family.modes())
                 .map(|m| self.model.mode_name(m))
                 .collect(),
             hit: None,
@@ -173,7 +183,7 @@ impl Section<'_> {
     pub fn map(&self, mode: Mode, x0: &[f64]) -> Result<Return, String> {
         let n = self.model.dimension();
         let directions: Vec<String> = (0..n).map(|k| format!("x{k}")).collect();
-        let variational = Variational::new(self.model, self.model.modes().len(), &directions);
+        let variational = Variational::new(self.model, self.family.modes(), &directions);
         let identity: Vec<Vec<f64>> = (0..n)
             .map(|j| (0..n).map(|i| if i == j { 1.0 } else { 0.0 }).collect())
             .collect();
@@ -185,7 +195,7 @@ impl Section<'_> {
             .collect();
         let state = after[..n].to_vec();
         let mut rate = vec![0.0; n];
-        if self.model.flow(mode_after) != crate::engine::Flow::Frozen {
+        if self.model.flow(mode_after) != Flow::Frozen {
             self.model.rhs(mode_after, &state, &mut rate);
         }
         let jacobian = DMatrix::from_fn(n, n, |i, j| monodromy[(i, j)] + rate[i] * dtau[j]);

@@ -11,7 +11,8 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use crate::engine::{HybridModel, Mode};
+use crate::engine::Mode;
+use crate::engine::names::intern;
 use crate::orbit::section::{Return, Section};
 
 /// Newton iterations at most.
@@ -20,6 +21,13 @@ pub const MAX_ITERATIONS: usize = 30;
 /// Where Newton stops: the residual below this fraction of the state's
 /// size.
 pub const TOLERANCE: f64 = 1e-12;
+
+/// How far outside the unit circle a multiplier still counts as on it
+/// (stable): multipliers read through difference Jacobians (guards and
+/// resets that give none of their own, as the angle formulation's chart
+/// changes) are good to about 1e-8, and a conservative orbit's sit on the
+/// circle.
+pub const ON_THE_CIRCLE: f64 = 1e-7;
 
 /// What a search asks: the section guard, the events per period, a
 /// transient to let die out first, and the period of a forcing (for an
@@ -60,7 +68,7 @@ pub struct Orbit {
     /// clock), then the others by decreasing modulus.
     pub multipliers: Vec<(f64, f64)>,
     /// Whether every multiplier but the trivial one lies within the unit
-    /// circle (to 1e-9).
+    /// circle (to [`ON_THE_CIRCLE`]).
     pub stable: bool,
     /// `|P(x) - x|` (on the free components) recomputed by a plain run.
     pub residual: f64,
@@ -175,7 +183,7 @@ pub fn multipliers(r: &Return, unknowns: &Unknowns) -> (Vec<(f64, f64)>, bool) {
     if let Some(i) = trivial {
         eigen.remove(i);
     }
-    let stable = eigen.iter().all(|z| z.0.hypot(z.1) <= 1.0 + 1e-9);
+    let stable = eigen.iter().all(|z| z.0.hypot(z.1) <= 1.0 + ON_THE_CIRCLE);
     eigen.sort_by(|a, b| (b.0.hypot(b.1)).total_cmp(&a.0.hypot(a.1)));
     eigen.insert(0, (1.0, 0.0));
     (eigen, stable)
@@ -183,7 +191,7 @@ pub fn multipliers(r: &Return, unknowns: &Unknowns) -> (Vec<(f64, f64)>, bool) {
 
 /// Newton from `x` (just after a section event, in `mode`).
 pub fn shoot(section: &Section, unknowns: &Unknowns, mode: Mode, x: Vec<f64>) -> Orbit {
-    let names = section.model.state_names(mode);
+    let names = names(section, mode, x.len());
     let mut x = x;
     unknowns.fold_clock(&mut x);
     let mut residuals = Vec::new();
@@ -208,7 +216,7 @@ pub fn shoot(section: &Section, unknowns: &Unknowns, mode: Mode, x: Vec<f64>) ->
             Ok(back) => back,
             Err(why) => return failed(format!("the section map failed: {why}"), residuals, &x),
         };
-        if back.mode != mode {
+        if !section.family.same_motion(mode, back.mode) {
             return failed(
                 format!(
                     "the run returns to the section in mode `{}`, not `{}`: not an orbit of {} events",
@@ -271,6 +279,21 @@ pub fn shoot(section: &Section, unknowns: &Unknowns, mode: Mode, x: Vec<f64>) ->
     )
 }
 
+/// The names of the `n` components of a state in `mode`: the model's,
+/// else the family's, else `x0`, `x1`, ... (a chain names its nodes only
+/// for the tools).
+fn names(section: &Section, mode: Mode, n: usize) -> Vec<&'static str> {
+    let own = section.model.state_names(mode);
+    if own.len() == n {
+        return own.to_vec();
+    }
+    let family = section.family.state_names();
+    if family.len() == n {
+        return family.iter().map(|name| intern(name)).collect();
+    }
+    (0..n).map(|i| intern(&format!("x{i}"))).collect()
+}
+
 /// The orbit at `x`, which Newton accepted: its period and multipliers
 /// from `back`, its residual recomputed by a plain run.
 fn verified(
@@ -281,7 +304,7 @@ fn verified(
     back: &Return,
     residuals: Vec<f64>,
 ) -> Orbit {
-    let names = section.model.state_names(mode);
+    let names = names(section, mode, x.len());
     let (multipliers, stable) = multipliers(back, unknowns);
     let plain = section.plain(mode, x);
     let (converged, status, residual) = match plain {

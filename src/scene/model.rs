@@ -17,9 +17,7 @@ use serde_json::Value;
 
 use crate::compare::Reference;
 use crate::compare_models::Release;
-use crate::engine::Observer;
-use crate::orbit::diagram::Column;
-use crate::orbit::{ContinuedBranch, Orbit, OrbitRequest};
+use crate::engine::{Family, Observer};
 use crate::runner::ensemble::{EnsembleReport, EnsembleRequest};
 use crate::runner::{Control, Report, Trajectory};
 use crate::scene::SceneError;
@@ -59,68 +57,15 @@ pub trait SceneModel: fmt::Debug + Send + Sync + 'static {
     /// Run the scene under `control`, reporting events to `observer`.
     fn run(&self, control: &Control, observer: &mut dyn Observer) -> Result<Report, SceneError>;
 
-    /// Have this scene's runs carry the derivatives of their state and of
-    /// every event time along `directions` (`NAME`, a parameter, or
-    /// `initial.NAME`, a state's initial value): `flicker run
-    /// --sensitivities`. Checked now; a model that gives none says so.
-    fn set_sensitivities(&mut self, directions: &[String]) -> Result<(), SceneError> {
-        let _ = directions;
+    /// The scene's model as the tools see it: the hybrid model, where the
+    /// scene starts, and its parameters. Periodic orbits, continuation,
+    /// bifurcation diagrams and sensitivities run on it, whatever the
+    /// kind. A kind with no finite state says why.
+    fn family(&self) -> Result<Box<dyn Family>, SceneError> {
         Err(SceneError::field(
-            "sensitivities",
+            "model",
             format!(
-                "a {} scene gives no sensitivities (automata do: write the model as one)",
-                self.model()
-            ),
-        ))
-    }
-
-    /// The periodic orbit `request` asks for (`flicker orbit`), found by
-    /// Newton shooting through a Poincare section. Default: the model
-    /// offers no search.
-    fn orbit(&self, request: &OrbitRequest) -> Result<Orbit, SceneError> {
-        let _ = request;
-        Err(SceneError::field(
-            "section",
-            format!(
-                "a {} scene has no periodic-orbit search (automata do: write the model as one)",
-                self.model()
-            ),
-        ))
-    }
-
-    /// The branch of periodic orbits through the one `request` finds,
-    /// followed in `parameter` to `to` (`points`: at most so many orbits,
-    /// the longest step as a fraction of the way): `flicker continue`. With the state's names and the parameter's component.
-    /// Default: the model offers no continuation.
-    fn continue_orbit(
-        &self,
-        request: &OrbitRequest,
-        parameter: &str,
-        to: f64,
-        points: (usize, f64),
-    ) -> Result<ContinuedBranch, SceneError> {
-        let _ = (request, parameter, to, points);
-        Err(SceneError::field(
-            "param",
-            format!("a {} scene has no continuation (automata do)", self.model()),
-        ))
-    }
-
-    /// The brute-force bifurcation diagram over `values` of `parameter`:
-    /// the section states of `events` events of `guard` after `settle`.
-    fn brute_force(
-        &self,
-        parameter: &str,
-        values: &[f64],
-        guard: &str,
-        settle: f64,
-        events: usize,
-    ) -> Result<Vec<Column>, SceneError> {
-        let _ = (parameter, values, guard, settle, events);
-        Err(SceneError::field(
-            "param",
-            format!(
-                "a {} scene has no bifurcation diagram (automata do)",
+                "a {} scene has no finite state for a tool to follow",
                 self.model()
             ),
         ))

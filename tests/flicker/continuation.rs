@@ -183,8 +183,13 @@ fn the_table_branch_turns_back_at_its_fold_onto_the_unstable_orbit() {
     }
 }
 
+/// The built-in mechanism's impacting orbit followed in `eta` (its
+/// family, not an automaton): every orbit's period is the closed form's
+/// `T_imp = 2 atan2(sqrt(2 H), 1 - eta)` at the energy `H` of its section
+/// state, and stays neutral (the mechanism is integrable). The continuum,
+/// with no finite state, is refused in one line (exit 2).
 #[test]
-fn continuation_of_a_model_without_it_is_refused() {
+fn the_built_in_mechanism_is_continued_on_its_closed_form() {
     let dir = tempfile::tempdir().unwrap();
     let done = flicker(&[
         "continue",
@@ -195,11 +200,53 @@ fn continuation_of_a_model_without_it_is_refused() {
         "eta",
         "--to",
         "1.5",
+        "--points",
+        "40",
+        "--brute-force",
+        "0",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    assert!(
+        done.status.success(),
+        "{}",
+        String::from_utf8_lossy(&done.stderr)
+    );
+    let text = std::fs::read_to_string(dir.path().join("continuation.csv")).unwrap();
+    let mut rows = text.lines();
+    assert_eq!(
+        rows.next(),
+        Some("parameter,period,strain,strain_rate,largest_multiplier,stable,label")
+    );
+    let mut last_eta = 0.0;
+    for row in rows {
+        let row: Vec<&str> = row.split(',').collect();
+        let number = |i: usize| row[i].parse::<f64>().unwrap();
+        let (eta, period, rate) = (number(0), number(1), number(3));
+        let t_imp = 2.0 * (rate.abs()).atan2(1.0 - eta);
+        assert!((period - t_imp).abs() < 1e-10, "{row:?}: T_imp {t_imp}");
+        assert!((number(4) - 1.0).abs() < 1e-8, "{row:?}");
+        last_eta = eta;
+    }
+    assert!(last_eta > 1.49, "the branch reached eta = {last_eta}");
+    let done = flicker(&[
+        "continue",
+        &crate::support::models("continuum_release_paper.json"),
+        "--section",
+        "impact",
+        "--param",
+        "load",
+        "--to",
+        "1.5",
         "--out",
         dir.path().to_str().unwrap(),
     ]);
     assert_eq!(done.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&done.stderr).contains("automata do"));
+    let err = String::from_utf8_lossy(&done.stderr);
+    assert!(
+        err.contains("no finite state") && err.trim().lines().count() == 1,
+        "{err}"
+    );
 }
 
 /// The table's frequency `w` sets the forcing, whose period

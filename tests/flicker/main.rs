@@ -42,4 +42,5 @@ mod stress;
 mod support;
 mod sweep;
 mod thermostat;
+mod tools_on_every_model;
 mod user_models;

@@ -8,6 +8,7 @@ use serde_json::{Value, json};
 use flicker::engine::Recorder;
 use flicker::runner::{Control, Report};
 use flicker::scene::Registry;
+use flicker::session::RunRequest;
 
 use crate::automata::automaton;
 
@@ -17,13 +18,17 @@ fn read(name: &str) -> Value {
 
 /// Run `scene` (with the derivatives along `directions`, if any).
 fn run(scene: &Value, directions: &[&str]) -> (Report, Recorder) {
-    let mut scene = Registry::builtin().from_value(scene).unwrap();
-    if !directions.is_empty() {
-        let names: Vec<String> = directions.iter().map(|s| s.to_string()).collect();
-        scene.set_sensitivities(&names).unwrap();
-    }
+    let scene = Registry::builtin().from_value(scene).unwrap();
+    let request = RunRequest {
+        sensitivities: (!directions.is_empty())
+            .then(|| directions.iter().map(|s| s.to_string()).collect()),
+        times: None,
+    };
+    request.check(&scene).unwrap();
     let mut events = Recorder::default();
-    let report = scene.run(&Control::default(), &mut events).unwrap();
+    let (report, _) = request
+        .run(&scene, &Control::default(), &mut events)
+        .unwrap();
     assert_eq!(
         report.outcome.status.as_str(),
         "completed",
@@ -157,13 +162,14 @@ fn bounce_times_and_the_zeno_point_move_with_the_restitution_as_the_closed_form(
     let t1 = (2.0 * h / g).sqrt();
     let mut scene = read("bouncing_ball.json");
     scene["t_end"] = json!(4.06);
-    let mut registry_scene = Registry::builtin().from_value(&scene).unwrap();
-    registry_scene
-        .set_sensitivities(&["e".to_string(), "initial.y".to_string()])
-        .unwrap();
+    let registry_scene = Registry::builtin().from_value(&scene).unwrap();
+    let request = RunRequest {
+        sensitivities: Some(vec!["e".to_string(), "initial.y".to_string()]),
+        times: None,
+    };
     let mut events = Recorder::default();
-    registry_scene
-        .run(&Control::default(), &mut events)
+    request
+        .run(&registry_scene, &Control::default(), &mut events)
         .unwrap();
     let n = events.events[0].after.len();
     let (de, dy) = (n - 2, n - 1);
@@ -192,25 +198,37 @@ fn bounce_times_and_the_zeno_point_move_with_the_restitution_as_the_closed_form(
 }
 
 /// A direction that is neither a parameter nor an initial value, or a
-/// model without sensitivities, is refused with the names it knows.
+/// model without a finite state, is refused with the names it knows.
 #[test]
 fn unknown_directions_are_refused() {
-    let mut scene = Registry::builtin()
+    let scene = Registry::builtin()
         .from_value(&read("mechanism.json"))
         .unwrap();
-    let err = scene.set_sensitivities(&["etta".to_string()]).unwrap_err();
+    let check = |scene: &flicker::scene::Scene, name: &str| {
+        flicker::sensitivities::check(scene, &[name.to_string()]).unwrap_err()
+    };
+    let err = check(&scene, "etta");
     assert!(err.reason.contains("no parameter is called `etta`") && err.reason.contains("eta"));
-    let err = scene
-        .set_sensitivities(&["initial.speed".to_string()])
-        .unwrap_err();
+    let err = check(&scene, "initial.speed");
     assert!(err.reason.contains("strain, strain_rate"));
-    let mut builtin = Registry::builtin()
+    let builtin = Registry::builtin()
         .load(std::path::Path::new(&crate::support::models(
             "mechanism_impacting.json",
         )))
         .unwrap();
-    let err = builtin.set_sensitivities(&["eta".to_string()]).unwrap_err();
-    assert!(err.reason.contains("automata do"));
+    let err = check(&builtin, "etta");
+    assert!(
+        err.reason.contains("(parameters: eta, omega;"),
+        "{}",
+        err.reason
+    );
+    let continuum = Registry::builtin()
+        .load(std::path::Path::new(&crate::support::models(
+            "continuum_release_paper.json",
+        )))
+        .unwrap();
+    let err = check(&continuum, "load");
+    assert!(err.reason.contains("no finite state"), "{}", err.reason);
 }
 
 /// The exact linear propagator asked for where a direction makes a flow

@@ -67,10 +67,10 @@ pub mod builder;
 pub mod definition;
 pub mod ensemble;
 pub mod expr;
+mod family;
 pub mod filippov;
 pub mod model;
 pub mod scene;
-pub mod sensitivities;
 
 pub use builder::{AutomatonBuilder, TransitionBuilder};
 pub use definition::Definition;

@@ -7,12 +7,11 @@ use crate::compare::Reference;
 use crate::engine::integrator::{methods_for, runs};
 use crate::engine::zeno;
 use crate::engine::{
-    EventTimes, HybridModel, Method, Observer, Sample, Status, Tolerances, simulate_sampled, taylor,
+    EventTimes, Family, HybridModel, Method, Observer, Sample, Status, Tolerances,
+    simulate_sampled, taylor,
 };
 use crate::models::automaton::definition::{Definition, Transition};
 use crate::models::automaton::model::Automaton;
-use crate::orbit::diagram::Column;
-use crate::orbit::{ContinuedBranch, Orbit, OrbitRequest};
 use crate::runner::ensemble::{EnsembleReport, EnsembleRequest};
 use crate::runner::{Control, Report, Trajectory};
 use crate::scene::fields::Fields;
@@ -41,9 +40,6 @@ pub struct AutomatonScene {
     pub max_events: u64,
     /// Free text.
     pub description: Option<String>,
-    /// Directions of the derivatives runs carry (`--sensitivities`; none
-    /// by default).
-    pub sensitivities: Vec<String>,
 }
 
 /// Validate the keys of an automaton scene.
@@ -62,7 +58,6 @@ pub fn scene(mut f: Fields) -> Result<Scene, SceneError> {
         tolerances: Tolerances::default(),
         max_events,
         description,
-        sensitivities: Vec::new(),
     };
     let solver = match f.optional("solver") {
         Some(value) => SolverSpec::from_json(value)?,
@@ -196,7 +191,7 @@ impl AutomatonScene {
 }
 
 impl AutomatonScene {
-    /// The run (with the derivatives asked for, if any), with the state at
+    /// The run, with the state at
     /// each of `times` passed to `on_sample`.
     fn run_sampled(
         &self,
@@ -205,9 +200,6 @@ impl AutomatonScene {
         on_sample: &mut dyn FnMut(&Sample),
         observer: &mut dyn Observer,
     ) -> Result<Report, SceneError> {
-        if !self.sensitivities.is_empty() {
-            return super::sensitivities::run(self, control, times, on_sample, observer);
-        }
         let (method, description) = self.resolved();
         let options = control.options(self.t_end, self.max_events, method, self.tolerances);
         let model = &*self.automaton;
@@ -386,42 +378,8 @@ impl SceneModel for AutomatonScene {
         self.run_sampled(control, &[], &mut |_| {}, observer)
     }
 
-    /// Every return of the section map within the scene's `t_end`.
-    fn orbit(&self, request: &OrbitRequest) -> Result<Orbit, SceneError> {
-        crate::orbit::search(&self.automaton, request, self.t_end)
-    }
-
-    fn continue_orbit(
-        &self,
-        request: &OrbitRequest,
-        parameter: &str,
-        to: f64,
-        points: (usize, f64),
-    ) -> Result<ContinuedBranch, SceneError> {
-        crate::orbit::follow(&self.definition, request, parameter, to, points, self.t_end)
-    }
-
-    fn brute_force(
-        &self,
-        parameter: &str,
-        values: &[f64],
-        guard: &str,
-        settle: f64,
-        events: usize,
-    ) -> Result<Vec<Column>, SceneError> {
-        crate::orbit::diagram::brute_force(
-            &self.definition,
-            parameter,
-            values,
-            guard,
-            (settle, events, self.t_end),
-        )
-    }
-
-    fn set_sensitivities(&mut self, directions: &[String]) -> Result<(), SceneError> {
-        super::sensitivities::check(self, directions)?;
-        self.sensitivities = directions.to_vec();
-        Ok(())
+    fn family(&self) -> Result<Box<dyn Family>, SceneError> {
+        Ok(Box::new(self.clone()))
     }
 
     fn offers_samples(&self) -> bool {

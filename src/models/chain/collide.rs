@@ -15,6 +15,21 @@ use std::ops::RangeInclusive;
 /// change of node 1's velocity the wall made (swaps conserve momentum;
 /// only wall flips change it).
 pub fn cascade(first: usize, shut: &[bool], v: &mut [f64]) -> (Option<RangeInclusive<usize>>, f64) {
+    cascade_with(first, shut, v, |_| {})
+}
+
+/// One step of a [`cascade`]: node velocities `i` and `i + 1` of its `v`
+/// swapped, or (`None`) node 1's flipped against the wall.
+pub type Step = Option<usize>;
+
+/// [`cascade`], each step it takes told to `step` as it is taken: what a
+/// reset's Jacobian (a signed permutation) is read from.
+pub fn cascade_with(
+    first: usize,
+    shut: &[bool],
+    v: &mut [f64],
+    mut step: impl FnMut(Step),
+) -> (Option<RangeInclusive<usize>>, f64) {
     assert_eq!(v.len(), shut.len() + 1, "one more node than units");
     let mut touched: Option<(usize, usize)> = None;
     let mut wall = 0.0;
@@ -30,8 +45,10 @@ pub fn cascade(first: usize, shut: &[bool], v: &mut [f64]) -> (Option<RangeInclu
             if unit == 1 {
                 wall -= 2.0 * v[1];
                 v[1] = -v[1];
+                step(None);
             } else {
                 v.swap(i, i + 1);
+                step(Some(i));
             }
             changed = true;
             touched = Some(touched.map_or((unit, unit), |(a, b)| (a.min(unit), b.max(unit))));

@@ -24,6 +24,7 @@ use crate::engine::{Direction, Guard, Label, Labels};
 pub mod coarse;
 pub mod collide;
 pub mod ensemble;
+pub mod family;
 pub mod modal;
 pub mod ode;
 pub(crate) mod run;

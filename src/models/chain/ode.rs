@@ -6,7 +6,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::collide::cascade;
+use super::collide::{cascade, cascade_with};
 use super::{Chain, impact_labels};
 use crate::engine::{Flow, Guard, HybridModel, Jump, Labels, Mode};
 
@@ -76,24 +76,50 @@ impl HybridModel for Chain {
     }
 
     fn reset(&self, mode: Mode, _: usize, x: &mut [f64]) -> Jump {
-        // A unit takes part if it is shut to within a few ulps of its
-        // nodes' positions (and closing, which the cascade checks).
         let n = self.units;
-        let window = 8.0 * f64::EPSILON;
-        let shut: Vec<bool> = (1..=n)
-            .map(|unit| {
-                let scale = x[unit - 1]
-                    .abs()
-                    .max(if unit > 1 { x[unit - 2].abs() } else { 0.0 });
-                self.elongation(x, unit) <= window * scale
-            })
-            .collect();
         let mut v = Vec::with_capacity(n + 1);
         v.push(0.0);
         v.extend_from_slice(&x[n..]);
-        let _ = cascade(1, &shut, &mut v);
+        let _ = cascade(1, &self.shut(x), &mut v);
         x[n..].copy_from_slice(&v[1..]);
         Jump::to(mode)
+    }
+
+    /// Positions stay; velocities are permuted and node 1's maybe
+    /// flipped, as the cascade at `x` does: a signed permutation, exact.
+    fn reset_jacobian(&self, _: Mode, _: usize, x: &[f64], out: &mut [f64]) -> bool {
+        let n = self.units;
+        let dim = 2 * n;
+        // Which node's velocity (1-based, 0 the wall) each slot holds, and its sign.
+        let mut from: Vec<(usize, f64)> = (0..=n).map(|k| (k, 1.0)).collect();
+        let mut v = Vec::with_capacity(n + 1);
+        v.push(0.0);
+        v.extend_from_slice(&x[n..]);
+        let _ = cascade_with(1, &self.shut(x), &mut v, |step| match step {
+            Some(i) => from.swap(i, i + 1),
+            None => from[1].1 = -from[1].1,
+        });
+        out[..dim * dim].fill(0.0);
+        for i in 0..n {
+            out[i * dim + i] = 1.0;
+        }
+        for slot in 1..=n {
+            let (node, sign) = from[slot];
+            if node > 0 {
+                out[(n + slot - 1) * dim + n + node - 1] = sign;
+            }
+        }
+        true
+    }
+
+    /// A unit's elongation `y_n - y_{n-1}`.
+    fn guard_gradient(&self, _: Mode, guard: usize, _: &[f64], out: &mut [f64]) -> bool {
+        out.fill(0.0);
+        out[guard] = 1.0;
+        if guard > 0 {
+            out[guard - 1] = -1.0;
+        }
+        true
     }
 
     fn labels(&self, _: Mode, guard: usize, x: &[f64]) -> Labels {
@@ -116,5 +142,22 @@ impl HybridModel for Chain {
 
     fn energy_scale(&self, initial_energy: f64) -> f64 {
         initial_energy.abs().max(f64::MIN_POSITIVE)
+    }
+}
+
+impl Chain {
+    /// Which units take part in an impact at `x`: those shut to within a
+    /// few ulps of their nodes' positions (the cascade checks that they
+    /// close).
+    fn shut(&self, x: &[f64]) -> Vec<bool> {
+        let window = 8.0 * f64::EPSILON;
+        (1..=self.units)
+            .map(|unit| {
+                let scale = x[unit - 1]
+                    .abs()
+                    .max(if unit > 1 { x[unit - 2].abs() } else { 0.0 });
+                self.elongation(x, unit) <= window * scale
+            })
+            .collect()
     }
 }

@@ -351,6 +351,10 @@ impl SceneModel for ChainScene {
         }))
     }
 
+    fn family(&self) -> Result<Box<dyn crate::engine::Family>, SceneError> {
+        Ok(Box::new(super::family::ChainFamily::new(self)))
+    }
+
     fn check_ensemble(&self, request: &EnsembleRequest) -> Result<(), SceneError> {
         super::ensemble::check(self, request)
     }

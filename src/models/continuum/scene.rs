@@ -366,6 +366,15 @@ impl SceneModel for ContinuumScene {
         }))
     }
 
+    fn family(&self) -> Result<Box<dyn crate::engine::Family>, SceneError> {
+        Err(SceneError::field(
+            "model",
+            "a continuum scene is a field with no finite state: orbits, sensitivities and \
+             spectra need a finite one; write the chain it is the limit of (\"model\": \"chain\")"
+                .into(),
+        ))
+    }
+
     fn clone_box(&self) -> Box<dyn SceneModel> {
         Box::new(self.clone())
     }

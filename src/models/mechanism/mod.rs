@@ -4,6 +4,7 @@
 
 pub mod angle;
 pub mod closed_form;
+pub mod family;
 pub(crate) mod run;
 pub mod scene;
 pub mod strain;

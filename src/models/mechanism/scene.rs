@@ -347,6 +347,10 @@ impl SceneModel for MechanismScene {
         super::run::run(self, control, observer)
     }
 
+    fn family(&self) -> Result<Box<dyn crate::engine::Family>, SceneError> {
+        Ok(Box::new(super::family::MechanismFamily::new(self)))
+    }
+
     fn offers_samples(&self) -> bool {
         true
     }
