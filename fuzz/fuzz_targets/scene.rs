@@ -4,7 +4,7 @@
 #![no_main]
 
 use flicker::runner::Control;
-use flicker::scene::{self, ChainScene};
+use flicker::models::{self as scene, ChainScene};
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {

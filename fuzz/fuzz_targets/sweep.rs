@@ -14,6 +14,6 @@ fuzz_target!(|data: &[u8]| {
     for point in 0..sweep.points().min(4) {
         let _ = sweep
             .scene_at(point)
-            .map(|v| flicker::scene::from_value(&v));
+            .map(|v| flicker::models::from_value(&v));
     }
 });

@@ -53,10 +53,10 @@ pub fn advise(args: AdviseArgs, registry: &Registry) -> Result<Code, Failure> {
             args.scene.display()
         ))
     };
-    let units = match scene.release() {
-        Some(Ok(Release {
+    let units = match crate::compare_models::release::described(&scene) {
+        Some(Release {
             units: Some(units), ..
-        })) => units,
+        }) => units,
         _ => return Err(not_a_chain()),
     };
     if !(args.tolerance.is_finite() && args.tolerance > 0.0) {

@@ -31,6 +31,7 @@ pub mod events;
 pub mod exit;
 pub mod orbit;
 pub mod plot;
+pub mod plot_run;
 pub mod progress;
 pub mod run;
 pub mod setup;

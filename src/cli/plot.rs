@@ -59,7 +59,7 @@ pub enum PlotCommand {
 
 /// `flicker plot DIR`: the pictures of what a run wrote.
 pub fn plot_dir(dir: &Path) -> Result<Code, Failure> {
-    let written = crate::plot::run::plot_run(dir).map_err(Failure::bad_input)?;
+    let written = crate::cli::plot_run::plot_run(dir).map_err(Failure::bad_input)?;
     let names: Vec<String> = written.iter().map(|p| p.display().to_string()).collect();
     say!("wrote {}", names.join(", "));
     Ok(Code::Ok)

@@ -294,7 +294,7 @@ pub fn run(args: RunArgs, registry: &Registry) -> Result<Code, Failure> {
     })?;
     print_report(&report, &scene, &summary_path, log, &written);
     if plot {
-        let drawn = crate::plot::run::plot_run(&out).map_err(Failure::untrusted)?;
+        let drawn = crate::cli::plot_run::plot_run(&out).map_err(Failure::untrusted)?;
         let names: Vec<String> = drawn.iter().map(|p| p.display().to_string()).collect();
         say!("  drew {}", names.join(", "));
     }

@@ -6,7 +6,6 @@
 //! against the [`Reference`]) and the bounds the run stated on them. [`chart`] draws error against cost.
 
 pub mod chart;
-pub mod reference;
 
 use std::path::Path;
 use std::time::Instant;
@@ -15,9 +14,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::engine::{EventTimes, Status, zeno};
 use crate::runner;
+use crate::scene::Reference;
 use crate::scene::solver::{METHODS, SolverSpec};
 use crate::scene::{Scene, SceneError};
-pub use reference::Reference;
 
 /// Default Dormand-Prince tolerances (`rtol = atol`).
 pub const TOLERANCES: [f64; 9] = [1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12];

@@ -12,6 +12,9 @@
 
 pub mod chart;
 pub mod files;
+pub mod release;
+
+pub use release::{Release, release};
 
 use std::time::Instant;
 
@@ -20,9 +23,10 @@ use rayon::prelude::*;
 use crate::engine::{LocalModel, Method, Options, Status, Tolerances, simulate_local};
 use crate::models::chain::coarse::{Coarse, WINDOW_WIDTH};
 use crate::models::chain::{Chain, TaylorChain};
+use crate::models::continuum::scene::ContinuumScene;
 use crate::models::continuum::{StringModel, Variant};
-use crate::runner::{self, Control};
-use crate::scene::{ContinuumScene, Scene, SceneError};
+use crate::runner::Control;
+use crate::scene::SceneError;
 use crate::time::Time;
 
 /// Fewest windows behind the front for a plateau to be measured.
@@ -34,38 +38,6 @@ pub const DEFAULT_CELLS: usize = 200;
 /// Window centres the coarse fields are compared at: every 0.02 on the
 /// paper's string of length 2.
 pub const CENTRES: usize = 101;
-
-/// What a chain or continuum scene says of the release it describes
-/// ([`SceneModel::release`](crate::scene::SceneModel::release)).
-#[derive(Debug, Clone)]
-pub struct Release {
-    /// The release as a continuum scene (a chain's string without its
-    /// units), its homogenized string on [`DEFAULT_CELLS`].
-    pub string: ContinuumScene,
-    /// The chain's units, for a chain scene.
-    pub units: Option<usize>,
-    /// Whether the string starts uniform and at rest.
-    pub uniform: bool,
-}
-
-/// The release a scene describes, as a continuum scene: asked of the
-/// scene's model. Scenes with an `initial` profile are refused: the models
-/// would not start alike.
-pub fn release(scene: &Scene) -> Result<Release, SceneError> {
-    let release = scene.release().unwrap_or_else(|| {
-        Err(SceneError::field(
-            "model",
-            "compares a chain with its continuum: give a chain or continuum scene".into(),
-        ))
-    })?;
-    if !release.uniform || release.string.cells[0].velocity != 0.0 {
-        return Err(SceneError::field(
-            "initial",
-            "the models are compared from the release of a uniform string at rest; leave `initial` out".into(),
-        ));
-    }
-    Ok(release)
-}
 
 /// The strain the string starts at, against which the front is found.
 fn undisturbed(release: &ContinuumScene) -> f64 {
@@ -210,11 +182,13 @@ pub fn continuum_track(
     let refused = |e: SceneError| e.to_string();
     match variant {
         Variant::Paper => {
-            let mut model = runner::front_tracking(release, release.constraint).map_err(refused)?;
+            let mut model =
+                crate::models::continuum::run::front_tracking(release, release.constraint)
+                    .map_err(refused)?;
             string_track(label, variant, held, &mut model, release, control)
         }
         Variant::Homogenized => {
-            let mut model = runner::homogenized(release).map_err(refused)?;
+            let mut model = crate::models::continuum::run::homogenized(release).map_err(refused)?;
             string_track(label, variant, 0.0, &mut model, release, control)
         }
     }

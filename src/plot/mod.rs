@@ -1,6 +1,6 @@
 //! Pictures: phase portraits of the mechanism ([`phase`]), any two states
-//! of a run against each other ([`plane`]), and what a run
-//! wrote ([`run`], with a chain's or a continuum's own in [`fields`]), drawn
+//! of a run against each other ([`plane`]), a chain's or a continuum's
+//! fields ([`fields`]), drawn
 //! with a bundled font ([`draw`]), so a machine without system fonts draws
 //! text.
 
@@ -8,7 +8,6 @@ pub mod draw;
 pub mod fields;
 pub mod phase;
 pub mod plane;
-pub mod run;
 
 use std::sync::Once;
 

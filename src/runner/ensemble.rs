@@ -16,8 +16,6 @@ use rand::SeedableRng;
 use rand_xorshift::XorShiftRng;
 use serde_json::Value;
 
-use crate::scene::SceneError;
-
 /// What `--ensemble K [--perturb P] [--seed S]` asks for.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EnsembleRequest {
@@ -31,20 +29,20 @@ pub struct EnsembleRequest {
 
 impl EnsembleRequest {
     /// The checks every model's ensemble makes: at least two copies, and a
-    /// perturbation in `(0, 1)`.
-    pub fn check(&self) -> Result<(), SceneError> {
-        let refuse = |reason: String| SceneError::field("ensemble", reason);
+    /// perturbation in `(0, 1)`; a refusal says why (of the `ensemble`
+    /// field).
+    pub fn check(&self) -> Result<(), String> {
         if self.copies < 2 {
-            return Err(refuse(format!(
+            return Err(format!(
                 "needs at least 2 copies to compare (got {})",
                 self.copies
-            )));
+            ));
         }
         if !(self.perturb.is_finite() && self.perturb > 0.0 && self.perturb < 1.0) {
-            return Err(refuse(format!(
+            return Err(format!(
                 "the perturbation must be in (0, 1) (got {})",
                 self.perturb
-            )));
+            ));
         }
         Ok(())
     }

@@ -9,7 +9,6 @@ use std::sync::atomic::AtomicBool;
 
 use crate::engine::{Method, Options, Outcome, Tolerances};
 
-pub use crate::models::continuum::run::{front_tracking, homogenized};
 pub use fields::{CLASSICAL_MAX_UNITS, Classical, FieldOutputs, Profile, TraceRow};
 
 /// A finished run and what the summary needs to say about it.

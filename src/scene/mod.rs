@@ -13,17 +13,14 @@
 pub mod extent;
 pub mod fields;
 pub mod model;
+pub mod reference;
 pub mod solver;
 
 use std::fmt;
 use std::path::{Path, PathBuf};
 
-use serde_json::Value;
-
-pub use crate::models::chain::scene::ChainScene;
-pub use crate::models::continuum::scene::ContinuumScene;
-pub use crate::models::mechanism::scene::{Formulation, Initial, MechanismScene};
 pub use crate::scene::model::{Kind, Registry, Scene, SceneModel, Validator};
+pub use crate::scene::reference::Reference;
 
 /// Why a scene was refused: where, and what is wrong.
 #[derive(Debug, Clone, PartialEq)]
@@ -77,19 +74,3 @@ impl fmt::Display for SceneError {
 }
 
 impl std::error::Error for SceneError {}
-
-/// Read and validate the scene in `path`, of a model this crate ships.
-pub fn load(path: &Path) -> Result<Scene, SceneError> {
-    Registry::builtin().load(path)
-}
-
-/// Validate a scene given as JSON text, of a model this crate ships.
-pub fn parse(text: &str) -> Result<Scene, SceneError> {
-    Registry::builtin().parse(text)
-}
-
-/// Validate a scene given as a parsed JSON value, of a model this crate
-/// ships.
-pub fn from_value(value: &Value) -> Result<Scene, SceneError> {
-    Registry::builtin().from_value(value)
-}

@@ -15,11 +15,10 @@ use std::fmt;
 
 use serde_json::Value;
 
-use crate::compare::Reference;
-use crate::compare_models::Release;
 use crate::engine::{Family, Observer};
 use crate::runner::ensemble::{EnsembleReport, EnsembleRequest};
 use crate::runner::{Control, Report, Trajectory};
+use crate::scene::Reference;
 use crate::scene::SceneError;
 use crate::scene::fields::{Fields, kind};
 use crate::scene::solver::SolverSpec;
@@ -107,13 +106,6 @@ pub trait SceneModel: fmt::Debug + Send + Sync + 'static {
     /// before anything runs.
     fn offers_samples(&self) -> bool {
         false
-    }
-
-    /// The release of a string this scene describes, as a continuum scene
-    /// (a chain's with its units): what `compare-models` and `advise` weigh
-    /// chains and continua on. `None` where the model describes no string.
-    fn release(&self) -> Option<Result<Release, SceneError>> {
-        None
     }
 
     /// Whether `flicker run --ensemble` can run this scene as `request`
@@ -252,38 +244,10 @@ const SCENE_SCHEMA_TITLE: &str = "flicker scene";
 const SCENE_SCHEMA_DESCRIPTION: &str = "A scene file for `flicker run`. The schema states the shape; `flicker check SCENE.json` also checks what a schema cannot (an energy no state has, an initial angle given to the strain formulation, ...).";
 
 impl Registry {
-    /// The models this crate ships: the mechanism, the chain, the
-    /// continuum, and automata defined in the file.
-    pub fn builtin() -> Self {
-        let kind = |model, validate, schema| Kind {
-            model,
-            validate,
-            schema,
-        };
-        Registry {
-            kinds: vec![
-                kind(
-                    "mechanism",
-                    crate::models::mechanism::scene::scene,
-                    include_str!("../models/mechanism/scene.schema.json"),
-                ),
-                kind(
-                    "chain",
-                    crate::models::chain::scene::scene,
-                    include_str!("../models/chain/scene.schema.json"),
-                ),
-                kind(
-                    "continuum",
-                    crate::models::continuum::scene::scene,
-                    include_str!("../models/continuum/scene.schema.json"),
-                ),
-                kind(
-                    "automaton",
-                    crate::models::automaton::scene::scene,
-                    include_str!("../models/automaton/scene.schema.json"),
-                ),
-            ],
-        }
+    /// A registry of these kinds, in this order (the order of the scene
+    /// schema's `oneOf`). [`Registry::builtin`] is the crate's own.
+    pub fn of(kinds: Vec<Kind>) -> Self {
+        Registry { kinds }
     }
 
     /// The same registry, knowing one more kind (or another definition of

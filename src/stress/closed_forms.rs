@@ -23,9 +23,9 @@
 
 use std::sync::Arc;
 
-use crate::compare::Reference;
 use crate::models::automaton::{AutomatonScene, Definition};
 use crate::models::mechanism::{ExactOrbit, Mechanism};
+use crate::scene::Reference;
 use crate::scene::{Scene, SceneError};
 
 /// The closed form of the bundled automaton `case`, if it has one.

@@ -142,7 +142,7 @@ fn dop853_event_times_fall_with_its_tolerance() {
     // keep falling with the tolerance (each decade at least 3x, down to
     // 1e-12 at tolerance 1e-13) instead of stalling at the interpolant's
     // error and wandering (1e-12 gave 1.4e-11, 1e-13 gave 3.4e-10 unsharpened).
-    let scene = flicker::scene::parse(
+    let scene = flicker::models::parse(
         r#"{"model": "mechanism", "formulation": "strain", "eta": 0.8, "omega": 1.0,
             "initial": {"energy": 0.1, "phase": "impact"}, "t_end": 100.0}"#,
     )

@@ -5,10 +5,10 @@
 //! refused.
 
 use flicker::compare_models::{Model, distance, release as release_of, run_all};
+use flicker::models as scene;
+use flicker::models::ContinuumScene;
 use flicker::models::continuum::Variant;
 use flicker::runner::Control;
-use flicker::scene;
-use flicker::scene::ContinuumScene;
 
 use crate::support::{flicker, models, read_json};
 

@@ -5,7 +5,7 @@
 
 use flicker::engine::{LocalModel, Options, Recorder, Status, simulate_local};
 use flicker::models::continuum::{Continuum, FrontTracking, Piece, StringModel};
-use flicker::scene::{self, ContinuumScene};
+use flicker::models::{self as scene, ContinuumScene};
 use flicker::time::Time;
 
 use crate::support::{flicker, models, read_json};

@@ -4,9 +4,9 @@
 //! elastic release at the wave speed.
 
 use flicker::engine::{LocalModel, Options, Status, simulate_local};
+use flicker::models as scene;
 use flicker::models::continuum::hugoniot;
 use flicker::models::continuum::{Continuum, Homogenized, StringModel, Variant};
-use flicker::scene;
 use flicker::time::Time;
 
 fn string(load: f64) -> Continuum {

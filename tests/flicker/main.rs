@@ -1,5 +1,6 @@
 //! flicker's integration tests: one binary, one module per behaviour.
 
+mod architecture;
 mod automata;
 mod automata_models;
 mod automata_tools;

@@ -6,8 +6,9 @@ use std::path::Path;
 
 use flicker::engine::Status;
 use flicker::models::mechanism::Mechanism;
+use flicker::models::{self as scene, ChainScene, ContinuumScene, Formulation, MechanismScene};
 use flicker::runner::{Control, Report};
-use flicker::scene::{self, ChainScene, ContinuumScene, Formulation, MechanismScene, Scene};
+use flicker::scene::Scene;
 
 use crate::oscillator::Unit;
 

@@ -32,7 +32,9 @@ const MAX_VALUES: usize = 100_000_000;
 
 /// Whether `request` can run on `scene`, checked before anything runs.
 pub fn check(scene: &AutomatonScene, request: &EnsembleRequest) -> Result<(), SceneError> {
-    request.check()?;
+    request
+        .check()
+        .map_err(|why| SceneError::field("ensemble", why))?;
     let stored = request
         .copies
         .saturating_mul(SAMPLES)

@@ -3,7 +3,6 @@
 
 use std::sync::Arc;
 
-use crate::compare::Reference;
 use crate::engine::integrator::{methods_for, runs};
 use crate::engine::zeno;
 use crate::engine::{
@@ -14,6 +13,7 @@ use crate::models::automaton::definition::{Definition, Transition};
 use crate::models::automaton::model::Automaton;
 use crate::runner::ensemble::{EnsembleReport, EnsembleRequest};
 use crate::runner::{Control, Report, Trajectory};
+use crate::scene::Reference;
 use crate::scene::fields::Fields;
 use crate::scene::solver::{SolverSpec, check_steps};
 use crate::scene::{Scene, SceneError, SceneModel};

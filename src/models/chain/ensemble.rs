@@ -15,10 +15,11 @@ use serde_json::json;
 
 use crate::engine::{Method, Options, Status, Tolerances, simulate_local};
 use crate::models::chain::coarse::Coarse;
+use crate::models::chain::scene::ChainScene;
 use crate::models::chain::{Chain, TaylorChain};
 use crate::runner::Control;
 use crate::runner::ensemble::{EnsembleReport, EnsembleRequest, spread};
-use crate::scene::{ChainScene, SceneError};
+use crate::scene::SceneError;
 use crate::time::Time;
 
 /// Unit strains differing by more than this are no longer reproducible.
@@ -77,7 +78,9 @@ struct Sample {
 /// bad flags lose nothing.
 pub fn check(scene: &ChainScene, request: &EnsembleRequest) -> Result<(), SceneError> {
     let refuse = |reason: String| SceneError::field("ensemble", reason);
-    request.check()?;
+    request
+        .check()
+        .map_err(|why| SceneError::field("ensemble", why))?;
     if !matches!(scene.method, Method::Auto | Method::Exact) {
         return Err(refuse(
             "runs a chain scene with its exact flow only; leave `--method` out".into(),

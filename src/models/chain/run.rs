@@ -6,11 +6,12 @@ use crate::engine::{
     HybridModel, LocalModel, Method, Observer, Options, Outcome, Sample, Status, simulate_local,
     simulate_sampled,
 };
+use crate::models::chain::scene::ChainScene;
 use crate::models::chain::{Chain, TaylorChain};
 use crate::runner::{
     CLASSICAL_MAX_UNITS, Classical, Control, FieldOutputs, Profile, Report, TraceRow,
 };
-use crate::scene::{ChainScene, SceneError};
+use crate::scene::SceneError;
 use crate::time::Time;
 
 /// The chain's state at one time, in gaps and velocities.

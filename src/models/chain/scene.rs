@@ -27,18 +27,16 @@
 
 use serde_json::Value;
 
-use crate::compare::Reference;
-use crate::compare_models::{DEFAULT_CELLS, Release};
 use crate::engine::integrator::methods_for;
 use crate::engine::{Method, Observer, Tolerances};
 use crate::models::chain::Chain;
-use crate::models::continuum::{Piece, Variant};
 use crate::runner::ensemble::{EnsembleReport, EnsembleRequest};
 use crate::runner::{Control, Report};
+use crate::scene::Reference;
 use crate::scene::extent;
 use crate::scene::fields::Fields;
 use crate::scene::solver::{SolverSpec, check_steps};
-use crate::scene::{ContinuumScene, Scene, SceneError, SceneModel};
+use crate::scene::{Scene, SceneError, SceneModel};
 
 /// Most units a scene may have.
 pub const MAX_UNITS: u64 = 1_000_000;
@@ -319,36 +317,6 @@ impl SceneModel for ChainScene {
              (its exact and ODE paths are checked against each other in tests/flicker/chain_exact.rs)"
                 .into(),
         ))
-    }
-
-    /// The string without its units, at the strain every unit starts at.
-    fn release(&self) -> Option<Result<Release, SceneError>> {
-        let rest = self.load_before - 1.0;
-        let uniform =
-            self.strain.iter().all(|e| *e == rest) && self.velocity.iter().all(|v| *v == 0.0);
-        let string = ContinuumScene {
-            variant: Variant::Paper,
-            length: self.length,
-            wave_speed: self.wave_speed,
-            load_before: self.load_before,
-            load_after: self.load_after,
-            constraint: self.constraint,
-            t_end: self.t_end,
-            snapshots: self.snapshots.clone(),
-            samples: self.samples,
-            resolution: DEFAULT_CELLS,
-            cells: vec![Piece {
-                strain: rest,
-                velocity: 0.0,
-            }],
-            max_events: self.max_events,
-            description: None,
-        };
-        Some(Ok(Release {
-            string,
-            units: Some(self.units),
-            uniform,
-        }))
     }
 
     fn family(&self) -> Result<Box<dyn crate::engine::Family>, SceneError> {

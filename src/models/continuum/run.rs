@@ -4,9 +4,10 @@
 //! (constraint off) beside it.
 
 use crate::engine::{Observer, Outcome, Status, simulate_local};
+use crate::models::continuum::scene::ContinuumScene;
 use crate::models::continuum::{FrontTracking, Homogenized, StringModel, Variant};
 use crate::runner::{Classical, Control, FieldOutputs, Profile, Report, TraceRow};
-use crate::scene::{ContinuumScene, SceneError};
+use crate::scene::SceneError;
 use crate::time::Time;
 
 pub(crate) fn run(

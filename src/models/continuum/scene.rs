@@ -26,11 +26,10 @@
 
 use serde_json::Value;
 
-use crate::compare::Reference;
-use crate::compare_models::{DEFAULT_CELLS, Release};
 use crate::engine::{Method, Observer};
 use crate::models::continuum::{Continuum, Piece, Variant};
 use crate::runner::{Control, Report};
+use crate::scene::Reference;
 use crate::scene::extent;
 use crate::scene::fields::{Fields, kind};
 use crate::scene::solver::SolverSpec;
@@ -352,18 +351,6 @@ impl SceneModel for ContinuumScene {
              exact front tracking only (`flicker compare-models` compares it with the chain)"
                 .into(),
         ))
-    }
-
-    /// Itself, on the comparison's cells.
-    fn release(&self) -> Option<Result<Release, SceneError>> {
-        Some(Ok(Release {
-            string: ContinuumScene {
-                resolution: DEFAULT_CELLS,
-                ..self.clone()
-            },
-            units: None,
-            uniform: self.cells.len() == 1,
-        }))
     }
 
     fn family(&self) -> Result<Box<dyn crate::engine::Family>, SceneError> {

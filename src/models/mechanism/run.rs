@@ -1,10 +1,11 @@
 //! Running a mechanism scene in the formulation and method it asks for.
 
 use crate::engine::{Method, Observer, Sample, simulate_sampled};
+use crate::models::mechanism::scene::{Formulation, Initial, MechanismScene};
 use crate::models::mechanism::strain::FLIGHT;
 use crate::models::mechanism::{AngleMechanism, Charts, StrainMechanism};
 use crate::runner::{Control, Report};
-use crate::scene::{Formulation, Initial, MechanismScene, SceneError};
+use crate::scene::SceneError;
 
 pub(crate) fn run(
     scene: &MechanismScene,

@@ -27,7 +27,6 @@
 
 use std::f64::consts::FRAC_PI_2;
 
-use crate::compare::Reference;
 use crate::engine::Observer;
 use crate::engine::integrator::{methods_for, runs};
 use crate::engine::zeno;
@@ -37,6 +36,7 @@ use crate::models::mechanism::strain::{self, FLIGHT};
 use crate::models::mechanism::{AngleMechanism, ExactOrbit, StrainMechanism, angle};
 use crate::models::mechanism::{Charts, Mechanism, Phase};
 use crate::runner::{Control, Report, Trajectory};
+use crate::scene::Reference;
 use crate::scene::fields::{Fields, kind};
 use crate::scene::solver::{SolverSpec, check_steps};
 use crate::scene::{Scene, SceneError, SceneModel};

@@ -1,6 +1,6 @@
 //! Pictures of what a run wrote, as SVG and PNG: the energy audit and the
 //! intervals between events, from `events.jsonl`; the work-precision chart,
-//! from `compare.csv`.
+//! from `compare.csv` (`flicker plot DIR`, and `flicker run --plot`).
 
 use std::path::{Path, PathBuf};
 

@@ -1,4 +1,5 @@
-//! The exact answer a comparison measures against.
+//! The exact answer a scene offers to measure runs against (`flicker
+//! compare`, `flicker stress`).
 
 use std::fmt;
 use std::sync::Arc;

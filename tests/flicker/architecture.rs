@@ -1,0 +1,158 @@
+//! The house points one way: read from the code's own `crate::` paths
+//! (comments and test modules aside), every top-level module of `src/`
+//! imports only from modules on lower layers, so no import circle can
+//! form between them. A new module must be given a layer here.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+
+/// The layers, lowest first: a module may import from any lower layer,
+/// none from its own or a higher one.
+const LAYERS: [&[&str]; 9] = [
+    &["numerics", "time"],
+    // The generic engine and the model interface the tools ask (Family).
+    &["engine"],
+    // What a run returns and what controls it.
+    &["runner"],
+    // Scene files and what every kind of scene offers; the event log.
+    &["scene", "log"],
+    // Physics, each kind with its scene adapter and family.
+    &["models"],
+    &["plot"],
+    // Tools over any scene.
+    &[
+        "compare",
+        "compare_models",
+        "orbit",
+        "sensitivities",
+        "stress",
+        "sweep",
+    ],
+    &["session"],
+    &["cli"],
+];
+
+fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.is_dir() {
+            rust_files(&path, out);
+        } else if path.extension().is_some_and(|e| e == "rs") {
+            out.push(path);
+        }
+    }
+}
+
+/// Every `crate::NAME` a file's code (not its comments, not its tests)
+/// names.
+fn imports(text: &str) -> BTreeSet<String> {
+    let code = text.split("#[cfg(test)]").next().unwrap_or("");
+    let mut names = BTreeSet::new();
+    for line in code.lines() {
+        // What follows `//` is a comment (or, rarely, a string's URL: no
+        // import is lost, since none follows one on the same line).
+        let line = line.split("//").next().unwrap_or("");
+        for (at, _) in line.match_indices("crate::") {
+            let name: String = line[at + 7..]
+                .chars()
+                .take_while(|c| c.is_alphanumeric() || *c == '_')
+                .collect();
+            if !name.is_empty() {
+                names.insert(name);
+            }
+        }
+    }
+    names
+}
+
+/// Which top-level module imports which, with a file that does.
+fn graph(src: &Path) -> BTreeMap<String, BTreeMap<String, PathBuf>> {
+    let mut files = Vec::new();
+    rust_files(src, &mut files);
+    let mut edges: BTreeMap<String, BTreeMap<String, PathBuf>> = BTreeMap::new();
+    for file in files {
+        let relative = file.strip_prefix(src).unwrap();
+        let top = relative
+            .components()
+            .next()
+            .unwrap()
+            .as_os_str()
+            .to_string_lossy()
+            .trim_end_matches(".rs")
+            .to_string();
+        if top == "lib" || top == "main" {
+            continue;
+        }
+        let text = std::fs::read_to_string(&file).unwrap();
+        let entry = edges.entry(top.clone()).or_default();
+        for name in imports(&text) {
+            if name != top {
+                entry.entry(name).or_insert_with(|| relative.to_path_buf());
+            }
+        }
+    }
+    edges
+}
+
+fn layer(module: &str) -> Option<usize> {
+    LAYERS.iter().position(|layer| layer.contains(&module))
+}
+
+/// A path of imports from `from` back to itself, if there is one.
+fn circle(edges: &BTreeMap<String, BTreeMap<String, PathBuf>>, from: &str) -> Option<Vec<String>> {
+    let mut stack = vec![vec![from.to_string()]];
+    let mut seen = BTreeSet::new();
+    while let Some(path) = stack.pop() {
+        let last = path.last().unwrap();
+        for next in edges.get(last).into_iter().flat_map(|e| e.keys()) {
+            if next == from {
+                let mut closed = path.clone();
+                closed.push(next.clone());
+                return Some(closed);
+            }
+            if seen.insert(next.clone()) {
+                let mut longer = path.clone();
+                longer.push(next.clone());
+                stack.push(longer);
+            }
+        }
+    }
+    None
+}
+
+#[test]
+fn every_import_points_down_and_no_circle_forms() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let edges = graph(&src);
+    let mut wrong = Vec::new();
+    for (module, imported) in &edges {
+        let Some(own) = layer(module) else {
+            wrong.push(format!("`{module}` has no layer: give it one in LAYERS"));
+            continue;
+        };
+        for (target, file) in imported {
+            match layer(target) {
+                Some(l) if l < own => {}
+                _ => wrong.push(format!(
+                    "{} imports `{target}`, which is not below `{module}`{}",
+                    file.display(),
+                    circle(&edges, module)
+                        .map(|c| format!(" (a circle: {})", c.join(" -> ")))
+                        .unwrap_or_default()
+                )),
+            }
+        }
+    }
+    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+}
+
+/// The reading itself: a comment, a doc link or a test module names a
+/// module without importing it; code does, in a `use` or inline.
+#[test]
+fn only_code_counts_as_an_import() {
+    let text = "//! [`x`]: crate::orbit::Orbit\nuse crate::engine::Mode;\n\
+                fn f() { crate::models::load(p); } // crate::cli\n\
+                #[cfg(test)]\nmod tests { use crate::sweep; }\n";
+    let found: Vec<String> = imports(text).into_iter().collect();
+    assert_eq!(found, ["engine", "models"]);
+}
