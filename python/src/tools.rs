@@ -243,12 +243,7 @@ pub fn orbit(
     })?;
     let found =
         found.map_err(|e| override_error(py, e.field.as_deref().unwrap_or("section"), e.reason))?;
-    let json = flicker::cli::orbit::orbit_json(
-        &found,
-        Path::new(&label),
-        &section,
-        started.elapsed().as_secs_f64(),
-    );
+    let json = found.to_json(Path::new(&label), &section, started.elapsed().as_secs_f64());
     Ok(json.to_string())
 }
 

@@ -104,11 +104,7 @@ pub fn compare_models(args: CompareModelsArgs, registry: &Registry) -> Result<Co
     release.samples = samples;
     let tracks = run_all(&release, &models, &control).map_err(Failure::bad_input)?;
     if let Some(t) = tracks.iter().find(|t| t.status != Status::Completed) {
-        let code = if stop.load(Ordering::Relaxed) {
-            Code::Interrupted
-        } else {
-            Code::Untrusted
-        };
+        let code = Code::stopped(stop.load(Ordering::Relaxed));
         say!(
             "{} stopped: {}",
             t.label,

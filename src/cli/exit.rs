@@ -1,4 +1,7 @@
-//! Exit codes, in one place.
+//! Exit codes, in one place: what each means, and which a run's status
+//! or a tool's stop gives.
+
+use crate::engine::Status;
 
 /// What the process tells its caller.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -11,6 +14,28 @@ pub enum Code {
     Untrusted = 3,
     /// Stopped by a signal.
     Interrupted = 130,
+}
+
+impl Code {
+    /// The code of a run that ended with `status`: a completed run and a
+    /// recognised Zeno point are fine, a failed run cannot be trusted.
+    pub fn of(status: Status) -> Code {
+        match status {
+            Status::Completed | Status::Zeno => Code::Ok,
+            Status::Failed => Code::Untrusted,
+            Status::Interrupted => Code::Interrupted,
+        }
+    }
+
+    /// The code of a tool that stopped short: interrupted (the stop flag
+    /// was set), else its result cannot be trusted.
+    pub fn stopped(interrupted: bool) -> Code {
+        if interrupted {
+            Code::Interrupted
+        } else {
+            Code::Untrusted
+        }
+    }
 }
 
 /// An error with its exit code and a one-line message.

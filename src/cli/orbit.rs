@@ -4,10 +4,8 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use serde_json::{Value, json};
-
 use crate::log::summary::write_atomically;
-use crate::orbit::{Orbit, OrbitRequest};
+use crate::orbit::OrbitRequest;
 use crate::scene::Registry;
 
 use crate::cli::exit::{Code, Failure};
@@ -36,36 +34,6 @@ pub struct OrbitArgs {
     /// Output directory (default: out/<scene name>-orbit).
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
-}
-
-/// The contents of `orbit.json`.
-pub fn orbit_json(orbit: &Orbit, scene: &Path, section: &str, wall: f64) -> Value {
-    let state: serde_json::Map<String, Value> = orbit
-        .section_state
-        .iter()
-        .map(|(n, x)| (n.to_string(), json!(x)))
-        .collect();
-    let multipliers: Vec<Value> = orbit
-        .multipliers
-        .iter()
-        .map(|(re, im)| json!([re, im]))
-        .collect();
-    json!({
-        "status": orbit.status,
-        "converged": orbit.converged,
-        "scene": scene.display().to_string(),
-        "section": section,
-        "period": orbit.period,
-        "events_per_period": orbit.events_per_period,
-        "mode": orbit.mode,
-        "section_state": state,
-        "multipliers": multipliers,
-        "stable": orbit.stable,
-        "residual": orbit.residual,
-        "iterations": orbit.iterations,
-        "newton_residuals": orbit.residuals,
-        "wall_seconds": wall,
-    })
 }
 
 /// Run `flicker orbit`: search, write `orbit.json`, say what was found.
@@ -100,7 +68,7 @@ pub fn orbit(args: OrbitArgs, registry: &Registry) -> Result<Code, Failure> {
     let wall = started.elapsed().as_secs_f64();
     crate::cli::setup::output_folder(&out)?;
     let path = out.join("orbit.json");
-    write_atomically(&path, &orbit_json(&orbit, &args.scene, &args.section, wall))
+    write_atomically(&path, &orbit.to_json(&args.scene, &args.section, wall))
         .map_err(|e| Failure::untrusted(format!("{}: cannot be written: {e}", path.display())))?;
     if !orbit.converged {
         say!("no orbit: {}", orbit.status);

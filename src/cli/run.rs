@@ -310,11 +310,7 @@ pub fn run(args: RunArgs, registry: &Registry) -> Result<Code, Failure> {
             .stop
             .as_ref()
             .is_some_and(|s| s.load(Ordering::Relaxed));
-        return Ok(if interrupted {
-            Code::Interrupted
-        } else {
-            Code::Untrusted
-        });
+        return Ok(Code::stopped(interrupted));
     }
     // A run that cannot be trusted says why on stderr too, where a caller
     // that keeps only the errors (`2>err`) looks.
@@ -330,11 +326,7 @@ pub fn run(args: RunArgs, registry: &Registry) -> Result<Code, Failure> {
                 .unwrap_or("no reason given")
         );
     }
-    Ok(match report.outcome.status {
-        Status::Completed | Status::Zeno => Code::Ok,
-        Status::Failed => Code::Untrusted,
-        Status::Interrupted => Code::Interrupted,
-    })
+    Ok(Code::of(report.outcome.status))
 }
 
 fn default_out(scene: &Path) -> PathBuf {

@@ -12,6 +12,7 @@
 
 pub mod continuation;
 pub mod diagram;
+mod json;
 pub mod section;
 pub mod shooting;
 
@@ -84,6 +85,7 @@ pub fn start(
     if settle > 0.0 {
         let options = Options {
             stop: section.stop.cloned(),
+            method: section.method(section.model),
             ..Options::until(settle)
         };
         let outcome = simulate(section.model, mode, &x, &options, &mut ());

@@ -107,12 +107,16 @@ impl std::fmt::Debug for Section<'_> {
 }
 
 impl Section<'_> {
-    /// The method the section's runs take: the exact linear propagator
+    /// The method `model`'s runs take (the section's, its transient): the
+    /// closed form where every mode has one, the exact linear propagator
     /// where every mode (with its derivatives) is linear or frozen, DOP853
     /// at 1e-13 otherwise.
-    fn method<M: HybridModel + ?Sized>(&self, model: &M) -> Method {
+    pub fn method<M: HybridModel + ?Sized>(&self, model: &M) -> Method {
         let modes = self.family.modes();
-        if (0..modes).all(|m| model.flow(m) == Flow::Frozen || model.is_linear(m)) {
+        if (0..modes).all(|m| matches!(model.flow(m), Flow::Frozen | Flow::Exact)) {
+            // Closed-form flows: the engine's own choice runs them exactly.
+            Method::Auto
+        } else if (0..modes).all(|m| model.flow(m) == Flow::Frozen || model.is_linear(m)) {
             Method::Linear
         } else {
             Method::Dop853(Tolerances {
