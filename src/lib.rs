@@ -65,6 +65,7 @@ pub mod compare;
 pub mod compare_models;
 pub mod engine;
 pub mod log;
+pub mod lyapunov;
 pub mod models;
 pub mod numerics;
 pub mod orbit;

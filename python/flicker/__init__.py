@@ -40,6 +40,7 @@ __all__ = [
     "compare",
     "continuation",
     "orbit",
+    "lyapunov",
     "run",
     "sweep",
     "work_precision",
@@ -288,6 +289,39 @@ def orbit(
     return json.loads(
         _flicker.orbit(
             text, path, section=section, events=events, settle=float(settle), forcing_period=forcing_period
+        )
+    )
+
+
+def lyapunov(
+    scene: Scene,
+    *,
+    exponents: Optional[int] = None,
+    transient: float = 0.0,
+    t_end: Optional[float] = None,
+    interval: Optional[float] = None,
+    wall: float = 600.0,
+) -> Dict[str, Any]:
+    """`flicker lyapunov`: the Lyapunov spectrum of any model with a finite
+    state, through its events (Benettin's method: tangents carried by the
+    variational equations and each event's saltation matrix,
+    re-orthonormalised every `interval`, default a quarter of the scene's
+    time scale), averaged over `t_end` (default the scene's) after
+    `transient`. Returns what `lyapunov.json` holds: `exponents` (largest
+    first; a forced system's clock gives one 0), `sum`, `t_span`,
+    `events`, `history` (rows of `t` and `exponents`), `method`, and
+    `status` (`completed`, or why it stopped short: Ctrl-C, or past `wall`
+    seconds)."""
+    text, path = _source(scene)
+    return json.loads(
+        _flicker.lyapunov(
+            text,
+            path,
+            exponents=exponents,
+            transient=float(transient),
+            t_end=None if t_end is None else float(t_end),
+            interval=None if interval is None else float(interval),
+            wall=float(wall),
         )
     )
 

@@ -43,6 +43,15 @@ def orbit(
     settle: float = 0.0,
     forcing_period: Optional[float] = None,
 ) -> str: ...
+def lyapunov(
+    text: Optional[str] = None,
+    path: Optional[str] = None,
+    exponents: Optional[int] = None,
+    transient: float = 0.0,
+    t_end: Optional[float] = None,
+    interval: Optional[float] = None,
+    wall: float = 600.0,
+) -> str: ...
 def continuation(
     text: Optional[str] = None,
     path: Optional[str] = None,

@@ -255,6 +255,7 @@ fn _flicker(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(tools::compare, m)?)?;
     m.add_function(wrap_pyfunction!(tools::sweep, m)?)?;
     m.add_function(wrap_pyfunction!(tools::orbit, m)?)?;
+    m.add_function(wrap_pyfunction!(tools::lyapunov, m)?)?;
     m.add_function(wrap_pyfunction!(tools::continuation, m)?)?;
     Ok(())
 }

@@ -318,3 +318,42 @@ pub fn continuation<'py>(
     out.set_item("ended", branch.ended.clone())?;
     Ok(out)
 }
+
+/// `flicker lyapunov`: the JSON text of `lyapunov.json` (the spectrum, or
+/// as far as it got and why it stopped).
+#[pyfunction]
+#[pyo3(signature = (text=None, path=None, exponents=None, transient=0.0, t_end=None, interval=None, wall=600.0))]
+#[allow(clippy::too_many_arguments)]
+pub fn lyapunov(
+    py: Python<'_>,
+    text: Option<&str>,
+    path: Option<&str>,
+    exponents: Option<usize>,
+    transient: f64,
+    t_end: Option<f64>,
+    interval: Option<f64>,
+    wall: f64,
+) -> PyResult<String> {
+    let (scene, label) = load(py, text, path)?;
+    let family = scene
+        .family()
+        .map_err(|e| override_error(py, "model", e.reason))?;
+    let request = flicker::lyapunov::Request {
+        exponents: exponents.unwrap_or_else(|| family.model().dimension()),
+        transient,
+        span: t_end.unwrap_or_else(|| scene.t_end()),
+        interval: interval.unwrap_or_else(|| scene.time_scale() / 4.0),
+        stop: None,
+        wall_seconds: wall,
+    };
+    flicker::lyapunov::check(&*family, &request)
+        .map_err(|(field, why)| override_error(py, field, why))?;
+    let found = interruptible(py, |stop| {
+        let request = flicker::lyapunov::Request {
+            stop: Some(stop.clone()),
+            ..request.clone()
+        };
+        flicker::lyapunov::spectrum(&*family, &request, &mut |_, _| {})
+    })?;
+    Ok(found.to_json(&request, Path::new(&label)).to_string())
+}

@@ -121,3 +121,15 @@ def test_the_built_in_mechanism_has_orbits_and_sensitivities_too():
     up = mechanism_closed_form(1.2, strain0 + h, 20.0)[1][0]
     down = mechanism_closed_form(1.2, strain0 - h, 20.0)[1][0]
     assert abs(got - (up - down) / (2 * h)) < 1e-6
+
+
+def test_lyapunov_spectrum_of_the_table_ball_sums_to_its_restitution_loss():
+    """The ball on the vibrating table: each impact's saltation matrix has
+    determinant r^2 and the flight keeps volume, so the exponents sum to
+    2 ln(r) x impacts per unit time; the clock gives a 0."""
+    found = flicker.lyapunov(TABLE, t_end=100.0, transient=2.0)
+    assert found["status"] == "completed"
+    rate = found["events"] / found["t_span"]
+    assert abs(sum(found["exponents"]) - 2 * math.log(R) * rate) < 1e-6
+    assert min(abs(x) for x in found["exponents"]) < 1e-9
+    assert found["history"][-1]["t"] == found["t_span"]

@@ -29,6 +29,7 @@ pub mod compare_models;
 pub mod continuation;
 pub mod events;
 pub mod exit;
+pub mod lyapunov;
 pub mod orbit;
 pub mod plot;
 pub mod plot_run;
@@ -146,6 +147,9 @@ enum Command {
     /// Follow a periodic orbit in a parameter (pseudo-arclength), label its
     /// bifurcations; writes DIR/continuation.csv and DIR/bifurcation.svg.
     Continue(continuation::ContinueArgs),
+    /// The Lyapunov spectrum through the events (Benettin's method with
+    /// saltation matrices); writes DIR/lyapunov.json and its convergence.
+    Lyapunov(lyapunov::LyapunovArgs),
     /// Print the JSON Schema of scene files, for every model this program
     /// knows (schemas/scene.schema.json is its output for the built-in ones).
     Schema,
@@ -202,6 +206,7 @@ pub fn dispatch(cli: Cli, registry: &Registry) -> Result<Code, Failure> {
         Command::CompareModels(args) => compare_models::compare_models(args, registry),
         Command::Orbit(args) => orbit::orbit(args, registry),
         Command::Continue(args) => continuation::continue_orbit(args, registry),
+        Command::Lyapunov(args) => lyapunov::lyapunov(args, registry),
         Command::Advise(args) => advise::advise(args, registry),
         Command::Stress {
             dir,

@@ -23,6 +23,7 @@ const LAYERS: [&[&str]; 9] = [
     &[
         "compare",
         "compare_models",
+        "lyapunov",
         "orbit",
         "sensitivities",
         "stress",

@@ -24,6 +24,7 @@ mod fuzz_regressions;
 mod golden;
 mod homogenized;
 mod invariants;
+mod lyapunov;
 mod mechanism_angle;
 mod mechanism_strain;
 mod orbits;
