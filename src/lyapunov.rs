@@ -57,7 +57,7 @@ pub struct Spectrum {
     pub t_span: f64,
     /// Events over that time.
     pub events: u64,
-    /// The exponents after each interval (at most [`HISTORY`] rows,
+    /// The exponents after each interval (at most 400 rows,
     /// evenly spread): `(t, exponents)`.
     pub history: Vec<(f64, Vec<f64>)>,
     /// The method the tangents were carried by.
