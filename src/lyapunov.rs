@@ -43,9 +43,9 @@ pub struct Request {
     pub interval: f64,
     /// Set from outside (Ctrl-C) to end the spectrum at the next interval.
     pub stop: Option<Arc<AtomicBool>>,
-    /// Wall-clock budget, in seconds: the spectrum stops, saying so, past
-    /// it.
-    pub wall_seconds: f64,
+    /// When the spectrum must end (`--wall`): it stops there, saying so,
+    /// keeping what it measured.
+    pub deadline: Option<Instant>,
 }
 
 /// A spectrum, as far as it got.
@@ -130,7 +130,6 @@ pub fn check(family: &dyn Family, request: &Request) -> Result<(), (&'static str
     };
     positive("t_end", request.span)?;
     positive("interval", request.interval)?;
-    positive("wall", request.wall_seconds)?;
     if !(request.transient.is_finite() && request.transient >= 0.0) {
         return Err((
             "transient",
@@ -156,7 +155,6 @@ pub fn spectrum(
     request: &Request,
     progress: &mut dyn FnMut(f64, u64),
 ) -> Spectrum {
-    let started = Instant::now();
     let model = family.model();
     let modes = family.modes();
     let n = model.dimension();
@@ -207,10 +205,10 @@ pub fn spectrum(
             spectrum.status = format!("interrupted at t = {t}");
             break;
         }
-        if started.elapsed().as_secs_f64() > request.wall_seconds {
+        if request.deadline.is_some_and(|d| Instant::now() >= d) {
             spectrum.status = format!(
-                "stopped at t = {t} of {}: past the wall-clock budget of {} s (--wall)",
-                request.span, request.wall_seconds
+                "stopped at t = {t} of {}: past the wall-clock budget (--wall)",
+                request.span
             );
             break;
         }
@@ -218,17 +216,27 @@ pub fn spectrum(
         let options = Options {
             method,
             stop: request.stop.clone(),
+            max_wall_seconds: request
+                .deadline
+                .map(|d| d.saturating_duration_since(Instant::now()).as_secs_f64()),
             ..Options::until(h)
         };
         let start = variational.initial(&x, &basis);
         let outcome = simulate(&variational, mode, &start, &options, &mut ());
         if outcome.status != Status::Completed {
-            spectrum.status = format!(
-                "the run {} at t = {}: {}",
-                outcome.status.as_str(),
-                t + outcome.t_reached,
-                outcome.reason.unwrap_or_default()
-            );
+            spectrum.status = if request.deadline.is_some_and(|d| Instant::now() >= d) {
+                format!(
+                    "stopped at t = {t} of {}: past the wall-clock budget (--wall)",
+                    request.span
+                )
+            } else {
+                format!(
+                    "the run {} at t = {}: {}",
+                    outcome.status.as_str(),
+                    t + outcome.t_reached,
+                    outcome.reason.unwrap_or_default()
+                )
+            };
             break;
         }
         spectrum.events += outcome.events;

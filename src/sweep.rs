@@ -306,16 +306,21 @@ impl Sweep {
     }
 
     /// Run the points of `shard`, in parallel, in point order, under
-    /// `control`: once its stop flag is set, the runs under way end
-    /// `interrupted` and the points not begun are marked so.
-    pub fn run(&self, shard: Shard, control: &Control) -> Vec<Row> {
+    /// `control`: once its stop flag is set or its deadline passed, the
+    /// runs under way end and the points not begun are marked so.
+    /// `done` hears of each point as it finishes.
+    pub fn run(&self, shard: Shard, control: &Control, done: &(dyn Fn() + Sync)) -> Vec<Row> {
         let points: Vec<usize> = (shard.index..self.points()).step_by(shard.count).collect();
         // Points differ in cost by orders of magnitude (chattering orbits
         // make thousands of impacts): small pieces keep both cores busy.
         points
             .par_iter()
             .with_max_len(4)
-            .map(|&point| self.run_point(point, control))
+            .map(|&point| {
+                let row = self.run_point(point, control);
+                done();
+                row
+            })
             .collect()
     }
 
@@ -341,7 +346,7 @@ impl Sweep {
             Err(e) => return failed(format!("invalid: {e}")),
         };
         if control.stopped() {
-            return failed("interrupted: not begun".into());
+            return failed(format!("{}; not begun", control.stop_reason()));
         }
         let mut times = FirstAndLast::default();
         let report = match scene.run(control, &mut times) {

@@ -179,6 +179,7 @@ fn run<'py>(
     let control = Control {
         stop: Some(stop.clone()),
         max_wall_seconds: None,
+        deadline: None,
     };
     let done = AtomicBool::new(false);
     let report = py.detach(|| {

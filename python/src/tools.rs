@@ -83,6 +83,7 @@ pub fn compare<'py>(
         let control = Control {
             stop: Some(stop.clone()),
             max_wall_seconds: None,
+            deadline: None,
         };
         run_compare(&scene, &plan, &control, &mut |_| {})
     })?;
@@ -147,8 +148,9 @@ pub fn sweep<'py>(
         let control = Control {
             stop: Some(stop.clone()),
             max_wall_seconds: None,
+            deadline: None,
         };
-        pool.install(|| spec.run(Shard::WHOLE, &control))
+        pool.install(|| spec.run(Shard::WHOLE, &control, &|| {}))
     })?;
     let out = PyDict::new(py);
     let header = spec.header();
@@ -212,6 +214,7 @@ fn request(
         settle,
         forcing_period,
         stop: None,
+        deadline: None,
     }
 }
 
@@ -283,6 +286,7 @@ pub fn continuation<'py>(
             to,
             (points, max_step),
             scene.t_end(),
+            &mut |_| {},
         )
     })?;
     let (branch, names, p) = followed
@@ -344,7 +348,12 @@ pub fn lyapunov(
         span: t_end.unwrap_or_else(|| scene.t_end()),
         interval: interval.unwrap_or_else(|| scene.time_scale() / 4.0),
         stop: None,
-        wall_seconds: wall,
+        deadline: (wall.is_finite() && wall > 0.0)
+            .then(|| {
+                std::time::Instant::now()
+                    .checked_add(std::time::Duration::from_secs_f64(wall.min(1e9)))
+            })
+            .ok_or_else(|| override_error(py, "wall", format!("a time > 0 (got {wall})")))?,
     };
     flicker::lyapunov::check(&*family, &request)
         .map_err(|(field, why)| override_error(py, field, why))?;

@@ -11,7 +11,8 @@ use crate::cli::exit::{Code, Failure};
 /// Run `flicker compare`: run the scene with each of `methods` (default:
 /// every method its model offers) over `tolerances` or `steps`, print one
 /// line per run, and write `compare.csv`, `compare.svg` and `compare.png`
-/// into `out` (default: `out/<scene name>-compare`).
+/// into `out` (default: `out/<scene name>-compare`), within `wall`
+/// seconds.
 pub fn compare(
     registry: &Registry,
     scene_path: &Path,
@@ -19,7 +20,9 @@ pub fn compare(
     tolerances: Option<Vec<f64>>,
     steps: Option<Vec<f64>>,
     out: Option<PathBuf>,
+    wall: f64,
 ) -> Result<Code, Failure> {
+    let deadline = crate::cli::setup::deadline(wall)?;
     let scene = registry.load(scene_path).map_err(Failure::bad_input)?;
     let plan = Plan::new(&scene, methods, tolerances, steps).map_err(|e| {
         Failure::bad_input(format!("--{}: {}", e.field.unwrap_or_default(), e.reason))
@@ -34,12 +37,22 @@ pub fn compare(
         "{:<8} {:>9} {:>9} {:>10} {:>10} {:>9} {:>10}  status",
         "method", "tol", "step", "seconds", "evals", "events", "error"
     );
-    let control = crate::runner::Control::default();
+    let stop = crate::cli::setup::stop_flag();
+    let control = crate::runner::Control {
+        stop: Some(stop.clone()),
+        deadline,
+        ..Default::default()
+    };
     let (reference, rows) = run_compare(&scene, &plan, &control, &mut |row| {
         eprintln!("{}", line(row))
     })
     .map_err(|e| {
-        if e.untrusted {
+        if control.interrupted() {
+            Failure {
+                code: Code::Interrupted,
+                message: e.in_path(scene_path).to_string(),
+            }
+        } else if e.untrusted {
             Failure::untrusted(e.in_path(scene_path).to_string())
         } else {
             Failure::bad_input(e.in_path(scene_path))

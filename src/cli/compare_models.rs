@@ -84,6 +84,7 @@ pub fn compare_models(args: CompareModelsArgs, registry: &Registry) -> Result<Co
     let control = Control {
         stop: Some(stop.clone()),
         max_wall_seconds: None,
+        deadline: None,
     };
     let mut models: Vec<Model> = units.iter().map(|&n| Model::Chain(n)).collect();
     models.push(Model::Continuum(Variant::Paper));

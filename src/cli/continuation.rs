@@ -3,6 +3,7 @@
 //! the brute-force diagram (`DIR/brute_force.csv`) in
 //! `DIR/bifurcation.svg` and `.png`.
 
+use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
 use crate::orbit::OrbitRequest;
@@ -16,7 +17,7 @@ use crate::cli::exit::{Code, Failure};
 /// `flicker continue`'s arguments.
 #[derive(Debug, clap::Args)]
 pub struct ContinueArgs {
-    /// The scene file (an automaton).
+    /// The scene file (any model with a finite state).
     scene: PathBuf,
     /// The transition whose events are the section (an impact).
     #[arg(long, value_name = "GUARD")]
@@ -59,6 +60,17 @@ pub struct ContinueArgs {
     /// Output directory (default: out/<scene name>-continuation).
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
+    /// End the branch, saying so, after this many seconds of wall time.
+    #[arg(
+        long,
+        value_name = "SECONDS",
+        default_value_t = 600.0,
+        allow_negative_numbers = true
+    )]
+    wall: f64,
+    /// Do not print each orbit as it is found.
+    #[arg(long)]
+    quiet: bool,
 }
 
 /// Run `flicker continue`.
@@ -69,7 +81,8 @@ pub fn continue_orbit(args: ContinueArgs, registry: &Registry) -> Result<Code, F
         events: args.events,
         settle: args.settle,
         forcing_period: args.forcing_period,
-        stop: None,
+        stop: Some(crate::cli::setup::stop_flag()),
+        deadline: crate::cli::setup::deadline(args.wall)?,
     };
     let flag = |e: crate::scene::SceneError| {
         Failure::bad_input(format!(
@@ -88,6 +101,22 @@ pub fn continue_orbit(args: ContinueArgs, registry: &Registry) -> Result<Code, F
         args.to,
         (args.points, args.max_step),
         scene.t_end(),
+        &mut |q| {
+            // One line per orbit on a terminal: a branch never goes quiet.
+            if !args.quiet && std::io::stderr().is_terminal() {
+                eprintln!(
+                    "  orbit at {} = {:.10e}: period {:.10e}{}",
+                    args.param,
+                    q.parameter,
+                    q.period,
+                    if q.label.is_empty() {
+                        String::new()
+                    } else {
+                        format!(" ({})", q.label)
+                    }
+                );
+            }
+        },
     )
     .map_err(flag)?;
     let out = args.out.clone().unwrap_or_else(|| {
@@ -203,6 +232,11 @@ pub fn continue_orbit(args: ContinueArgs, registry: &Registry) -> Result<Code, F
         .any(|why| branch.ended.starts_with(why));
     if lost {
         eprintln!("flicker: the branch was lost: {}", branch.ended);
+    }
+    let interrupted = branch.ended.starts_with("interrupted");
+    if interrupted || branch.ended.starts_with("stopped: past") {
+        eprintln!("flicker: the branch stopped short: {}", branch.ended);
+        return Ok(Code::stopped(interrupted));
     }
     Ok(if lost { Code::Untrusted } else { Code::Ok })
 }

@@ -97,7 +97,7 @@ pub fn lyapunov(args: LyapunovArgs, registry: &Registry) -> Result<Code, Failure
         span: args.t_end.unwrap_or_else(|| scene.t_end()),
         interval: args.interval.unwrap_or_else(|| scene.time_scale() / 4.0),
         stop: Some(stop.clone()),
-        wall_seconds: args.wall,
+        deadline: crate::cli::setup::deadline(args.wall)?,
     };
     check(&*family, &request).map_err(|(field, why)| {
         Failure::bad_input(format!("--{}: {why}", field.replace('_', "-")))

@@ -80,6 +80,14 @@ enum Command {
         /// Output directory (default: out/<scene name>-compare).
         #[arg(long, value_name = "DIR")]
         out: Option<PathBuf>,
+        /// Stop, saying so, after this many seconds of wall time.
+        #[arg(
+            long,
+            value_name = "SECONDS",
+            default_value_t = 3600.0,
+            allow_negative_numbers = true
+        )]
+        wall: f64,
     },
     /// Run a release scene as the chain at several N and as the continuum,
     /// and measure each against the densest chain: DIR/compare_models.csv,
@@ -115,6 +123,18 @@ enum Command {
         /// Output CSV (default: out/<sweep name>.csv, or .shard-I-of-N.csv).
         #[arg(long, value_name = "FILE")]
         out: Option<PathBuf>,
+        /// Stop after this many seconds of wall time: the points not done
+        /// are written as not begun.
+        #[arg(
+            long,
+            value_name = "SECONDS",
+            default_value_t = 3600.0,
+            allow_negative_numbers = true
+        )]
+        wall: f64,
+        /// Do not draw progress.
+        #[arg(long)]
+        quiet: bool,
     },
     /// Join the shard CSVs of a sweep into the CSV a single run writes.
     Merge {
@@ -202,7 +222,8 @@ pub fn dispatch(cli: Cli, registry: &Registry) -> Result<Code, Failure> {
             tolerances,
             steps,
             out,
-        } => compare::compare(registry, &scene, methods, tolerances, steps, out),
+            wall,
+        } => compare::compare(registry, &scene, methods, tolerances, steps, out, wall),
         Command::CompareModels(args) => compare_models::compare_models(args, registry),
         Command::Orbit(args) => orbit::orbit(args, registry),
         Command::Continue(args) => continuation::continue_orbit(args, registry),
@@ -218,7 +239,9 @@ pub fn dispatch(cli: Cli, registry: &Registry) -> Result<Code, Failure> {
             shard,
             threads,
             out,
-        } => sweep::sweep(registry, &file, shard, threads, out),
+            wall,
+            quiet,
+        } => sweep::sweep(registry, &file, shard, threads, out, (wall, quiet)),
         Command::Merge {
             sweep: file,
             shards,

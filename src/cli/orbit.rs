@@ -34,6 +34,14 @@ pub struct OrbitArgs {
     /// Output directory (default: out/<scene name>-orbit).
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
+    /// Stop the search, saying so, after this many seconds of wall time.
+    #[arg(
+        long,
+        value_name = "SECONDS",
+        default_value_t = 600.0,
+        allow_negative_numbers = true
+    )]
+    wall: f64,
 }
 
 /// Run `flicker orbit`: search, write `orbit.json`, say what was found.
@@ -45,7 +53,8 @@ pub fn orbit(args: OrbitArgs, registry: &Registry) -> Result<Code, Failure> {
         events: args.events,
         settle: args.settle,
         forcing_period: args.forcing_period,
-        stop: None,
+        stop: Some(crate::cli::setup::stop_flag()),
+        deadline: crate::cli::setup::deadline(args.wall)?,
     };
     let out = args.out.unwrap_or_else(|| {
         let stem = args

@@ -153,6 +153,7 @@ fn scene_plane(
     let control = Control {
         stop: Some(crate::cli::setup::stop_flag()),
         max_wall_seconds: None,
+        deadline: None,
     };
     let (figure, report) = state_plane(&scene, &x, &y, samples, &control)
         .map_err(|e| Failure::bad_input(format!("{}: {e}", path.display())))?;

@@ -187,6 +187,7 @@ pub fn run(args: RunArgs, registry: &Registry) -> Result<Code, Failure> {
     let control = Control {
         stop: Some(crate::cli::setup::stop_flag()),
         max_wall_seconds: None,
+        deadline: None,
     };
 
     let log_path = out.join("events.jsonl");

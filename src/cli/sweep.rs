@@ -14,14 +14,17 @@ use crate::scene::Registry;
 /// Run `flicker sweep`: run the points of the sweep in `file` (all, or one
 /// `shard` given as `I/N`) on `threads` threads (default: one per core)
 /// and write one CSV row per point to `out` (default:
-/// `out/<sweep name>.csv`, or `.shard-I-of-N.csv`).
+/// `out/<sweep name>.csv`, or `.shard-I-of-N.csv`), within `wall` seconds
+/// (the points not begun by then, or on Ctrl-C, are written as such).
 pub fn sweep(
     registry: &Registry,
     file: &Path,
     shard: Option<String>,
     threads: Option<usize>,
     out: Option<PathBuf>,
+    (wall, quiet): (f64, bool),
 ) -> Result<Code, Failure> {
+    let deadline = crate::cli::setup::deadline(wall)?;
     let spec = sweep::load(file, registry).map_err(Failure::bad_input)?;
     let shard = match shard {
         Some(text) => {
@@ -53,7 +56,15 @@ pub fn sweep(
         })?;
     }
     let started = Instant::now();
-    let rows = pool.install(|| spec.run(shard, &crate::runner::Control::default()));
+    let control = crate::runner::Control {
+        stop: Some(crate::cli::setup::stop_flag()),
+        deadline,
+        ..Default::default()
+    };
+    let total = (shard.index..spec.points()).step_by(shard.count).count();
+    let bar = Points::new(total, quiet);
+    let rows = pool.install(|| spec.run(shard, &control, &|| bar.tick()));
+    bar.finish();
     let seconds = started.elapsed().as_secs_f64();
     let file = File::create(&out)
         .map_err(|e| Failure::bad_input(format!("{}: cannot be created: {e}", out.display())))?;
@@ -70,6 +81,11 @@ pub fn sweep(
         pool.current_num_threads(),
         out.display()
     );
+    if control.stopped() {
+        let why = control.stop_reason();
+        eprintln!("flicker: the sweep stopped short ({why}); the points not begun say so");
+        return Ok(Code::stopped(control.interrupted()));
+    }
     Ok(Code::Ok)
 }
 
@@ -87,4 +103,33 @@ pub fn merge(
         .map_err(|e| Failure::untrusted(format!("{}: cannot be written: {e}", out.display())))?;
     say!("merged {} shards into {}", shards.len(), out.display());
     Ok(Code::Ok)
+}
+
+/// A progress bar over a sweep's points, drawn only on a terminal.
+struct Points(Option<indicatif::ProgressBar>);
+
+impl Points {
+    fn new(total: usize, quiet: bool) -> Self {
+        use std::io::IsTerminal;
+        Points((!quiet && std::io::stderr().is_terminal()).then(|| {
+            let bar = indicatif::ProgressBar::new(total as u64);
+            bar.set_style(
+                indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} points ({elapsed})")
+                    .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+            );
+            bar
+        }))
+    }
+
+    fn tick(&self) {
+        if let Some(bar) = &self.0 {
+            bar.inc(1);
+        }
+    }
+
+    fn finish(&self) {
+        if let Some(bar) = &self.0 {
+            bar.finish_and_clear();
+        }
+    }
 }

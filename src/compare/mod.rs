@@ -149,7 +149,7 @@ pub fn compare(
                 return Err(SceneError {
                     file: None,
                     field: None,
-                    reason: "interrupted: the stop flag was set".into(),
+                    reason: control.stop_reason().into(),
                     untrusted: true,
                 });
             }

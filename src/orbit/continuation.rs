@@ -298,13 +298,16 @@ fn locate(
 }
 
 /// Follow the orbit at `x` (solved, just after a section event in `mode`)
-/// as `plan` asks.
+/// as `plan` asks; `on_point` hears of each orbit as it joins the branch.
+/// The branch ends, saying why, once the section is spent (interrupted,
+/// or past its deadline).
 pub fn follow(
     section: &Section,
     unknowns: &Unknowns,
     mode: Mode,
     x: Vec<f64>,
     plan: &Plan,
+    on_point: &mut dyn FnMut(&Point),
 ) -> Branch {
     let p = plan.parameter;
     let k = unknowns.free.len();
@@ -326,7 +329,12 @@ pub fn follow(
     points.push(point(unknowns, p, &start, ""));
     let mut here = start;
     let mut ended = format!("stopped after {} orbits", plan.points);
+    on_point(&points[0]);
     while points.len() < plan.points {
+        if let Some(why) = section.spent() {
+            ended = format!("{why}, after {} orbits", points.len());
+            break;
+        }
         let (_, a) = system(unknowns, p, &here.x, &here.back);
         let Some(t) = tangent(&a, &previous) else {
             ended = "the branch's tangent is undefined here".into();
@@ -359,6 +367,9 @@ pub fn follow(
         match correct(section, unknowns, p, mode, x, Some((&z_pred, &t))) {
             Ok(next) => {
                 push_with_bifurcations(section, unknowns, p, mode, &here, &next, &mut points);
+                if let Some(last) = points.last() {
+                    on_point(last);
+                }
                 here = next;
                 previous = t;
                 ds = (ds * 1.3).min(ds_max);

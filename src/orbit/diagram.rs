@@ -40,6 +40,7 @@ pub fn brute_force(
         events: 1,
         t_max,
         stop: None,
+        deadline: None,
     };
     Ok(values
         .par_iter()

@@ -123,6 +123,7 @@ pub fn search(
         events: request.events,
         t_max,
         stop: request.stop.as_ref(),
+        deadline: request.deadline,
     };
     let n = model.dimension();
     let unknowns = Unknowns {
@@ -161,7 +162,7 @@ pub type ContinuedBranch = (continuation::Branch, Vec<&'static str>, usize);
 /// A branch of orbits of `family`'s model followed in its parameter
 /// `parameter` to `to` (at most `points` orbits, the longest step
 /// `max_step` of the way), from the orbit found as `request` asks; every
-/// return within `t_max`.
+/// return within `t_max`; `on_point` hears of each orbit as it is found.
 pub fn follow(
     family: &dyn Family,
     request: &OrbitRequest,
@@ -169,6 +170,7 @@ pub fn follow(
     to: f64,
     (points, max_step): (usize, f64),
     t_max: f64,
+    on_point: &mut dyn FnMut(&continuation::Point),
 ) -> Result<ContinuedBranch, SceneError> {
     if !(max_step.is_finite() && max_step > 0.0 && max_step <= 1.0) {
         return Err(SceneError::field(
@@ -206,6 +208,7 @@ pub fn follow(
         events: request.events,
         t_max,
         stop: request.stop.as_ref(),
+        deadline: request.deadline,
     };
     let unknowns = Unknowns {
         free: (0..n).filter(|&i| i != p).collect(),
@@ -241,7 +244,7 @@ pub fn follow(
         step: (0.2 * max_step, max_step),
     };
     Ok((
-        continuation::follow(&section, &unknowns, mode, x, &plan),
+        continuation::follow(&section, &unknowns, mode, x, &plan, on_point),
         names,
         p,
     ))

@@ -13,6 +13,7 @@
 
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
 
 use nalgebra::DMatrix;
 
@@ -42,6 +43,8 @@ pub struct Section<'a> {
     /// Set from outside (Ctrl-C) to end the search: the run under way
     /// ends at its next event, and the next map refuses.
     pub stop: Option<&'a Arc<AtomicBool>>,
+    /// When the work must end (`--wall`): runs get what is left of it.
+    pub deadline: Option<Instant>,
 }
 
 /// One return of the map.
@@ -134,8 +137,8 @@ impl Section<'_> {
         mode: Mode,
         x0: &[f64],
     ) -> Result<(f64, Mode, Vec<f64>), String> {
-        if self.stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
-            return Err("interrupted: the stop flag was set".into());
+        if let Some(why) = self.spent() {
+            return Err(why);
         }
         let stop = Arc::new(AtomicBool::new(false));
         let options = Options {
@@ -144,7 +147,9 @@ impl Section<'_> {
             method: self.method(model),
             tolerances: Tolerances::default(),
             stop: Some(stop.clone()),
-            max_wall_seconds: None,
+            max_wall_seconds: self
+                .deadline
+                .map(|d| d.saturating_duration_since(Instant::now()).as_secs_f64()),
         };
         let mut counter = Counter {
             guard: self.guard,
@@ -174,6 +179,18 @@ impl Section<'_> {
                     outcome.reason.unwrap_or_default()
                 ),
             }),
+        }
+    }
+
+    /// Why no more runs may begin, if none may: interrupted, or past the
+    /// deadline.
+    pub fn spent(&self) -> Option<String> {
+        if self.stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
+            Some("interrupted: the stop flag was set".into())
+        } else if self.deadline.is_some_and(|d| Instant::now() >= d) {
+            Some("stopped: past the wall-clock budget (--wall)".into())
+        } else {
+            None
         }
     }
 

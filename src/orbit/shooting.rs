@@ -46,6 +46,9 @@ pub struct OrbitRequest {
     /// Set from outside (Ctrl-C) to end the search or the branch at the
     /// next return of the section map.
     pub stop: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
+    /// When the search or the branch must end (`--wall`): the run under
+    /// way fails there, and the search or branch ends saying so.
+    pub deadline: Option<std::time::Instant>,
 }
 
 /// A periodic orbit found (or why not).
@@ -212,6 +215,9 @@ pub fn shoot(section: &Section, unknowns: &Unknowns, mode: Mode, x: Vec<f64>) ->
         residuals,
     };
     for _ in 0..MAX_ITERATIONS {
+        if let Some(why) = section.spent() {
+            return failed(why, residuals, &x);
+        }
         let back = match section.map(mode, &x) {
             Ok(back) => back,
             Err(why) => return failed(format!("the section map failed: {why}"), residuals, &x),

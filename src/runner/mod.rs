@@ -77,15 +77,39 @@ pub struct Control {
     pub stop: Option<Arc<AtomicBool>>,
     /// Fails the run after this much wall time.
     pub max_wall_seconds: Option<f64>,
+    /// When the whole work under this control must end (a tool's
+    /// `--wall`): each run gets what is left of it, and a tool that runs
+    /// many begins none past it.
+    pub deadline: Option<std::time::Instant>,
 }
 
 impl Control {
     /// Whether the stop flag is set: a tool that runs many scenes stops
     /// between them.
     pub fn stopped(&self) -> bool {
+        self.interrupted() || self.past_deadline()
+    }
+
+    /// Whether the stop flag is set.
+    pub fn interrupted(&self) -> bool {
         self.stop
             .as_ref()
             .is_some_and(|s| s.load(std::sync::atomic::Ordering::Relaxed))
+    }
+
+    /// Whether the deadline has passed.
+    pub fn past_deadline(&self) -> bool {
+        self.deadline
+            .is_some_and(|d| std::time::Instant::now() >= d)
+    }
+
+    /// Why the work stopped, in words, once [`stopped`](Control::stopped).
+    pub fn stop_reason(&self) -> &'static str {
+        if self.interrupted() {
+            "interrupted: the stop flag was set"
+        } else {
+            "stopped: past the wall-clock budget (--wall)"
+        }
     }
 
     /// The engine's options for a scene's run under this control.
@@ -102,7 +126,15 @@ impl Control {
             method,
             tolerances,
             stop: self.stop.clone(),
-            max_wall_seconds: self.max_wall_seconds,
+            max_wall_seconds: match (self.max_wall_seconds, self.deadline) {
+                (own, None) => own,
+                (own, Some(d)) => {
+                    let left = d
+                        .saturating_duration_since(std::time::Instant::now())
+                        .as_secs_f64();
+                    Some(own.map_or(left, |own| own.min(left)))
+                }
+            },
         }
     }
 }

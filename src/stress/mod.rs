@@ -193,6 +193,7 @@ pub fn run_case(
     let control = Control {
         stop: None,
         max_wall_seconds: Some(wall_seconds),
+        deadline: None,
     };
     let start = Instant::now();
     let report = scene.run(&control, &mut times)?;

@@ -46,3 +46,4 @@ mod sweep;
 mod thermostat;
 mod tools_on_every_model;
 mod user_models;
+mod wall_budgets;
