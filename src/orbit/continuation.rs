@@ -22,15 +22,20 @@
 //! - **torus**: a complex pair through the unit circle, the product of
 //!   `|mu|^2 - 1` over the pairs.
 //!
-//! **Grazing**, the orbit touching a guard tangentially, ends the branch
-//! where a section map can no longer tell whether an event fires: the run
-//! says so, and so does the branch's last label.
+//! **Grazing**, the orbit touching a guard tangentially: the impact speed
+//! is watched along the branch, and where it falls to zero within the
+//! next step the grazing parameter is solved for directly
+//! ([`crate::orbit::grazing`]); the branch of impacting orbits
+//! ends there, labelled, saying on which side they exist. A corrector that
+//! meets a graze first (a section map that cannot tell whether an event
+//! fires) ends the branch too, labelling its last orbit.
 //!
 //! [`Definition::with_parameters_as_states`]: crate::models::automaton::Definition::with_parameters_as_states
 
 use nalgebra::{DMatrix, DVector};
 
 use crate::engine::Mode;
+use crate::orbit::grazing;
 use crate::orbit::section::{Return, Section};
 use crate::orbit::shooting::{Unknowns, least_squares, multipliers};
 
@@ -321,6 +326,14 @@ pub fn follow(
             };
         }
     };
+    // A return that takes more than thrice the branch's period has missed
+    // the section (a trial orbit past a graze): give up on it then, not at
+    // the scene's t_end.
+    let section = &Section {
+        t_max: section.t_max.min(3.0 * start.back.elapsed),
+        ..*section
+    };
+    let mut watched = grazing::impact_speed(section, mode, &start.x).map(|q| (start.x[p], q));
     let range = (plan.to - start.x[p]).abs().max(f64::MIN_POSITIVE);
     let (mut ds, ds_max) = (plan.step.0 * range, plan.step.1 * range);
     let toward = (plan.to - start.x[p]).signum();
@@ -370,6 +383,26 @@ pub fn follow(
                 if let Some(last) = points.last() {
                     on_point(last);
                 }
+                let speed = grazing::impact_speed(section, mode, &next.x).map(|q| (next.x[p], q));
+                if let Some((at, orbit)) = watched
+                    .zip(speed)
+                    .and_then(|(before, now)| graze_ahead(before, now))
+                    .and_then(|guess| {
+                        locate_grazing(section, unknowns, p, mode, (&here, &next), guess)
+                    })
+                {
+                    let mut graze = point(unknowns, p, &orbit, "grazing");
+                    graze.parameter = at;
+                    on_point(&graze);
+                    points.push(graze);
+                    let side = if at > next.x[p] { "below" } else { "above" };
+                    ended = format!(
+                        "grazing at {at}: the impact speed falls to zero there, and the impacting \
+                         orbits exist {side} it; the branch of impacting orbits ends"
+                    );
+                    break;
+                }
+                watched = speed;
                 here = next;
                 previous = t;
                 ds = (ds * 1.3).min(ds_max);
@@ -396,6 +429,76 @@ pub fn follow(
         last.label = "end".into();
     }
     Branch { points, ended }
+}
+
+/// Where the impact speed, falling from `before` to `now` (parameter,
+/// speed), reaches zero, if it does within one and a half more such
+/// steps.
+fn graze_ahead(before: (f64, f64), now: (f64, f64)) -> Option<f64> {
+    let falling = now.1.signum() == before.1.signum() && now.1.abs() < before.1.abs();
+    let zero = grazing::predicted(before, now)?;
+    let step = now.0 - before.0;
+    let ahead = (zero - now.0) / step;
+    (falling && (0.0..=1.5).contains(&ahead)).then_some(zero)
+}
+
+/// The grazing parameter near `guess`, approached from the impacting
+/// orbits `previous` and `near` (see [`grazing`]): three orbits of its period corrected at
+/// distances `3d`, `2d`, `d` short of the estimate (`d` a quarter of the
+/// way from `near` at first), the zero of the quadratic
+/// through their impact speeds the next estimate, `d` halved each round
+/// (the fit's error falls eightfold), until the estimate moves by less
+/// than 1e-12 of its size or the orbits are too near the graze to be
+/// corrected. Also the orbit nearest the graze.
+fn locate_grazing(
+    section: &Section,
+    unknowns: &Unknowns,
+    p: usize,
+    mode: Mode,
+    (previous, near): (&Solved, &Solved),
+    guess: f64,
+) -> Option<(f64, Solved)> {
+    let toward = (guess - near.x[p]).signum();
+    let (mut estimate, mut d) = (guess, 0.25 * (guess - near.x[p]).abs());
+    let period = near.back.elapsed;
+    // Each trial starts on the secant through the last two orbits (the
+    // section state moves with the parameter: a start left behind would
+    // miss the guard and return after another period).
+    let mut last = (previous.clone(), near.clone());
+    let mut rounds = 0;
+    'rounds: for _ in 0..8 {
+        let mut points = [(0.0, 0.0); 3];
+        for (slot, k) in [3.0, 2.0, 1.0].into_iter().enumerate() {
+            let target = estimate - toward * k * d;
+            let (a, b) = (&last.0.x, &last.1.x);
+            let f = (target - b[p]) / (b[p] - a[p]);
+            let mut x: Vec<f64> = a.iter().zip(b).map(|(a, b)| b + f * (b - a)).collect();
+            x[p] = target;
+            // Too near the graze for the section map: the last estimate stands.
+            // An orbit of another period (the corrector slid onto another
+            // branch) is not this branch's.
+            let Some((orbit, q)) = correct(section, unknowns, p, mode, x, None)
+                .ok()
+                .filter(|o| (o.back.elapsed - period).abs() <= 1e-6 * period)
+                .and_then(|o| grazing::impact_speed(section, mode, &o.x).map(|q| (o, q)))
+            else {
+                break 'rounds;
+            };
+            points[slot] = (orbit.x[p], q);
+            last = (last.1, orbit);
+        }
+        rounds += 1;
+        let Some(next) = grazing::quadratic_zero(&points, estimate) else {
+            break;
+        };
+        let moved = (next - estimate).abs();
+        estimate = next;
+        if moved <= 1e-12 * estimate.abs().max(1.0) {
+            return Some((estimate, last.1));
+        }
+        d *= 0.5;
+    }
+    (rounds > 0).then_some((estimate, last.1))
 }
 
 /// Push `next`, after the bifurcations between `here` and it.

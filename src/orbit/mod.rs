@@ -12,6 +12,7 @@
 
 pub mod continuation;
 pub mod diagram;
+pub mod grazing;
 mod json;
 pub mod section;
 pub mod shooting;

@@ -274,3 +274,61 @@ fn continuation_in_the_forcing_frequency_is_refused() {
     assert!(said.contains("`w`") && said.contains("forcing"), "{said}");
     assert!(!dir.path().join("continuation.csv").exists());
 }
+
+/// The forced linear oscillator `x'' + 2 zeta x' + x = cos(w t)` against a
+/// stop at `s` (`impact_oscillator.json`, from `s = 2`): its impacting
+/// period-one orbit, followed as the stop moves out, grazes where `s` is
+/// the free response's amplitude `1 / sqrt((1 - w^2)^2 + (2 zeta w)^2)`.
+/// The branch labels `grazing` there to 1e-8, says the impacting orbits
+/// lie below it, and ends, within its minute (`--wall 60`).
+#[test]
+fn the_impact_oscillator_s_branch_grazes_at_the_free_amplitude() {
+    let (zeta, w) = (0.05_f64, 0.8_f64);
+    let amplitude = 1.0 / ((1.0 - w * w).powi(2) + (2.0 * zeta * w).powi(2)).sqrt();
+    let mut scene =
+        crate::support::read_json(std::path::Path::new(&automaton("impact_oscillator.json")));
+    scene["parameters"]["s"] = serde_json::json!(2.0);
+    scene["t_end"] = serde_json::json!(2000.0);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("oscillator.json");
+    std::fs::write(&path, scene.to_string()).unwrap();
+    let period = (2.0 * PI / w).to_string();
+    let done = flicker(&[
+        "continue",
+        path.to_str().unwrap(),
+        "--section",
+        "impact",
+        "--param",
+        "s",
+        "--to",
+        "3",
+        "--settle",
+        "300",
+        "--forcing-period",
+        &period,
+        "--brute-force",
+        "0",
+        "--wall",
+        "60",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    let said = String::from_utf8_lossy(&done.stdout);
+    assert_eq!(
+        done.status.code(),
+        Some(0),
+        "{said}{}",
+        String::from_utf8_lossy(&done.stderr)
+    );
+    assert!(said.contains("impacting orbits exist below"), "{said}");
+    let rows = std::fs::read_to_string(dir.path().join("continuation.csv")).unwrap();
+    let graze: Vec<&str> = rows.lines().filter(|r| r.ends_with(",grazing")).collect();
+    assert_eq!(graze.len(), 1, "{rows}");
+    let s: f64 = graze[0].split(',').next().unwrap().parse().unwrap();
+    assert!(
+        (s - amplitude).abs() < 1e-8,
+        "grazing at {s}, closed form {amplitude}"
+    );
+    let last = rows.lines().last().unwrap();
+    assert!(last.ends_with(",grazing"), "the branch ends there: {last}");
+}
