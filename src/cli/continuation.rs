@@ -250,10 +250,14 @@ fn largest(q: &Point) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// The state (not the parameter) whose range along the branch is widest.
+/// The state (not the parameter, nor one the section pins to it) whose
+/// range along the branch is widest.
 fn most_varied(branch: &Branch, n: usize, p: usize) -> usize {
+    // A state the section pins to the parameter (the position at a stop
+    // that moves with it) draws only the diagonal.
+    let pinned = |i: usize| branch.points.iter().all(|q| q.state[i] == q.parameter);
     (0..n)
-        .filter(|&i| i != p)
+        .filter(|&i| i != p && !pinned(i))
         .max_by(|&a, &b| {
             let range = |i: usize| {
                 let (lo, hi) = branch

@@ -384,7 +384,7 @@ pub fn follow(
                     on_point(last);
                 }
                 let speed = grazing::impact_speed(section, mode, &next.x).map(|q| (next.x[p], q));
-                if let Some((at, orbit)) = watched
+                if let Some((at, orbit, state)) = watched
                     .zip(speed)
                     .and_then(|(before, now)| graze_ahead(before, now))
                     .and_then(|guess| {
@@ -393,6 +393,7 @@ pub fn follow(
                 {
                     let mut graze = point(unknowns, p, &orbit, "grazing");
                     graze.parameter = at;
+                    graze.state = state;
                     on_point(&graze);
                     points.push(graze);
                     let side = if at > next.x[p] { "below" } else { "above" };
@@ -449,7 +450,9 @@ fn graze_ahead(before: (f64, f64), now: (f64, f64)) -> Option<f64> {
 /// through their impact speeds the next estimate, `d` halved each round
 /// (the fit's error falls eightfold), until the estimate moves by less
 /// than 1e-12 of its size or the orbits are too near the graze to be
-/// corrected. Also the orbit nearest the graze.
+/// corrected. Also the orbit nearest the graze, and the grazing orbit's
+/// section state (the secant through the last two carried to the
+/// estimate).
 fn locate_grazing(
     section: &Section,
     unknowns: &Unknowns,
@@ -457,7 +460,7 @@ fn locate_grazing(
     mode: Mode,
     (previous, near): (&Solved, &Solved),
     guess: f64,
-) -> Option<(f64, Solved)> {
+) -> Option<(f64, Solved, Vec<f64>)> {
     let toward = (guess - near.x[p]).signum();
     let (mut estimate, mut d) = (guess, 0.25 * (guess - near.x[p]).abs());
     let period = near.back.elapsed;
@@ -494,11 +497,17 @@ fn locate_grazing(
         let moved = (next - estimate).abs();
         estimate = next;
         if moved <= 1e-12 * estimate.abs().max(1.0) {
-            return Some((estimate, last.1));
+            break;
         }
         d *= 0.5;
     }
-    (rounds > 0).then_some((estimate, last.1))
+    // The grazing orbit's section state: the last two orbits' secant
+    // carried to the estimate.
+    let (a, b) = (&last.0.x, &last.1.x);
+    let f = (estimate - b[p]) / (b[p] - a[p]);
+    let mut state: Vec<f64> = a.iter().zip(b).map(|(a, b)| b + f * (b - a)).collect();
+    state[p] = estimate;
+    (rounds > 0).then_some((estimate, last.1, state))
 }
 
 /// Push `next`, after the bifurcations between `here` and it.

@@ -196,7 +196,11 @@ fn the_largest_exponent_predicts_the_chain_s_horizon() {
             "--out",
             out.to_str().unwrap(),
         ]);
-        assert!(done.status.success(), "{}", String::from_utf8_lossy(&done.stderr));
+        assert!(
+            done.status.success(),
+            "{}",
+            String::from_utf8_lossy(&done.stderr)
+        );
         read_json(&out.join("summary.json"))["ensemble"]["horizon"]
             .as_f64()
             .unwrap()
