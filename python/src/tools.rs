@@ -242,7 +242,7 @@ pub fn orbit(
             stop: Some(stop.clone()),
             ..request.clone()
         };
-        flicker::orbit::search(&*family, &request, scene.t_end())
+        flicker::orbit::search(&*family, &request, scene.t_end(), Default::default())
     })?;
     let found =
         found.map_err(|e| override_error(py, e.field.as_deref().unwrap_or("section"), e.reason))?;

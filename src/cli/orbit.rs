@@ -1,6 +1,7 @@
 //! `flicker orbit`: a periodic orbit of a scene through a Poincare section,
 //! by Newton shooting, written to `DIR/orbit.json`.
 
+use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -9,6 +10,7 @@ use crate::orbit::OrbitRequest;
 use crate::scene::Registry;
 
 use crate::cli::exit::{Code, Failure};
+use crate::cli::progress::WithProgress;
 
 /// `flicker orbit`'s arguments.
 #[derive(Debug, clap::Args)]
@@ -34,6 +36,9 @@ pub struct OrbitArgs {
     /// Output directory (default: out/<scene name>-orbit).
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
+    /// Do not draw progress.
+    #[arg(long)]
+    quiet: bool,
     /// Stop the search, saying so, after this many seconds of wall time.
     #[arg(
         long,
@@ -67,7 +72,25 @@ pub fn orbit(args: OrbitArgs, registry: &Registry) -> Result<Code, Failure> {
     let family = scene
         .family()
         .map_err(|e| Failure::bad_input(format!("{}: {}", args.scene.display(), e.reason)))?;
-    let orbit = crate::orbit::search(&*family, &request, scene.t_end()).map_err(|e| {
+    // On a terminal: a bar over the transient, a line per Newton iteration.
+    let shown = !args.quiet && std::io::stderr().is_terminal();
+    let mut bar = WithProgress::new((), args.settle, args.quiet);
+    let clear = bar.clearer();
+    let mut newton = |k: usize, residual: f64| {
+        if k == 0 {
+            clear();
+        }
+        if shown {
+            eprintln!("  Newton iteration {k}: residual {residual:.3e}");
+        }
+    };
+    let watch = crate::orbit::Watch {
+        transient: Some(&mut bar),
+        newton: Some(&mut newton),
+    };
+    let found = crate::orbit::search(&*family, &request, scene.t_end(), watch);
+    bar.finish();
+    let orbit = found.map_err(|e| {
         Failure::bad_input(format!(
             "--{}: {}",
             e.field.clone().unwrap_or_default().replace('_', "-"),

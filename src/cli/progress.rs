@@ -40,6 +40,17 @@ impl<O> WithProgress<O> {
         }
     }
 
+    /// A handle that removes the bar from elsewhere (once what it measures
+    /// is over, before other lines are printed).
+    pub fn clearer(&self) -> impl Fn() + use<O> {
+        let bar = self.bar.clone();
+        move || {
+            if let Some(bar) = &bar {
+                bar.finish_and_clear();
+            }
+        }
+    }
+
     /// Remove the bar, leaving the terminal clean for the report.
     pub fn finish(&self) {
         if let Some(bar) = &self.bar {

@@ -60,7 +60,7 @@ pub fn brute_force(
                 })
                 .collect();
             let mut states = Vec::with_capacity(events);
-            if let Ok((mut mode, mut x)) = start(&section, mode, &x0, settle) {
+            if let Ok((mut mode, mut x)) = start(&section, mode, &x0, settle, &mut ()) {
                 states.push(x.clone());
                 while states.len() < events {
                     match section.plain(mode, &x) {

@@ -17,7 +17,7 @@ mod json;
 pub mod section;
 pub mod shooting;
 
-use crate::engine::{Family, HybridModel, Mode, Options, Status, simulate};
+use crate::engine::{Family, HybridModel, Mode, Observer, Options, Status, simulate};
 use crate::scene::SceneError;
 pub use section::Section;
 pub use shooting::{Orbit, OrbitRequest, Unknowns};
@@ -81,15 +81,20 @@ pub fn start(
     mode: Mode,
     x0: &[f64],
     settle: f64,
+    observer: &mut dyn Observer,
 ) -> Result<(Mode, Vec<f64>), String> {
     let (mut mode, mut x) = (mode, x0.to_vec());
     if settle > 0.0 {
         let options = Options {
             stop: section.stop.cloned(),
             method: section.method(section.model),
+            max_wall_seconds: section.deadline.map(|d| {
+                d.saturating_duration_since(std::time::Instant::now())
+                    .as_secs_f64()
+            }),
             ..Options::until(settle)
         };
-        let outcome = simulate(section.model, mode, &x, &options, &mut ());
+        let outcome = simulate(section.model, mode, &x, &options, observer);
         if outcome.status != Status::Completed {
             return Err(format!(
                 "the transient stopped at t = {}: {}",
@@ -107,6 +112,17 @@ pub fn start(
     Ok((mode, x))
 }
 
+/// Who hears how a search goes (nobody by default): the transient's run,
+/// as any run's observer (its progress), and each Newton iteration's
+/// residual.
+#[derive(Default)]
+pub struct Watch<'a> {
+    /// The observer of the transient's run.
+    pub transient: Option<&'a mut dyn Observer>,
+    /// Told each Newton iteration and its residual.
+    pub newton: Option<&'a mut dyn FnMut(usize, f64)>,
+}
+
 /// The periodic orbit of `family`'s model (from its start, after
 /// `request.settle`) through the section `request` names; every return
 /// within `t_max`.
@@ -114,6 +130,7 @@ pub fn search(
     family: &dyn Family,
     request: &OrbitRequest,
     t_max: f64,
+    watch: Watch<'_>,
 ) -> Result<Orbit, SceneError> {
     let model = family.model();
     check(model, family.modes(), request)?;
@@ -135,7 +152,12 @@ pub fn search(
             .map(|(p, c)| (c, p)),
     };
     let (mode0, x0) = family.start();
-    let (mode, x) = match start(&section, mode0, &x0, request.settle) {
+    let mut nobody = ();
+    let transient: &mut dyn Observer = match watch.transient {
+        Some(observer) => observer,
+        None => &mut nobody,
+    };
+    let (mode, x) = match start(&section, mode0, &x0, request.settle, transient) {
         Ok(start) => start,
         Err(why) => {
             return Ok(Orbit {
@@ -153,7 +175,12 @@ pub fn search(
             });
         }
     };
-    Ok(shooting::shoot(&section, &unknowns, mode, x))
+    let mut quiet = |_: usize, _: f64| {};
+    let newton: &mut dyn FnMut(usize, f64) = match watch.newton {
+        Some(newton) => newton,
+        None => &mut quiet,
+    };
+    Ok(shooting::shoot(&section, &unknowns, mode, x, newton))
 }
 
 /// A followed branch, the names of the state's components, and the
@@ -219,7 +246,13 @@ pub fn follow(
             .map(|(period, c)| (c, period)),
     };
     let names = model.state_names(promoted.mode).to_vec();
-    let (mode, x) = match start(&section, promoted.mode, &promoted.start, request.settle) {
+    let (mode, x) = match start(
+        &section,
+        promoted.mode,
+        &promoted.start,
+        request.settle,
+        &mut (),
+    ) {
         Ok(start) => start,
         Err(why) => {
             let branch = continuation::Branch {
@@ -229,7 +262,7 @@ pub fn follow(
             return Ok((branch, names, p));
         }
     };
-    let orbit = shooting::shoot(&section, &unknowns, mode, x.clone());
+    let orbit = shooting::shoot(&section, &unknowns, mode, x.clone(), &mut |_, _| {});
     if !orbit.converged {
         let branch = continuation::Branch {
             points: Vec::new(),

@@ -192,8 +192,15 @@ pub fn multipliers(r: &Return, unknowns: &Unknowns) -> (Vec<(f64, f64)>, bool) {
     (eigen, stable)
 }
 
-/// Newton from `x` (just after a section event, in `mode`).
-pub fn shoot(section: &Section, unknowns: &Unknowns, mode: Mode, x: Vec<f64>) -> Orbit {
+/// Newton from `x` (just after a section event, in `mode`); `on_iteration`
+/// hears each iteration's residual.
+pub fn shoot(
+    section: &Section,
+    unknowns: &Unknowns,
+    mode: Mode,
+    x: Vec<f64>,
+    on_iteration: &mut dyn FnMut(usize, f64),
+) -> Orbit {
     let names = names(section, mode, x.len());
     let mut x = x;
     unknowns.fold_clock(&mut x);
@@ -237,6 +244,7 @@ pub fn shoot(section: &Section, unknowns: &Unknowns, mode: Mode, x: Vec<f64>) ->
         let r = unknowns.residual(&x, &back.state, back.elapsed);
         let norm = size(&r, unknowns, &x);
         residuals.push(norm);
+        on_iteration(residuals.len() - 1, norm);
         if norm <= TOLERANCE {
             return verified(section, unknowns, mode, &x, &back, residuals);
         }
