@@ -7,6 +7,7 @@
 //! the flow exactly to it, applies the reset, re-predicts what the reset can
 //! affect, and records the event.
 //!
+//! - [`prelude`]: what most programs need, in one import.
 //! - [`engine`]: the generic engine ([`engine::HybridModel`],
 //!   [`engine::simulate`]).
 //! - [`models`]: models built on it (the bistable mechanism).
@@ -17,7 +18,7 @@
 //! A model of your own: a sawtooth, `x' = 1`, reset to zero at `x = 1`.
 //!
 //! ```
-//! use flicker::engine::{Direction, Flow, Guard, HybridModel, Jump, Mode, Options, simulate};
+//! use flicker::prelude::*;
 //!
 //! struct Sawtooth;
 //! const WRAP: [Guard; 1] = [Guard::affine("wrap", Direction::Rising)];
@@ -70,6 +71,7 @@ pub mod models;
 pub mod numerics;
 pub mod orbit;
 pub mod plot;
+pub mod prelude;
 pub mod runner;
 pub mod scene;
 pub mod sensitivities;

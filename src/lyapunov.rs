@@ -172,9 +172,18 @@ pub fn spectrum(
     };
     let (mut mode, mut x) = family.start();
     if request.transient > 0.0 {
+        // The transient carries no tangents: a closed form runs it exactly.
+        let exact = (0..modes).all(|m| matches!(model.flow(m), Flow::Frozen | Flow::Exact));
         let options = Options {
-            method: self::method(model, modes),
+            method: if exact {
+                Method::Auto
+            } else {
+                self::method(model, modes)
+            },
             stop: request.stop.clone(),
+            max_wall_seconds: request
+                .deadline
+                .map(|d| d.saturating_duration_since(Instant::now()).as_secs_f64()),
             ..Options::until(request.transient)
         };
         let outcome = simulate(model, mode, &x, &options, &mut ());
@@ -212,7 +221,13 @@ pub fn spectrum(
             );
             break;
         }
-        let h = request.interval.min(request.span - t);
+        // The interval's end from its count, so no rounding accumulates.
+        let end = if step + 1 == intervals {
+            request.span
+        } else {
+            request.interval * (step + 1) as f64
+        };
+        let h = end - t;
         let options = Options {
             method,
             stop: request.stop.clone(),
@@ -253,7 +268,7 @@ pub fn spectrum(
             sums[j] += r[(j, j)].abs().ln();
             basis[j] = q.column(j).iter().copied().collect();
         }
-        t += h;
+        t = end;
         mode = outcome.final_mode;
         x = outcome.final_state[..n].to_vec();
         spectrum.t_span = t;

@@ -196,7 +196,8 @@ def run(
         events: keep the events as arrays (`Run.events`).
         sensitivities: directions (a parameter's name, or `initial.STATE`)
             to carry the derivatives of the state and of every event time
-            along (automata): the summary's `sensitivities`, and
+            along (any model with a finite state: the mechanism, the chain,
+            automata): the summary's `sensitivities`, and
             `d{state}/d{direction}`, `dt/d{direction}` among the events'
             states.
         t_eval: times (from 0 to t_end, any order) at which to keep the

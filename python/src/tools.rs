@@ -236,7 +236,7 @@ pub fn orbit(
     let started = std::time::Instant::now();
     let family = scene
         .family()
-        .map_err(|e| override_error(py, "section", e.reason))?;
+        .map_err(|e| override_error(py, "model", e.reason))?;
     let found = interruptible(py, |stop| {
         let request = OrbitRequest {
             stop: Some(stop.clone()),
@@ -273,7 +273,7 @@ pub fn continuation<'py>(
     let request = request(section, events, settle, forcing_period);
     let family = scene
         .family()
-        .map_err(|e| override_error(py, "param", e.reason))?;
+        .map_err(|e| override_error(py, "model", e.reason))?;
     let followed = interruptible(py, |stop| {
         let request = OrbitRequest {
             stop: Some(stop.clone()),
@@ -346,7 +346,9 @@ pub fn lyapunov(
         exponents: exponents.unwrap_or_else(|| family.model().dimension()),
         transient,
         span: t_end.unwrap_or_else(|| scene.t_end()),
-        interval: interval.unwrap_or_else(|| scene.time_scale() / 4.0),
+        interval: interval.unwrap_or_else(|| {
+            (scene.time_scale() / 4.0).min(t_end.unwrap_or_else(|| scene.t_end()))
+        }),
         stop: None,
         deadline: (wall.is_finite() && wall > 0.0)
             .then(|| {

@@ -133,7 +133,9 @@ pub fn continue_orbit(args: ContinueArgs, registry: &Registry) -> Result<Code, F
     let Some(first) = branch.points.first() else {
         say!("no branch: {}", branch.ended);
         eprintln!("flicker: no branch: {}", branch.ended);
-        return Ok(Code::Untrusted);
+        return Ok(Code::stopped(
+            branch.ended.contains("interrupted: the stop flag"),
+        ));
     };
     let plotted = match &args.plot {
         Some(name) => names
@@ -166,6 +168,7 @@ pub fn continue_orbit(args: ContinueArgs, registry: &Registry) -> Result<Code, F
             &values,
             &args.section,
             (scene.t_end() / 2.0, args.brute_force_events, scene.t_end()),
+            (request.stop.as_ref(), request.deadline),
         )
         .map_err(flag)?
     } else {
@@ -233,8 +236,8 @@ pub fn continue_orbit(args: ContinueArgs, registry: &Registry) -> Result<Code, F
     if lost {
         eprintln!("flicker: the branch was lost: {}", branch.ended);
     }
-    let interrupted = branch.ended.starts_with("interrupted");
-    if interrupted || branch.ended.starts_with("stopped: past") {
+    let interrupted = branch.ended.contains("interrupted: the stop flag");
+    if interrupted || branch.ended.contains("past the wall-clock budget") {
         eprintln!("flicker: the branch stopped short: {}", branch.ended);
         return Ok(Code::stopped(interrupted));
     }

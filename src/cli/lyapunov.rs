@@ -95,7 +95,9 @@ pub fn lyapunov(args: LyapunovArgs, registry: &Registry) -> Result<Code, Failure
         exponents: args.exponents.unwrap_or_else(|| family.model().dimension()),
         transient: args.transient,
         span: args.t_end.unwrap_or_else(|| scene.t_end()),
-        interval: args.interval.unwrap_or_else(|| scene.time_scale() / 4.0),
+        interval: args.interval.unwrap_or_else(|| {
+            (scene.time_scale() / 4.0).min(args.t_end.unwrap_or_else(|| scene.t_end()))
+        }),
         stop: Some(stop.clone()),
         deadline: crate::cli::setup::deadline(args.wall)?,
     };

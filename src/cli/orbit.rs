@@ -106,7 +106,9 @@ pub fn orbit(args: OrbitArgs, registry: &Registry) -> Result<Code, Failure> {
         say!("no orbit: {}", orbit.status);
         say!("  wrote {}", path.display());
         eprintln!("flicker: no orbit: {}", orbit.status);
-        return Ok(Code::Untrusted);
+        return Ok(Code::stopped(
+            orbit.status.contains("interrupted: the stop flag"),
+        ));
     }
     let state: Vec<String> = orbit
         .section_state

@@ -72,7 +72,8 @@ pub struct Promoted {
     /// Where it starts, the parameters at their values.
     pub start: Vec<f64>,
     /// Each parameter's component of the state (after the model's own
-    /// states; a forced model's clock stays last).
+    /// states; an automaton keeps its clock last, a rebuilt model keeps it
+    /// where it was).
     pub parameters: Vec<usize>,
     /// For each parameter, the derivative of the whole starting state
     /// along it: its unit vector, and the initial values it gives.

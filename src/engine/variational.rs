@@ -6,8 +6,9 @@
 //! `x` (`n` components), for each direction `j` the derivative `S_j` of `x`
 //! along it (`S_j(0)` is the direction), and `tau_j`, the derivative of the
 //! last event's time along it. A parameter is a direction once the model
-//! holds it as a state that never changes (an automaton does that:
-//! [`Definition::with_parameters_as_states`]).
+//! holds it as a state that never changes ([`Family::promoted`]: an
+//! automaton recompiles its definition, other models are rebuilt from the
+//! parameters' values).
 //!
 //! - Along a flow, `S_j' = J(x) S_j` (the variational equations), with `J`
 //!   the model's exact Jacobian where it gives one
@@ -22,7 +23,7 @@
 //! A linear model stays linear (`[A, I (x) A]`), so the exact propagator
 //! runs its sensitivities too; every method with a right-hand side does.
 //!
-//! [`Definition::with_parameters_as_states`]: crate::models::automaton::Definition::with_parameters_as_states
+//! [`Family::promoted`]: crate::engine::Family::promoted
 
 use nalgebra::{DMatrix, DVector};
 
@@ -54,6 +55,12 @@ impl<'m, M: HybridModel + ?Sized> Variational<'m, M> {
         let names = (0..modes)
             .map(|mode| {
                 let base = model.state_names(mode);
+                // A model that names no states (a chain's are many) names
+                // none of their derivatives either: names and values are
+                // paired in order, and a partial list would mislabel them.
+                if base.is_empty() {
+                    return Vec::new();
+                }
                 let mut names: Vec<&'static str> = base.to_vec();
                 for p in directions {
                     names.extend(base.iter().map(|x| intern(&format!("d{x}/d{p}"))));

@@ -5,7 +5,10 @@
 //! (continuation) or carry derivatives along it (sensitivities).
 //!
 //! What does not depend on `p` (names, guards, the kind of flow) is the
-//! base model's.
+//! base model's. The model's exact reset Jacobians and guard gradients are
+//! passed on (their columns along `p` by differences); its flow's Jacobian
+//! and linear form are not (the variational equations take differences,
+//! and the exact linear propagator does not run it), nor its Taylor series.
 
 use crate::engine::labels::Labels;
 use crate::engine::model::{Flow, Guard, HybridModel, Jump, Mode};
@@ -49,6 +52,25 @@ impl<M: HybridModel, F: Fn(&[f64]) -> M> WithParameters<M, F> {
     fn at(&self, x: &[f64]) -> M {
         (self.build)(&x[self.n..])
     }
+}
+
+/// The positions in `known` of the parameters `names`, each known and
+/// named once; a refusal names the one at fault.
+pub fn positions(names: &[String], known: &[&str]) -> Result<Vec<usize>, String> {
+    let mut which = Vec::new();
+    for name in names {
+        let k = known.iter().position(|p| p == name).ok_or_else(|| {
+            format!(
+                "no parameter is called `{name}` (parameters: {})",
+                known.join(", ")
+            )
+        })?;
+        if which.contains(&k) {
+            return Err(format!("`{name}` is named twice"));
+        }
+        which.push(k);
+    }
+    Ok(which)
 }
 
 impl<M, F> std::fmt::Debug for WithParameters<M, F> {
@@ -135,6 +157,54 @@ impl<M: HybridModel, F: Fn(&[f64]) -> M> HybridModel for WithParameters<M, F> {
 
     fn labels(&self, mode: Mode, guard: usize, before: &[f64]) -> Labels {
         self.at(before).labels(mode, guard, &before[..self.n])
+    }
+
+    /// The model's exact reset Jacobian where it gives one, its columns
+    /// along the parameters by central differences (a reset that reads
+    /// no parameter gives zeros there).
+    fn reset_jacobian(&self, mode: Mode, guard: usize, x: &[f64], out: &mut [f64]) -> bool {
+        let (n, dim) = (self.n, self.n + self.p);
+        let mut own = vec![0.0; n * n];
+        if !self.at(x).reset_jacobian(mode, guard, &x[..n], &mut own) {
+            return false;
+        }
+        out[..dim * dim].fill(0.0);
+        for i in 0..n {
+            out[i * dim..i * dim + n].copy_from_slice(&own[i * n..(i + 1) * n]);
+        }
+        for k in n..dim {
+            out[k * dim + k] = 1.0;
+            let h = f64::EPSILON.cbrt() * x[k].abs().max(1.0);
+            let (mut up, mut down) = (x.to_vec(), x.to_vec());
+            up[k] += h;
+            down[k] -= h;
+            self.reset(mode, guard, &mut up);
+            self.reset(mode, guard, &mut down);
+            for i in 0..n {
+                out[i * dim + k] = (up[i] - down[i]) / (2.0 * h);
+            }
+        }
+        true
+    }
+
+    /// The model's exact guard gradient where it gives one, its entries
+    /// along the parameters by central differences.
+    fn guard_gradient(&self, mode: Mode, guard: usize, x: &[f64], out: &mut [f64]) -> bool {
+        let n = self.n;
+        if !self
+            .at(x)
+            .guard_gradient(mode, guard, &x[..n], &mut out[..n])
+        {
+            return false;
+        }
+        for k in n..n + self.p {
+            let h = f64::EPSILON.cbrt() * x[k].abs().max(1.0);
+            let (mut up, mut down) = (x.to_vec(), x.to_vec());
+            up[k] += h;
+            down[k] -= h;
+            out[k] = (self.guard(mode, guard, &up) - self.guard(mode, guard, &down)) / (2.0 * h);
+        }
+        true
     }
 
     fn clock(&self) -> Option<usize> {

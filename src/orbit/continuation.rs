@@ -3,8 +3,8 @@
 //! way.
 //!
 //! The unknowns are the orbit's section state (the free components) and
-//! the parameter, held by the automaton as a state that never changes
-//! ([`Definition::with_parameters_as_states`]), so that the section map's
+//! the parameter, held by the model as a state that never changes
+//! ([`Family::promoted`]), so that the section map's
 //! Jacobian has its derivative with respect to the parameter as one more
 //! column. From each orbit the branch's tangent (the null vector of `[DP -
 //! I | dP/dp]`, oriented as the last) predicts the next, which Newton
@@ -30,7 +30,7 @@
 //! meets a graze first (a section map that cannot tell whether an event
 //! fires) ends the branch too, labelling its last orbit.
 //!
-//! [`Definition::with_parameters_as_states`]: crate::models::automaton::Definition::with_parameters_as_states
+//! [`Family::promoted`]: crate::engine::Family::promoted
 
 use nalgebra::{DMatrix, DVector};
 
@@ -326,12 +326,13 @@ pub fn follow(
             };
         }
     };
-    // A return that takes more than thrice the branch's period has missed
-    // the section (a trial orbit past a graze): give up on it then, not at
-    // the scene's t_end.
-    let section = &Section {
-        t_max: section.t_max.min(3.0 * start.back.elapsed),
-        ..*section
+    // A return that takes more than thrice the branch's period (the
+    // latest orbit's) has missed the section (a trial orbit past a
+    // graze): give up on it then, not at the scene's t_end.
+    let whole = section;
+    let capped = |period: f64| Section {
+        t_max: whole.t_max.min(3.0 * period),
+        ..*whole
     };
     let mut watched = grazing::impact_speed(section, mode, &start.x).map(|q| (start.x[p], q));
     let range = (plan.to - start.x[p]).abs().max(f64::MIN_POSITIVE);
@@ -344,6 +345,7 @@ pub fn follow(
     let mut ended = format!("stopped after {} orbits", plan.points);
     on_point(&points[0]);
     while points.len() < plan.points {
+        let section = &capped(here.back.elapsed);
         if let Some(why) = section.spent() {
             ended = format!("{why}, after {} orbits", points.len());
             break;
@@ -386,7 +388,7 @@ pub fn follow(
                 let speed = grazing::impact_speed(section, mode, &next.x).map(|q| (next.x[p], q));
                 if let Some((at, orbit, state)) = watched
                     .zip(speed)
-                    .and_then(|(before, now)| graze_ahead(before, now))
+                    .and_then(|(before, now)| graze_ahead(before, now, plan.to))
                     .and_then(|guess| {
                         locate_grazing(section, unknowns, p, mode, (&here, &next), guess)
                     })
@@ -433,14 +435,16 @@ pub fn follow(
 }
 
 /// Where the impact speed, falling from `before` to `now` (parameter,
-/// speed), reaches zero, if it does within one and a half more such
-/// steps.
-fn graze_ahead(before: (f64, f64), now: (f64, f64)) -> Option<f64> {
+/// speed), reaches zero, if it does within one and a half more such steps
+/// and before the branch's end `to`.
+fn graze_ahead(before: (f64, f64), now: (f64, f64), to: f64) -> Option<f64> {
     let falling = now.1.signum() == before.1.signum() && now.1.abs() < before.1.abs();
     let zero = grazing::predicted(before, now)?;
     let step = now.0 - before.0;
     let ahead = (zero - now.0) / step;
-    (falling && (0.0..=1.5).contains(&ahead)).then_some(zero)
+    // Within the branch's asked range: a graze past `--to` is not met.
+    let before_the_end = (to - zero) * step.signum() >= 0.0;
+    (falling && before_the_end && (0.0..=1.5).contains(&ahead)).then_some(zero)
 }
 
 /// The grazing parameter near `guess`, approached from the impacting
@@ -478,11 +482,14 @@ fn locate_grazing(
             let mut x: Vec<f64> = a.iter().zip(b).map(|(a, b)| b + f * (b - a)).collect();
             x[p] = target;
             // Too near the graze for the section map: the last estimate stands.
-            // An orbit of another period (the corrector slid onto another
-            // branch) is not this branch's.
+            // A forced orbit of another period (the corrector slid onto
+            // another branch, closing on more forcing periods) is not this
+            // branch's; an autonomous branch's period moves with it.
             let Some((orbit, q)) = correct(section, unknowns, p, mode, x, None)
                 .ok()
-                .filter(|o| (o.back.elapsed - period).abs() <= 1e-6 * period)
+                .filter(|o| {
+                    unknowns.clock.is_none() || (o.back.elapsed - period).abs() <= 1e-6 * period
+                })
                 .and_then(|o| grazing::impact_speed(section, mode, &o.x).map(|q| (o, q)))
             else {
                 break 'rounds;

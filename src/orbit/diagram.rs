@@ -3,6 +3,10 @@
 //! section events once a transient has passed, from plain runs (in
 //! parallel, one value each).
 
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
+use std::time::Instant;
+
 use rayon::prelude::*;
 
 use crate::engine::Family;
@@ -21,13 +25,15 @@ pub struct Column {
 
 /// At each of `values` of `parameter` of `family`, from the scene's
 /// start: `settle` run through, then the states after the next `events`
-/// events of `guard`, each within `t_max` of the one before.
+/// events of `guard`, each within `t_max` of the one before; runs not
+/// begun once `stop` is set or `deadline` passed, cut short if under way.
 pub fn brute_force(
     family: &dyn Family,
     parameter: &str,
     values: &[f64],
     guard: &str,
     (settle, events, t_max): (f64, usize, f64),
+    (stop, deadline): (Option<&Arc<AtomicBool>>, Option<Instant>),
 ) -> Result<Vec<Column>, SceneError> {
     let promoted = family
         .promoted(&[parameter.to_string()])
@@ -39,8 +45,8 @@ pub fn brute_force(
         guard,
         events: 1,
         t_max,
-        stop: None,
-        deadline: None,
+        stop,
+        deadline,
     };
     Ok(values
         .par_iter()

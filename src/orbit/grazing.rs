@@ -52,7 +52,12 @@ pub fn quadratic_zero(points: &[(f64, f64); 3], guess: f64) -> Option<f64> {
     let u = if c == 0.0 {
         -a / b
     } else {
-        let disc = (b * b - 4.0 * a * c).max(0.0).sqrt();
+        let disc = b * b - 4.0 * a * c;
+        // No real zero: the fit does not meet zero (its vertex is no root).
+        if disc < 0.0 {
+            return None;
+        }
+        let disc = disc.sqrt();
         // The root of smaller size, computed without cancellation.
         let big = -(b + b.signum() * disc) / 2.0;
         let (r1, r2) = (big / c, a / big);

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 
 /// The layers, lowest first: a module may import from any lower layer,
 /// none from its own or a higher one.
-const LAYERS: [&[&str]; 9] = [
+const LAYERS: [&[&str]; 10] = [
     &["numerics", "time"],
     // The generic engine and the model interface the tools ask (Family).
     &["engine"],
@@ -30,6 +30,7 @@ const LAYERS: [&[&str]; 9] = [
         "sweep",
     ],
     &["session"],
+    &["prelude"],
     &["cli"],
 ];
 
@@ -54,12 +55,26 @@ fn imports(text: &str) -> BTreeSet<String> {
         // import is lost, since none follows one on the same line).
         let line = line.split("//").next().unwrap_or("");
         for (at, _) in line.match_indices("crate::") {
-            let name: String = line[at + 7..]
-                .chars()
-                .take_while(|c| c.is_alphanumeric() || *c == '_')
-                .collect();
-            if !name.is_empty() {
-                names.insert(name);
+            let rest = &line[at + 7..];
+            // `crate::{a::X, b}` names each of `a` and `b`.
+            let heads: Vec<&str> = match rest.strip_prefix('{') {
+                Some(group) => group
+                    .split(['}', ';'])
+                    .next()
+                    .unwrap_or("")
+                    .split(',')
+                    .collect(),
+                None => vec![rest],
+            };
+            for head in heads {
+                let name: String = head
+                    .trim_start()
+                    .chars()
+                    .take_while(|c| c.is_alphanumeric() || *c == '_')
+                    .collect();
+                if !name.is_empty() {
+                    names.insert(name);
+                }
             }
         }
     }
@@ -152,8 +167,9 @@ fn every_import_points_down_and_no_circle_forms() {
 #[test]
 fn only_code_counts_as_an_import() {
     let text = "//! [`x`]: crate::orbit::Orbit\nuse crate::engine::Mode;\n\
+                use crate::{log::X, plot};\n\
                 fn f() { crate::models::load(p); } // crate::cli\n\
                 #[cfg(test)]\nmod tests { use crate::sweep; }\n";
     let found: Vec<String> = imports(text).into_iter().collect();
-    assert_eq!(found, ["engine", "models"]);
+    assert_eq!(found, ["engine", "log", "models", "plot"]);
 }

@@ -194,3 +194,44 @@ fn the_continuum_refuses_the_tools_in_one_line() {
         assert_eq!(err.trim().lines().count(), 1, "{err}");
     }
 }
+
+/// A model that names no states (the chain) names none of their
+/// derivatives in its log either: names and values are paired in order,
+/// and a partial list would put `dt/dload` on a node's position.
+#[test]
+fn a_chain_s_log_with_sensitivities_mislabels_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = json!({
+        "model": "chain", "units": 10, "length": 10.0, "wave_speed": 1.0,
+        "load": {"before": 1.0, "after": 1.3}, "constraint": true,
+        "initial": {
+            "strain": [0.3, 0.1, 0.25, 0.05, 0.2, 0.3, 0.1, 0.15, 0.05, 0.2],
+            "velocity": [0.1, -0.2, 0.0, 0.3, -0.1, 0.0, 0.2, -0.3, 0.1, 0.0]
+        },
+        "t_end": 6.0
+    });
+    let path = dir.path().join("chain.json");
+    std::fs::write(&path, scene.to_string()).unwrap();
+    let out = dir.path().join("out");
+    let done = flicker(&[
+        "run",
+        path.to_str().unwrap(),
+        "--sensitivities",
+        "load",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        done.status.success(),
+        "{}",
+        String::from_utf8_lossy(&done.stderr)
+    );
+    let log = std::fs::read_to_string(out.join("events.jsonl")).unwrap();
+    assert!(log.lines().count() > 5);
+    for line in log.lines() {
+        let event: Value = serde_json::from_str(line).unwrap();
+        assert_eq!(event["before"], json!({}), "{line}");
+        assert_eq!(event["after"], json!({}), "{line}");
+    }
+}

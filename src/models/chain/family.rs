@@ -8,7 +8,7 @@
 //! ODE is the same chain, and for the sizes a tool's dense derivatives
 //! make sense at (tens of units), as fast.
 
-use crate::engine::with_parameters::WithParameters;
+use crate::engine::with_parameters::{WithParameters, positions};
 use crate::engine::{Family, HybridModel, Mode, Promoted};
 use crate::models::chain::Chain;
 use crate::models::chain::scene::ChainScene;
@@ -89,19 +89,7 @@ impl Family for ChainFamily {
     }
 
     fn promoted(&self, names: &[String]) -> Result<Promoted, String> {
-        let mut which = Vec::new();
-        for name in names {
-            let k = PARAMETERS.iter().position(|p| p == name).ok_or_else(|| {
-                format!(
-                    "no parameter is called `{name}` (parameters: {})",
-                    PARAMETERS.join(", ")
-                )
-            })?;
-            if which.contains(&k) {
-                return Err(format!("`{name}` is named twice"));
-            }
-            which.push(k);
-        }
+        let which = positions(names, &PARAMETERS)?;
         let values: Vec<f64> = which
             .iter()
             .map(|&k| if k == 0 { self.load } else { self.wave_speed })

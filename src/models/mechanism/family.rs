@@ -8,7 +8,7 @@
 //! `(eps, eps')`, so an orbit that returns on the other side is periodic
 //! in the strain ([`Family::same_motion`]).
 
-use crate::engine::with_parameters::WithParameters;
+use crate::engine::with_parameters::{WithParameters, positions};
 use crate::engine::{Family, HybridModel, Mode, Promoted};
 use crate::models::mechanism::angle::{self, AngleMechanism};
 use crate::models::mechanism::scene::{Formulation, Initial, MechanismScene};
@@ -100,19 +100,7 @@ impl Family for MechanismFamily {
     }
 
     fn promoted(&self, names: &[String]) -> Result<Promoted, String> {
-        let mut which = Vec::new();
-        for name in names {
-            let k = PARAMETERS.iter().position(|p| p == name).ok_or_else(|| {
-                format!(
-                    "no parameter is called `{name}` (parameters: {})",
-                    PARAMETERS.join(", ")
-                )
-            })?;
-            if which.contains(&k) {
-                return Err(format!("`{name}` is named twice"));
-            }
-            which.push(k);
-        }
+        let which = positions(names, &PARAMETERS)?;
         let base = self.strain.mechanism;
         let values: Vec<f64> = which
             .iter()
@@ -133,16 +121,21 @@ impl Family for MechanismFamily {
                         .filter(|(m, _)| *m == mode)
                         .map(|(_, x)| x)
                 };
+                let (Some(up), Some(down)) = (moved(h), moved(-h)) else {
+                    return Err(format!(
+                        "the start moves out of its chart or its energy's reach as `{}` moves: \
+                         its derivative along it is not defined here",
+                        PARAMETERS[which[j]]
+                    ));
+                };
                 let mut s = vec![0.0; n + which.len()];
-                if let (Some(up), Some(down)) = (moved(h), moved(-h)) {
-                    for i in 0..n {
-                        s[i] = (up[i] - down[i]) / (2.0 * h);
-                    }
+                for i in 0..n {
+                    s[i] = (up[i] - down[i]) / (2.0 * h);
                 }
                 s[n + j] = 1.0;
-                s
+                Ok(s)
             })
-            .collect();
+            .collect::<Result<Vec<_>, String>>()?;
         let mut start = x0;
         start.extend_from_slice(&values);
         let parameters = (n..n + which.len()).collect();
