@@ -166,15 +166,8 @@ fn bad_requests_are_refused_and_a_spent_budget_stops_the_spectrum() {
 /// on average, impact by impact).
 #[test]
 fn the_largest_exponent_predicts_the_chain_s_horizon() {
-    let chain = json!({
-        "model": "chain", "units": 10, "length": 10.0, "wave_speed": 1.0,
-        "load": {"before": 1.0, "after": 1.3}, "constraint": true,
-        "initial": {
-            "strain": [0.3, 0.1, 0.25, 0.05, 0.2, 0.3, 0.1, 0.15, 0.05, 0.2],
-            "velocity": [0.1, -0.2, 0.0, 0.3, -0.1, 0.0, 0.2, -0.3, 0.1, 0.0]
-        },
-        "t_end": 600.0, "samples": 6001
-    });
+    let mut chain = crate::support::ten_unit_chain(600.0);
+    chain["samples"] = json!(6001);
     let (code, found, err) = lyapunov(&chain, &["--exponents", "1"]);
     assert_eq!(code, Some(0), "{err}");
     let l1 = exponents(&found.unwrap())[0];

@@ -156,3 +156,17 @@ impl SvgChart {
         (1.0 / self.x_axis.1.abs(), 1.0 / self.y_axis.1.abs())
     }
 }
+
+/// A chain of 10 units that impacts (strains and velocities set apart,
+/// load 1.3 after the release) to `t_end`: the tools' test chain.
+pub fn ten_unit_chain(t_end: f64) -> Value {
+    serde_json::json!({
+        "model": "chain", "units": 10, "length": 10.0, "wave_speed": 1.0,
+        "load": {"before": 1.0, "after": 1.3}, "constraint": true,
+        "initial": {
+            "strain": [0.3, 0.1, 0.25, 0.05, 0.2, 0.3, 0.1, 0.15, 0.05, 0.2],
+            "velocity": [0.1, -0.2, 0.0, 0.3, -0.1, 0.0, 0.2, -0.3, 0.1, 0.0]
+        },
+        "t_end": t_end
+    })
+}

@@ -131,15 +131,9 @@ fn the_mechanism_s_sensitivities_meet_differences_of_the_closed_form() {
 #[test]
 fn a_chain_s_sensitivities_meet_differences_of_plain_runs() {
     let chain = |load: f64| {
-        json!({
-            "model": "chain", "units": 10, "length": 10.0, "wave_speed": 1.0,
-            "load": {"before": 1.0, "after": load}, "constraint": true,
-            "initial": {
-                "strain": [0.3, 0.1, 0.25, 0.05, 0.2, 0.3, 0.1, 0.15, 0.05, 0.2],
-                "velocity": [0.1, -0.2, 0.0, 0.3, -0.1, 0.0, 0.2, -0.3, 0.1, 0.0]
-            },
-            "t_end": 6.0
-        })
+        let mut chain = crate::support::ten_unit_chain(6.0);
+        chain["load"]["after"] = json!(load);
+        chain
     };
     let scene = Registry::builtin().from_value(&chain(1.3)).unwrap();
     let s = sensitivities(&scene, &["initial.y_4", "load"]);
@@ -201,15 +195,7 @@ fn the_continuum_refuses_the_tools_in_one_line() {
 #[test]
 fn a_chain_s_log_with_sensitivities_mislabels_nothing() {
     let dir = tempfile::tempdir().unwrap();
-    let scene = json!({
-        "model": "chain", "units": 10, "length": 10.0, "wave_speed": 1.0,
-        "load": {"before": 1.0, "after": 1.3}, "constraint": true,
-        "initial": {
-            "strain": [0.3, 0.1, 0.25, 0.05, 0.2, 0.3, 0.1, 0.15, 0.05, 0.2],
-            "velocity": [0.1, -0.2, 0.0, 0.3, -0.1, 0.0, 0.2, -0.3, 0.1, 0.0]
-        },
-        "t_end": 6.0
-    });
+    let scene = crate::support::ten_unit_chain(6.0);
     let path = dir.path().join("chain.json");
     std::fs::write(&path, scene.to_string()).unwrap();
     let out = dir.path().join("out");
