@@ -21,6 +21,7 @@ pub mod observer;
 pub mod queue;
 pub mod run;
 mod run_loop;
+pub mod saltation;
 pub mod simulation;
 pub mod tangent;
 pub mod taylor;

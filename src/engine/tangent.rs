@@ -12,6 +12,7 @@
 
 use crate::engine::error_set::TRACKED;
 use crate::engine::model::{Flow, HybridModel, Mode};
+use crate::engine::saltation;
 
 /// Scratch for the linearisations of one run; matrices are row-major
 /// `n x n`.
@@ -280,13 +281,8 @@ impl Tangents {
     }
 
     /// The saltation matrix of `guard`'s event at `before` in `mode`, into
-    /// `out`: `S = R + (f+ - R f-) grad(g)^T / (grad(g) . f-)`, with `R`
-    /// the reset's Jacobian and `f-`, `f+` the rates before and after. An
-    /// error `d` before the event moves it by `-grad(g) . d / (grad(g) .
-    /// f-)` in time and leaves `S d` after it. Returns the closing speed
-    /// `grad(g) . f-` (zero at a graze, where `S` is not defined) and the
-    /// largest component of `f+ - R f-`: what firing the event a time `dt`
-    /// late leaves in the state, per unit of `dt`.
+    /// `out` ([`saltation::matrix`]), the reset's Jacobian by central
+    /// differences: the closing speed and the largest jump of the rate.
     #[allow(clippy::too_many_arguments)]
     pub fn saltation<M: HybridModel + ?Sized>(
         &mut self,
@@ -318,16 +314,8 @@ impl Tangents {
         let mut rate_after = std::mem::take(&mut self.down);
         self.rate(model, mode, before, &mut rate_before);
         self.rate(model, mode_after, after, &mut rate_after);
-        let closing: f64 = gradient.iter().zip(&rate_before).map(|(g, f)| g * f).sum();
-        let mut largest_jump: f64 = 0.0;
-        for i in 0..n {
-            let pushed: f64 = (0..n).map(|k| reset[i * n + k] * rate_before[k]).sum();
-            largest_jump = largest_jump.max((rate_after[i] - pushed).abs());
-            let jump = (rate_after[i] - pushed) / closing;
-            for j in 0..n {
-                out[i * n + j] = reset[i * n + j] + jump * gradient[j];
-            }
-        }
+        let (closing, largest_jump) =
+            saltation::matrix(&reset, gradient, &rate_before, &rate_after, out);
         self.a = reset;
         self.up = rate_before;
         self.down = rate_after;

@@ -17,8 +17,9 @@
 //! - At an event of guard `g`, with `R` the reset's Jacobian and `f-`, `f+`
 //!   the rates just before and after: `tau_j = -grad g . S_j / (grad g .
 //!   f-)`, the event time's derivative, and `S_j <- R S_j - (f+ - R f-)
-//!   tau_j`, the saltation matrix applied (docs/physics.md's impacts, and
-//!   any reset: a change of mode, a restitution).
+//!   tau_j`, the saltation matrix applied ([`saltation::matrix`], the one
+//!   the error bounds use: docs/physics.md's impacts, and any reset: a
+//!   change of mode, a restitution).
 //!
 //! A linear model stays linear (`[A, I (x) A]`), so the exact propagator
 //! runs its sensitivities too; every method with a right-hand side does.
@@ -30,6 +31,7 @@ use nalgebra::{DMatrix, DVector};
 use crate::engine::labels::Labels;
 use crate::engine::model::{Flow, Guard, HybridModel, Jump, Mode};
 use crate::engine::names::intern;
+use crate::engine::saltation;
 
 /// A model with the derivatives of its state along `m` directions.
 #[derive(Debug)]
@@ -231,22 +233,16 @@ impl<M: HybridModel + ?Sized> HybridModel for Variational<'_, M> {
         let jump = self.model.reset(mode, guard, &mut x[..n]);
         let rate_before = self.rate(mode, &before);
         let rate_after = self.rate(jump.mode, &x[..n]);
-        let closing: f64 = gradient.iter().zip(&rate_before).map(|(g, f)| g * f).sum();
-        let pushed: Vec<f64> = (0..n)
-            .map(|i| {
-                (0..n)
-                    .map(|k| reset[i * n + k] * rate_before[k])
-                    .sum::<f64>()
-            })
-            .collect();
+        let mut salt = vec![0.0; n * n];
+        let (closing, _) =
+            saltation::matrix(&reset, &gradient, &rate_before, &rate_after, &mut salt);
         for j in 0..m {
             let s: Vec<f64> = x[n * (1 + j)..n * (2 + j)].to_vec();
-            let tau = -gradient.iter().zip(&s).map(|(g, v)| g * v).sum::<f64>() / closing;
             for i in 0..n {
-                let carried: f64 = (0..n).map(|k| reset[i * n + k] * s[k]).sum();
-                x[n * (1 + j) + i] = carried - (rate_after[i] - pushed[i]) * tau;
+                x[n * (1 + j) + i] = (0..n).map(|k| salt[i * n + k] * s[k]).sum();
             }
-            x[n * (1 + m) + j] = tau;
+            x[n * (1 + m) + j] =
+                -gradient.iter().zip(&s).map(|(g, v)| g * v).sum::<f64>() / closing;
         }
         jump
     }
