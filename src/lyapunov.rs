@@ -19,8 +19,9 @@ use std::time::Instant;
 use nalgebra::DMatrix;
 use serde_json::{Value, json};
 
+use crate::engine::integrator::tightest;
 use crate::engine::variational::Variational;
-use crate::engine::{Family, Flow, HybridModel, Method, Options, Status, Tolerances, simulate};
+use crate::engine::{Family, Options, Status, simulate};
 
 /// Tolerance of the runs where the flows (with their derivatives) are not
 /// all linear.
@@ -95,19 +96,6 @@ impl Spectrum {
     }
 }
 
-/// The method the tangents ride by: the exact propagator where every mode
-/// (with its derivatives) is linear or frozen, DOP853 otherwise.
-fn method<M: HybridModel + ?Sized>(model: &M, modes: usize) -> Method {
-    if (0..modes).all(|m| model.flow(m) == Flow::Frozen || model.is_linear(m)) {
-        Method::Linear
-    } else {
-        Method::Dop853(Tolerances {
-            rtol: TOLERANCE,
-            atol: TOLERANCE,
-        })
-    }
-}
-
 /// Check `request` against `family` before anything runs; the error says
 /// which field is wrong and why.
 pub fn check(family: &dyn Family, request: &Request) -> Result<(), (&'static str, String)> {
@@ -161,7 +149,8 @@ pub fn spectrum(
     let k = request.exponents;
     let directions: Vec<String> = (0..k).map(|j| format!("v{j}")).collect();
     let variational = Variational::new(model, modes, &directions);
-    let method = method(&variational, modes);
+    // Tangents are never a closed form: the propagator or DOP853.
+    let method = tightest(&variational, modes, TOLERANCE);
     let mut spectrum = Spectrum {
         exponents: vec![f64::NAN; k],
         t_span: 0.0,
@@ -173,13 +162,8 @@ pub fn spectrum(
     let (mut mode, mut x) = family.start();
     if request.transient > 0.0 {
         // The transient carries no tangents: a closed form runs it exactly.
-        let exact = (0..modes).all(|m| matches!(model.flow(m), Flow::Frozen | Flow::Exact));
         let options = Options {
-            method: if exact {
-                Method::Auto
-            } else {
-                self::method(model, modes)
-            },
+            method: tightest(model, modes, TOLERANCE),
             stop: request.stop.clone(),
             max_wall_seconds: request
                 .deadline

@@ -18,9 +18,10 @@
 
 use serde_json::{Map, Value, json};
 
+use crate::engine::integrator::tightest;
 use crate::engine::variational::Variational;
 use crate::engine::{
-    Family, Flow, HybridModel, Method, Mode, Observer, Sample, Tolerances, simulate_sampled,
+    Family, HybridModel, Method, Mode, Observer, Sample, Tolerances, simulate_sampled,
 };
 use crate::runner::{Control, Report};
 use crate::scene::{Scene, SceneError};
@@ -142,8 +143,8 @@ fn method<M: HybridModel + ?Sized>(
     modes: usize,
     variational: &Variational<'_, M>,
 ) -> Result<(Method, String), SceneError> {
-    let affine =
-        (0..modes).all(|m| variational.flow(m) == Flow::Frozen || variational.is_linear(m));
+    // Derivatives ride as an ODE: linear where the propagator runs them.
+    let affine = tightest(variational, modes, TOLERANCE) == Method::Linear;
     let spec = scene.solver();
     let (asked, tolerances) = spec.resolve()?;
     match asked {

@@ -124,6 +124,25 @@ pub fn runs<M: HybridModel + ?Sized>(
         .try_for_each(|&mode| motion(model, mode, method).map(|_| ()))
 }
 
+/// The tightest method a tool can run `model`'s modes `0..modes` by
+/// without Taylor series (which derivatives carried as states do not
+/// have): the closed form where every mode has one (or is frozen), the
+/// exact linear propagator where every mode is linear (or frozen), DOP853
+/// at `tolerance` otherwise. What orbits, sensitivities and Lyapunov
+/// spectra run by.
+pub fn tightest<M: HybridModel + ?Sized>(model: &M, modes: usize, tolerance: f64) -> Method {
+    if (0..modes).all(|m| matches!(model.flow(m), Flow::Frozen | Flow::Exact)) {
+        Method::Auto
+    } else if (0..modes).all(|m| model.flow(m) == Flow::Frozen || model.is_linear(m)) {
+        Method::Linear
+    } else {
+        Method::Dop853(Tolerances {
+            rtol: tolerance,
+            atol: tolerance,
+        })
+    }
+}
+
 /// The names of the methods a user can choose that run every one of
 /// `modes` of `model` ([`runs`]), in the order exact, linear, taylor,
 /// dopri5, dop853, verlet: the one place that says which methods a model

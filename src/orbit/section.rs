@@ -17,6 +17,7 @@ use std::time::Instant;
 
 use nalgebra::DMatrix;
 
+use crate::engine::integrator::tightest;
 use crate::engine::variational::Variational;
 use crate::engine::{
     EventRecord, Family, Flow, HybridModel, Method, Mode, Observer, Options, Status, Tolerances,
@@ -110,23 +111,10 @@ impl std::fmt::Debug for Section<'_> {
 }
 
 impl Section<'_> {
-    /// The method `model`'s runs take (the section's, its transient): the
-    /// closed form where every mode has one, the exact linear propagator
-    /// where every mode (with its derivatives) is linear or frozen, DOP853
-    /// at 1e-13 otherwise.
+    /// The method `model`'s runs take (the section's, its transient):
+    /// [`tightest`] at 1e-13.
     pub fn method<M: HybridModel + ?Sized>(&self, model: &M) -> Method {
-        let modes = self.family.modes();
-        if (0..modes).all(|m| matches!(model.flow(m), Flow::Frozen | Flow::Exact)) {
-            // Closed-form flows: the engine's own choice runs them exactly.
-            Method::Auto
-        } else if (0..modes).all(|m| model.flow(m) == Flow::Frozen || model.is_linear(m)) {
-            Method::Linear
-        } else {
-            Method::Dop853(Tolerances {
-                rtol: TOLERANCE,
-                atol: TOLERANCE,
-            })
-        }
+        tightest(model, self.family.modes(), TOLERANCE)
     }
 
     /// Run `model` from `x0` in `mode` to the `K`-th section event: its
