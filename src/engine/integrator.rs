@@ -11,7 +11,7 @@ use crate::engine::dopri5::Dopri5;
 use crate::engine::linear::Linear;
 use crate::engine::locate::{Interpolant, Start, StepScan};
 use crate::engine::model::{Flow, HybridModel, Mode};
-use crate::engine::taylor::Taylor;
+use crate::engine::taylor_method::Taylor;
 use crate::engine::verlet::Verlet;
 
 /// How to advance the flows.

@@ -223,7 +223,7 @@ impl Linear {
 
     /// Where the model gives its guards' series: the first crossing of
     /// `guard` in the step on its series, as Taylor's method finds it (see
-    /// [`crate::engine::taylor`]); `None` where the step is to be scanned.
+    /// [`crate::engine::taylor_method`]); `None` where the step is to be scanned.
     pub fn locate<M: HybridModel + ?Sized>(
         &mut self,
         model: &M,
@@ -238,7 +238,7 @@ impl Linear {
         let w = ORDER + 1;
         self.guard
             .copy_from_slice(&self.guards[guard * w..(guard + 1) * w]);
-        Some(crate::engine::taylor::locate_on_series(
+        Some(crate::engine::taylor_method::locate_on_series(
             model,
             mode,
             guard,

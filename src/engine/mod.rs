@@ -24,7 +24,7 @@ mod run_loop;
 pub mod saltation;
 pub mod simulation;
 pub mod tangent;
-pub mod taylor;
+pub mod taylor_method;
 pub mod variational;
 pub mod verlet;
 pub mod with_parameters;

@@ -18,7 +18,7 @@
 
 use serde_json::Value;
 
-use crate::engine::{Method, Tolerances, taylor};
+use crate::engine::{Method, Tolerances, taylor_method};
 use crate::scene::SceneError;
 use crate::scene::fields::Fields;
 
@@ -99,8 +99,8 @@ impl SolverSpec {
             Some("dopri5") => Method::Dopri5(tolerances),
             Some("dop853") => Method::Dop853(tolerances),
             Some("taylor") => Method::Taylor(Tolerances {
-                rtol: rtol.unwrap_or(taylor::DEFAULT_TOLERANCE),
-                atol: atol.unwrap_or(taylor::DEFAULT_TOLERANCE),
+                rtol: rtol.unwrap_or(taylor_method::DEFAULT_TOLERANCE),
+                atol: atol.unwrap_or(taylor_method::DEFAULT_TOLERANCE),
             }),
             Some(other @ ("verlet" | "linear" | "exact")) if rtol.is_some() || atol.is_some() => {
                 return Err(not_for(if rtol.is_some() { "rtol" } else { "atol" }, other));

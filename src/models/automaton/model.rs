@@ -19,7 +19,7 @@ use crate::engine::names::intern;
 use crate::engine::{Flow, Guard, HybridModel, Jump, Mode};
 use crate::models::automaton::definition::{Definition, Source};
 use crate::models::automaton::expr::derivative::{jacobian, jacobian_into};
-use crate::models::automaton::expr::series::Series;
+use crate::models::automaton::expr::recurrences::Series;
 use crate::models::automaton::expr::{Ast, Scope, Tape};
 use crate::models::automaton::filippov::{self, Target};
 use crate::scene::SceneError;

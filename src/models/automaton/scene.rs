@@ -7,7 +7,7 @@ use crate::engine::integrator::{methods_for, runs};
 use crate::engine::zeno;
 use crate::engine::{
     EventTimes, Family, HybridModel, Method, Observer, Sample, Status, Tolerances,
-    simulate_sampled, taylor,
+    simulate_sampled, taylor_method,
 };
 use crate::models::automaton::definition::{Definition, Transition};
 use crate::models::automaton::model::Automaton;
@@ -136,15 +136,15 @@ impl AutomatonScene {
             ),
             Method::Auto if runs(&*self.automaton, &modes, Method::Taylor(tol)).is_ok() => {
                 let tol = Tolerances {
-                    rtol: self.solver.rtol.unwrap_or(taylor::DEFAULT_TOLERANCE),
-                    atol: self.solver.atol.unwrap_or(taylor::DEFAULT_TOLERANCE),
+                    rtol: self.solver.rtol.unwrap_or(taylor_method::DEFAULT_TOLERANCE),
+                    atol: self.solver.atol.unwrap_or(taylor_method::DEFAULT_TOLERANCE),
                 };
                 (
                     Method::Taylor(tol),
                     format!(
                         "a mode's flow is not affine: Taylor's method of order {}, rtol {:e}, atol {:e}, \
                          events on each guard's series",
-                        taylor::order_for(tol),
+                        taylor_method::order_for(tol),
                         tol.rtol,
                         tol.atol
                     ),
@@ -164,7 +164,7 @@ impl AutomatonScene {
                 self.method,
                 format!(
                     "Taylor's method of order {}, rtol {:e}, atol {:e}, events on each guard's series",
-                    taylor::order_for(t),
+                    taylor_method::order_for(t),
                     t.rtol,
                     t.atol
                 ),
@@ -417,8 +417,8 @@ impl SceneModel for AutomatonScene {
     /// chattering orbit, and no final state to compare.
     fn reference(&self) -> Result<Reference, SceneError> {
         let tightest = Tolerances {
-            rtol: taylor::DEFAULT_TOLERANCE,
-            atol: taylor::DEFAULT_TOLERANCE,
+            rtol: taylor_method::DEFAULT_TOLERANCE,
+            atol: taylor_method::DEFAULT_TOLERANCE,
         };
         let modes = self.automaton.modes();
         let (method, kind) = if self.automaton.all_linear() {

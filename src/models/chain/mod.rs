@@ -10,7 +10,7 @@
 //! instant until none does ([`collide`]).
 //!
 //! Two descriptions of the same chain:
-//! - [`taylor::TaylorChain`], the exact event-local one (the default): the
+//! - [`event_local::TaylorChain`], the exact event-local one (the default): the
 //!   free chain propagated by Taylor series with certified truncation and
 //!   a certified reach of each impact, so an event costs the same at any N;
 //! - [`Chain`] as a linear second-order ODE ([`ode`]), which the numerical
@@ -24,16 +24,16 @@ use crate::engine::{Direction, Guard, Label, Labels};
 pub mod coarse;
 pub mod collide;
 pub mod ensemble;
+pub mod event_local;
 pub mod family;
 pub mod modal;
 pub mod ode;
 pub(crate) mod run;
 pub mod scene;
-pub mod series;
-pub mod taylor;
+pub mod window_series;
 
+pub use event_local::TaylorChain;
 pub use modal::modal;
-pub use taylor::TaylorChain;
 
 /// The chain's parameters, in the scene units of docs/physics.md s.4 or any.
 #[derive(Debug, Clone, PartialEq)]

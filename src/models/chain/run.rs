@@ -174,7 +174,7 @@ fn run_exact(
         "chain of {} units: exact event-local flow (Taylor series of order {order} in windows of omega t = {}; \
          each impact re-expands the {} units within its certified reach), impacts as the first roots of the series",
         scene.units,
-        crate::models::chain::taylor::WINDOW,
+        crate::models::chain::event_local::WINDOW,
         2 * reach + 1
     );
     Ok(report(

@@ -4,7 +4,7 @@
 
 pub mod derivative;
 pub mod parse;
-pub mod series;
+pub mod recurrences;
 pub mod symbolic;
 pub mod tape;
 

@@ -28,8 +28,8 @@
 use crate::engine::adaptive::{StepFailure, Tolerances};
 use crate::engine::locate::{Start, StepScan};
 use crate::engine::model::{Direction, HybridModel, Mode};
+use crate::numerics::first_crossing::{eval2, first_fall};
 use crate::numerics::polynomial::eval_compensated;
-use crate::numerics::taylor::{eval2, first_fall};
 
 /// The tolerance `taylor` takes unless told: machine epsilon, as heyoka.
 pub const DEFAULT_TOLERANCE: f64 = f64::EPSILON;

@@ -52,11 +52,11 @@
 //! captured nor released over and over.
 
 use crate::engine::{Direction, Fired, Guard, Labels, LocalModel};
-use crate::numerics::taylor::{integral, search_fall};
+use crate::numerics::first_crossing::{integral, search_fall};
 use crate::time::Time;
 
 use super::collide::{alone, cascade};
-use super::series::{MAX_COLUMN, Series, blocks};
+use super::window_series::{MAX_COLUMN, Series, blocks};
 use super::{Chain, impact_labels};
 
 /// Window length in scaled time `omega t`: longer windows mean fewer full
