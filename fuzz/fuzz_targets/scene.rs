@@ -23,8 +23,8 @@ fuzz_target!(|data: &[u8]| {
     let t_end = scene.t_end().min(10.0);
     if scene.set_t_end(t_end).is_ok() {
         let control = Control {
-            stop: None,
             max_wall_seconds: Some(0.05),
+            ..Control::default()
         };
         let _ = scene.run(&control, &mut ());
     }
