@@ -46,8 +46,8 @@ fuzz_target!(|data: &[u8]| {
         return;
     };
     let control = Control {
-        stop: None,
         max_wall_seconds: Some(0.05),
+        ..Control::default()
     };
     for method in scene.methods() {
         let mut run = scene.clone();
