@@ -62,8 +62,6 @@
 #![deny(missing_docs)]
 
 pub mod cli;
-pub mod compare;
-pub mod compare_models;
 pub mod engine;
 pub mod log;
 pub mod lyapunov;
@@ -72,6 +70,7 @@ pub mod numerics;
 pub mod orbit;
 pub mod plot;
 pub mod prelude;
+pub mod release_convergence;
 pub mod runner;
 pub mod scene;
 pub mod sensitivities;
@@ -79,3 +78,4 @@ pub mod session;
 pub mod stress;
 pub mod sweep;
 pub mod time;
+pub mod work_precision;

@@ -9,11 +9,11 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use serde_json::Value;
 
-use flicker::compare::{Plan, compare as run_compare};
 use flicker::orbit::OrbitRequest;
 use flicker::runner::Control;
 use flicker::scene::Registry;
 use flicker::sweep::{Row as SweepRow, Shard, Sweep, is_sweep, parse_text};
+use flicker::work_precision::{Plan, compare as run_compare};
 
 use crate::interrupt::interruptible;
 use crate::{load, override_error, scene_error};
@@ -100,7 +100,7 @@ pub fn compare<'py>(
         "status",
         PyList::new(py, rows.iter().map(|r| r.status.clone()))?,
     )?;
-    let numbers: [(&str, fn(&flicker::compare::Row) -> Option<f64>); 10] = [
+    let numbers: [(&str, fn(&flicker::work_precision::Row) -> Option<f64>); 10] = [
         ("tolerance", |r| r.tolerance),
         ("step", |r| r.step),
         ("wall_seconds", |r| Some(r.wall_seconds)),

@@ -14,12 +14,12 @@
 
 use std::path::PathBuf;
 
-use crate::compare_models::Release;
-use crate::compare_models::{
-    Track, chain_track, continuum_track, distance, release, without_homogenized,
-};
 use crate::engine::Status;
 use crate::models::continuum::Variant;
+use crate::release_convergence::Release;
+use crate::release_convergence::{
+    Track, chain_track, continuum_track, distance, release, without_homogenized,
+};
 use crate::runner::Control;
 use crate::scene::Registry;
 
@@ -53,7 +53,7 @@ pub fn advise(args: AdviseArgs, registry: &Registry) -> Result<Code, Failure> {
             args.scene.display()
         ))
     };
-    let units = match crate::compare_models::release::described(&scene) {
+    let units = match crate::release_convergence::release::described(&scene) {
         Some(Release {
             units: Some(units), ..
         }) => units,

@@ -21,13 +21,13 @@ const LAYERS: [&[&str]; 10] = [
     &["plot"],
     // Tools over any scene.
     &[
-        "compare",
-        "compare_models",
         "lyapunov",
         "orbit",
+        "release_convergence",
         "sensitivities",
         "stress",
         "sweep",
+        "work_precision",
     ],
     &["session"],
     &["prelude"],

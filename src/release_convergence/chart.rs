@@ -6,15 +6,15 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::compare_models::{Model, Track};
 use crate::models::chain::coarse::Coarse;
 use crate::models::continuum::Variant;
 use crate::plot::draw::{Curve, Figure, Style};
+use crate::release_convergence::{Model, Track};
 
 /// Draw every picture into `dir` (SVG and PNG); `reference` is the index of
 /// the densest chain in `tracks`. Returns the files written.
 pub fn draw_all(tracks: &[Track], reference: usize, dir: &Path) -> Result<Vec<PathBuf>, String> {
-    let over_time = |value: fn(&crate::compare_models::Sample) -> Option<f64>| -> Vec<Curve> {
+    let over_time = |value: fn(&crate::release_convergence::Sample) -> Option<f64>| -> Vec<Curve> {
         tracks
             .iter()
             .enumerate()
