@@ -350,12 +350,8 @@ pub fn lyapunov(
             (scene.time_scale() / 4.0).min(t_end.unwrap_or_else(|| scene.t_end()))
         }),
         stop: None,
-        deadline: (wall.is_finite() && wall > 0.0)
-            .then(|| {
-                std::time::Instant::now()
-                    .checked_add(std::time::Duration::from_secs_f64(wall.min(1e9)))
-            })
-            .ok_or_else(|| override_error(py, "wall", format!("a time > 0 (got {wall})")))?,
+        deadline: flicker::runner::deadline_in(wall)
+            .map_err(|why| override_error(py, "wall", why))?,
     };
     flicker::lyapunov::check(&*family, &request)
         .map_err(|(field, why)| override_error(py, field, why))?;

@@ -29,10 +29,5 @@ pub fn stop_flag() -> Arc<AtomicBool> {
 
 /// The instant `seconds` (`--wall`) from now, checked finite and positive.
 pub fn deadline(seconds: f64) -> Result<Option<std::time::Instant>, Failure> {
-    if !(seconds.is_finite() && seconds > 0.0) {
-        return Err(Failure::bad_input(format!(
-            "--wall: a time > 0 (got {seconds})"
-        )));
-    }
-    Ok(std::time::Instant::now().checked_add(std::time::Duration::from_secs_f64(seconds.min(1e9))))
+    crate::runner::deadline_in(seconds).map_err(|why| Failure::bad_input(format!("--wall: {why}")))
 }

@@ -17,7 +17,6 @@ mod json;
 pub mod section;
 pub mod shooting;
 
-use crate::engine::names::intern;
 use crate::engine::{Family, HybridModel, Mode, Observer, Options, Status, simulate};
 use crate::scene::SceneError;
 pub use section::Section;
@@ -246,20 +245,8 @@ pub fn follow(
             .zip(model.clock())
             .map(|(period, c)| (c, period)),
     };
-    // The names of the section state, in the mode the section is in: the
-    // model's own, else the family's with the parameter, else x0, x1, ...
-    let names_in = |mode: Mode| -> Vec<&'static str> {
-        let own = model.state_names(mode);
-        if own.len() == n {
-            return own.to_vec();
-        }
-        let mut listed: Vec<String> = family.state_names();
-        if listed.len() + 1 == n {
-            listed.insert(p, parameter.to_string());
-            return listed.iter().map(|name| intern(name)).collect();
-        }
-        (0..n).map(|i| intern(&format!("x{i}"))).collect()
-    };
+    // The section state's names, in the mode the section is in.
+    let names_in = |mode: Mode| shooting::names(&section, mode, n, Some((p, parameter)));
     let names = names_in(promoted.mode);
     let (mode, x) = match start(
         &section,

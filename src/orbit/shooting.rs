@@ -201,7 +201,7 @@ pub fn shoot(
     x: Vec<f64>,
     on_iteration: &mut dyn FnMut(usize, f64),
 ) -> Orbit {
-    let names = names(section, mode, x.len());
+    let names = names(section, mode, x.len(), None);
     let mut x = x;
     unknowns.fold_clock(&mut x);
     let mut residuals = Vec::new();
@@ -294,16 +294,25 @@ pub fn shoot(
 }
 
 /// The names of the `n` components of a state in `mode`: the model's,
-/// else the family's, else `x0`, `x1`, ... (a chain names its nodes only
-/// for the tools).
-fn names(section: &Section, mode: Mode, n: usize) -> Vec<&'static str> {
+/// else the family's (with `parameter`'s name at its component, for a
+/// model that holds one as a state), else `x0`, `x1`, ... (a chain names
+/// its nodes only for the tools).
+pub(crate) fn names(
+    section: &Section,
+    mode: Mode,
+    n: usize,
+    parameter: Option<(usize, &str)>,
+) -> Vec<&'static str> {
     let own = section.model.state_names(mode);
     if own.len() == n {
         return own.to_vec();
     }
-    let family = section.family.state_names();
-    if family.len() == n {
-        return family.iter().map(|name| intern(name)).collect();
+    let mut listed = section.family.state_names();
+    if let Some((p, name)) = parameter.filter(|_| listed.len() + 1 == n) {
+        listed.insert(p, name.to_string());
+    }
+    if listed.len() == n {
+        return listed.iter().map(|name| intern(name)).collect();
     }
     (0..n).map(|i| intern(&format!("x{i}"))).collect()
 }
@@ -318,7 +327,7 @@ fn verified(
     back: &Return,
     residuals: Vec<f64>,
 ) -> Orbit {
-    let names = names(section, mode, x.len());
+    let names = names(section, mode, x.len(), None);
     let (multipliers, stable) = multipliers(back, unknowns);
     let plain = section.plain(mode, x);
     let (converged, status, residual) = match plain {

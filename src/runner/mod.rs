@@ -83,6 +83,15 @@ pub struct Control {
     pub deadline: Option<std::time::Instant>,
 }
 
+/// The instant `seconds` (a wall-clock budget, `--wall`) from now, or
+/// why `seconds` is not a budget.
+pub fn deadline_in(seconds: f64) -> Result<Option<std::time::Instant>, String> {
+    if !(seconds.is_finite() && seconds > 0.0) {
+        return Err(format!("a time > 0 (got {seconds})"));
+    }
+    Ok(std::time::Instant::now().checked_add(std::time::Duration::from_secs_f64(seconds.min(1e9))))
+}
+
 impl Control {
     /// Whether the stop flag is set: a tool that runs many scenes stops
     /// between them.
