@@ -48,8 +48,13 @@ def _sigint_in(seconds):
 
 
 def test_ctrl_c_stops_a_long_run_within_a_second():
+    # A forced oscillator: the mechanism's exactly periodic orbit would be
+    # jumped over whole periods (no events kept) and end at once.
+    scene = json.loads((MODELS / "automata" / "impact_oscillator.json").read_text())
+    scene["t_end"] = 1e12
+    scene["max_events"] = 10**15
     sent = _sigint_in(0.5)
-    run = flicker.run(_endless_mechanism(), events=False)
+    run = flicker.run(scene, events=False)
     returned = time.perf_counter()
     assert sent, "the run ended before the signal"
     assert run.status == "interrupted", run.summary
@@ -73,6 +78,14 @@ def _endless_mechanism():
     scene["t_end"] = 1e12
     scene["max_events"] = 10**15
     return scene
+
+
+def test_an_endless_periodic_orbit_without_events_is_jumped_over():
+    run = flicker.run(_endless_mechanism(), events=False)
+    assert run.status == "completed", run.summary
+    jumped = run.summary["fast_forward"]
+    assert jumped["periods"] + 5 >= run.summary["events"] > 2e11
+    assert run.summary["wall_seconds"] < 1.0
 
 
 def test_ctrl_c_stops_a_sweep():

@@ -366,6 +366,16 @@ fn print_report(
     } else {
         say!("  events: {} ({})", o.events, by_guard.join(", "));
     }
+    if let Some(f) = &o.fast_forward {
+        say!(
+            "  fast-forwarded: {} periods of {:e} between t = {:e} and {:e}, one event each, counted, \
+             not fired (the orbit returned to its state to round-off; a run that writes its event log fires each)",
+            f.periods,
+            f.period,
+            f.from,
+            f.to
+        );
+    }
     if let (Some(e0), Some(e1), Some(err)) = (o.energy_initial, o.energy_final, o.max_energy_error)
     {
         say!("  energy: initial {e0:e}, final {e1:e}, largest relative error {err:.2e}");

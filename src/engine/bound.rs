@@ -348,6 +348,12 @@ impl Bound {
         Ok(())
     }
 
+    /// The run jumped over `periods` periods of `tau` (see
+    /// [`periodic`](crate::engine::periodic)): its last event moves with it.
+    pub fn postpone(&mut self, periods: u64, tau: f64) {
+        self.last_event = self.last_event.map(|t| t.after_multiple(periods, tau));
+    }
+
     /// The time error of the last event.
     pub fn last_time_bound(&self) -> f64 {
         self.last_time_bound

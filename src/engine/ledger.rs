@@ -10,7 +10,7 @@ use std::time::Instant;
 
 use crate::engine::model::Mode;
 use crate::engine::observer::{EventRecord, Observer, SETTLE};
-use crate::engine::run::{Options, Outcome, Status};
+use crate::engine::run::{FastForward, Options, Outcome, Status};
 use crate::engine::run_loop::{BUDGET_CHECK, CLOCK_EVERY, End, PROGRESS_SECONDS};
 use crate::engine::zeno::ZenoWatch;
 use crate::time::Time;
@@ -60,6 +60,8 @@ pub(crate) struct Ledger<'o> {
     /// (a forced system started at rest): relative to zero, any change
     /// would be infinite.
     energy_peak: f64,
+    /// The periods jumped over so far.
+    fast_forward: Option<FastForward>,
 }
 
 impl<'o> Ledger<'o> {
@@ -84,6 +86,7 @@ impl<'o> Ledger<'o> {
             energy_scale,
             max_energy_error: energy_initial.map(|_| 0.0),
             energy_peak: energy_initial.map_or(0.0, f64::abs),
+            fast_forward: None,
         }
     }
 
@@ -193,6 +196,56 @@ impl<'o> Ledger<'o> {
     /// Count an event the model named otherwise than its guard.
     pub fn count_named(&mut self, name: &'static str) {
         *self.named.entry(name).or_insert(0) += 1;
+    }
+
+    /// Events a jump over whole periods of `tau` from `now` may count,
+    /// so that the budget's rules hold as if each event fired: never past
+    /// the budget (the event past it fails the run), and not past the
+    /// budget's next projection where that projection (at the orbit's
+    /// rate, one event per period) would fail the run there.
+    pub fn jump_allowance(&self, tau: f64, now: Time) -> u64 {
+        let max = self.options.max_events;
+        let left = max.saturating_sub(self.events);
+        let to_projection = self.budget_check.0.saturating_sub(self.events);
+        let needed = self.events as f64 + Time::new(self.options.t_end).since(now) / tau;
+        if left > to_projection && needed > max as f64 {
+            to_projection
+        } else {
+            left
+        }
+    }
+
+    /// A jump over `periods` periods of `tau`, from `from` to `to`, each
+    /// with one event of guard `slot` in `mode` (or the name its reset
+    /// gives, `named`): count them as fired.
+    pub fn jumped(
+        &mut self,
+        (mode, slot, named): (Mode, usize, Option<&'static str>),
+        periods: u64,
+        tau: f64,
+        (from, to): (Time, Time),
+    ) {
+        self.events += periods;
+        if self.events > self.budget_check.0 {
+            // The projections jumped over passed (see `jump_allowance`);
+            // one the jump stops at is the loop's to make.
+            self.budget_check = (self.events + BUDGET_CHECK, self.events, to);
+        }
+        match named {
+            Some(name) => *self.named.entry(name).or_insert(0) += periods,
+            None => {
+                self.count(mode, slot);
+                self.counts[mode][slot] += periods - 1;
+            }
+        }
+        let jump = self.fast_forward.get_or_insert(FastForward {
+            periods: 0,
+            period: tau,
+            from: from.value(),
+            to: to.value(),
+        });
+        jump.periods += periods;
+        (jump.period, jump.to) = (tau, to.value());
     }
 
     /// Count a non-internal event of guard `slot` in `mode`.
@@ -349,6 +402,7 @@ impl<'o> Ledger<'o> {
             flow_evaluations: last.flow_evaluations,
             error_bound: last.error_bound,
             event_time_bound: last.event_time_bound,
+            fast_forward: self.fast_forward,
             wall_seconds: self.started.elapsed().as_secs_f64(),
         }
     }

@@ -1,8 +1,10 @@
 //! Events as the engine reports them, and the observers that receive them.
 //!
 //! The engine pushes one [`EventRecord`] per fired (non-internal) guard to an
-//! [`Observer`]. `()` ignores them, [`Recorder`] keeps them in memory, and the
-//! JSON Lines writer in [`crate::log`] streams them to disk.
+//! [`Observer`]. `()` ignores them (and lets a run jump over whole periods
+//! of an exactly periodic orbit), [`EachEvent`] ignores them but has each
+//! one fired, [`Recorder`] keeps them in memory, and the JSON Lines writer
+//! in [`crate::log`] streams them to disk.
 
 use crate::engine::labels::Labels;
 
@@ -49,7 +51,8 @@ pub trait Observer {
 
     /// Whether the observer looks at events at all. An event-local model
     /// computes the energies of an event (a sum over the whole model) only
-    /// for an observer that does.
+    /// for an observer that does, and a run jumps over whole periods of an
+    /// exactly periodic orbit only for one that does not.
     fn wants_details(&self) -> bool {
         true
     }
@@ -62,6 +65,19 @@ impl Observer for () {
 
     fn wants_details(&self) -> bool {
         false
+    }
+}
+
+/// Asks for every event and keeps none: a run under it fires each event,
+/// even along an orbit it could jump over whole periods of (see
+/// [`periodic`](crate::engine::periodic)). For measuring what each event
+/// costs: benchmarks, soak runs.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct EachEvent;
+
+impl Observer for EachEvent {
+    fn on_event(&mut self, _: &EventRecord) -> std::io::Result<()> {
+        Ok(())
     }
 }
 

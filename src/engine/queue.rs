@@ -86,6 +86,15 @@ impl EventQueue {
         );
     }
 
+    /// Move every prediction `k tau` later (a run that jumps over `k`
+    /// periods of `tau`); the order is unchanged.
+    pub fn postpone(&mut self, k: u64, tau: f64) {
+        let slots: Vec<usize> = self.queue.iter().map(|(slot, _)| *slot).collect();
+        for slot in slots {
+            self.schedule(slot, self.exact[slot].after_multiple(k, tau));
+        }
+    }
+
     /// Forget every prediction.
     pub fn clear(&mut self) {
         self.queue.clear();
@@ -117,6 +126,17 @@ mod tests {
         q.schedule(1, Time::new(3.0)); // replaces the 1.0 prediction
         let order: Vec<usize> = std::iter::from_fn(|| q.pop().map(|(s, _)| s)).collect();
         assert_eq!(order, vec![0, 3, 1]);
+    }
+
+    #[test]
+    fn postponing_moves_every_prediction_by_the_same_multiple() {
+        let mut q = EventQueue::default();
+        q.schedule(0, Time::new(2.0));
+        q.schedule(4, Time::new(1.5));
+        q.postpone(1000, 0.25);
+        assert_eq!(q.pop(), Some((4, Time::new(251.5))));
+        assert_eq!(q.pop(), Some((0, Time::new(252.0))));
+        assert!(q.pop().is_none());
     }
 
     #[test]

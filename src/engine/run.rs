@@ -122,6 +122,24 @@ pub struct Outcome {
     /// allowance of [`ROUNDOFF_ULPS`](crate::engine::bound::ROUNDOFF_ULPS) ulps of the time reached; `None`
     /// where the errors are not tracked.
     pub event_time_bound: Option<f64>,
+    /// Whole periods of an exactly periodic orbit the run jumped over
+    /// instead of firing their events (see
+    /// [`periodic`](crate::engine::periodic)); `None` where it fired
+    /// every event.
+    pub fast_forward: Option<FastForward>,
     /// Wall time the run took, in seconds.
     pub wall_seconds: f64,
+}
+
+/// The periods a run jumped over, summed over its jumps.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FastForward {
+    /// Whole periods jumped over, one event each (counted as if fired).
+    pub periods: u64,
+    /// The period of the last jump.
+    pub period: f64,
+    /// Where the first jump started and the last ended.
+    pub from: f64,
+    /// See `from`.
+    pub to: f64,
 }

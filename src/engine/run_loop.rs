@@ -46,6 +46,11 @@
 //!   resets may change the energy (`HybridModel::resets_keep_energy`), each
 //!   logged reset's change moves what the energy is held to, so the audit
 //!   measures the flows.
+//! - **Periods.** Where the source proves that its orbit repeats after an
+//!   event ([`periodic`]) and the observer does not look at events, whole
+//!   periods are jumped over (short of the end, the next sample, the event
+//!   budget and its next projection, so the budget's rules hold as if
+//!   every event fired) and their events counted as fired.
 //! - **Counts.** Non-internal events are counted per guard, settlings
 //!   apart; the outcome reports them by guard name.
 //!
@@ -55,7 +60,9 @@
 use crate::engine::bound::ROUNDOFF_ULPS;
 use crate::engine::ledger::Ledger;
 use crate::engine::observer::Observer;
+use crate::engine::periodic;
 use crate::engine::run::Status;
+use crate::engine::zeno;
 use crate::time::Time;
 
 /// Why the loop stopped, with a reason for anything but completion.
@@ -119,6 +126,21 @@ pub(crate) trait Segments {
         None
     }
 
+    /// The period of the orbit the last event showed to repeat, where the
+    /// source can prove it does (see [`periodic`]): the time from the
+    /// current origin to the next event, which is the same guard's again.
+    ///
+    /// [`periodic`]: crate::engine::periodic
+    fn period(&self) -> Option<f64> {
+        None
+    }
+
+    /// Jump `periods` whole periods of `tau` ahead (the state repeats),
+    /// counting their events in `ledger`.
+    fn jump(&mut self, periods: u64, tau: f64, ledger: &mut Ledger) {
+        let _ = (periods, tau, ledger);
+    }
+
     /// Reach `t_end` with nothing more to happen before it, or say why the
     /// state there cannot be vouched for. An event due at `t_end` may have
     /// fired a rounding past it: the state after it is the final state.
@@ -173,7 +195,23 @@ fn turns<S: Segments + ?Sized, O: Observer + ?Sized>(
             continue;
         }
         match guard {
-            Some(guard) => source.fire(guard, t, ledger, observer)?,
+            Some(guard) => {
+                source.fire(guard, t, ledger, observer)?;
+                // An observer that looks at events sees every one fired.
+                if !observer.wants_details()
+                    && let Some(tau) = source.period()
+                    // Events closer than the run resolves are the Zeno
+                    // watch's, not a period's.
+                    && tau > zeno::resolution(t.value(), t_end)
+                {
+                    let limit = samples.peek().map_or(t_end, |&s| s.min(t_end));
+                    let periods = periodic::periods_to_skip(source.origin(), tau, limit)
+                        .min(ledger.jump_allowance(tau, source.origin()));
+                    if periods > 0 {
+                        source.jump(periods, tau, ledger);
+                    }
+                }
+            }
             None => source.renew(t)?,
         }
         ledger.check_events(source.origin())?;

@@ -23,6 +23,7 @@ use crate::engine::ledger::{Final, Ledger};
 use crate::engine::locate::{Start, scan_step};
 use crate::engine::model::{Affects, Direction, HybridModel, Mode};
 use crate::engine::observer::{EventRecord, Observer, SETTLE};
+use crate::engine::periodic::Returns;
 use crate::engine::queue::EventQueue;
 use crate::engine::run::{Options, Outcome, Status};
 use crate::engine::run_loop::{End, Segments, drive, end_window};
@@ -149,6 +150,10 @@ struct Run<'m, 's, M: HybridModel + ?Sized> {
     /// The model's clock component and its value at `t = 0`: the clock
     /// reads the run's time from there.
     clock: Option<(usize, f64)>,
+    /// The state after the last event, to prove the orbit periodic, and
+    /// that event's mode, guard and name (what a period's event counts as).
+    returns: Returns,
+    repeated: (Mode, usize, Option<&'static str>),
 }
 
 impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
@@ -268,7 +273,7 @@ impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
         if let Some(what) = ledger.zeno(mode, slot, guard.name, t) {
             return self.settle(what, t, ledger, observer);
         }
-        match (self.motion, jump.affects) {
+        let predicted = match (self.motion, jump.affects) {
             (Motion::Exact, Affects::Range { first, count }) if jump.mode == mode => {
                 let guards = model.guards(mode).len();
                 if first.saturating_add(count) > guards {
@@ -327,7 +332,35 @@ impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
                 }
                 self.start_segment()
             }
+        };
+        predicted?;
+        // An exact, autonomous flow with nothing to carry repeats from a
+        // repeated state (see `periodic`).
+        if !guard.internal
+            && jump.mode == mode
+            && self.motion == Motion::Exact
+            && self.clock.is_none()
+            && self.bound.idle()
+        {
+            self.returns.visit(mode, slot, t, &self.state);
+            self.repeated = (mode, slot, jump.event);
+        } else {
+            self.returns.forget();
         }
+        Ok(())
+    }
+
+    fn period(&self) -> Option<f64> {
+        let (next, at) = self.queue.peek()?;
+        (self.returns.returned() && next == self.repeated.1).then(|| at.since(self.origin))
+    }
+
+    fn jump(&mut self, periods: u64, tau: f64, ledger: &mut Ledger) {
+        let from = self.origin;
+        self.origin = from.after_multiple(periods, tau);
+        self.queue.postpone(periods, tau);
+        self.bound.postpone(periods, tau);
+        ledger.jumped(self.repeated, periods, tau, (from, self.origin));
     }
 
     fn renew(&mut self, t: Time) -> Result<(), End> {
@@ -436,6 +469,8 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
             before: vec![0.0; n],
             after: vec![0.0; n],
             clock: model.clock().map(|c| (c, x0[c])),
+            returns: Returns::default(),
+            repeated: (mode, 0, None),
         }
     }
 
@@ -550,6 +585,7 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
         observer: &mut O,
     ) -> Result<(), End> {
         self.after.copy_from_slice(&self.state);
+        self.returns.forget();
         let Some(rest) = self.model.settle(self.mode, &mut self.after) else {
             return Err(Ledger::unsettled(&what));
         };

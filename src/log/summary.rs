@@ -13,7 +13,10 @@
 //! impulses, relative; exact path only), null for other models; with
 //! `--sensitivities`, `sensitivities`: for each direction, the derivatives
 //! of the final state (`final_state`, by name) and of the last event's time
-//! (`last_event_time`).
+//! (`last_event_time`); where the run jumped over whole periods of an
+//! exactly periodic orbit (no event log, see `engine::periodic`),
+//! `fast_forward`: `periods` (one event each, counted, not fired), `period` (the
+//! last jump's), `from` and `to` (where the jumps began and ended).
 
 use std::io;
 use std::path::Path;
@@ -55,6 +58,14 @@ pub fn summary(report: &Report, model: &str, scene: &Path, log: Option<&Path>) -
         "momentum": report.fields.as_ref().map(|c| c.momentum),
         "momentum_balance_error": report.fields.as_ref().and_then(|c| c.momentum_balance_error),
     });
+    if let Some(f) = &o.fast_forward {
+        value["fast_forward"] = json!({
+            "periods": f.periods,
+            "period": f.period,
+            "from": f.from,
+            "to": f.to,
+        });
+    }
     if let Some(sensitivities) = &report.sensitivities {
         value["sensitivities"] = sensitivities.clone();
     }

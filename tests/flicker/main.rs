@@ -19,6 +19,7 @@ mod convergence;
 mod engine_generic;
 mod error_bound;
 mod event_location;
+mod fast_forward;
 mod filippov;
 mod fuzz_regressions;
 mod golden;
