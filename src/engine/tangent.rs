@@ -194,12 +194,7 @@ impl Tangents {
                         out.copy_from_slice(&piece);
                     } else {
                         // out = piece * out: the later piece acts last.
-                        for i in 0..n {
-                            for j in 0..n {
-                                product[i * n + j] =
-                                    (0..n).map(|l| piece[i * n + l] * out[l * n + j]).sum();
-                            }
-                        }
+                        mat_mul(n, &piece, out, &mut product);
                         out.copy_from_slice(&product);
                     }
                 }
@@ -401,24 +396,48 @@ fn exp_dense(n: usize, a: &[f64], out: &mut [f64], term: &mut [f64], next: &mut 
             break;
         }
         let factor = scale / k as f64;
-        for i in 0..n {
-            for j in 0..n {
-                next[i * n + j] =
-                    factor * (0..n).map(|l| term[i * n + l] * a[l * n + j]).sum::<f64>();
-            }
+        mat_mul(n, term, a, next);
+        for (t, x) in term.iter_mut().zip(next.iter()) {
+            *t = factor * x;
         }
-        term.copy_from_slice(next);
         for (o, t) in out.iter_mut().zip(term.iter()) {
             *o += t;
         }
     }
     for _ in 0..squarings {
-        for i in 0..n {
-            for j in 0..n {
-                next[i * n + j] = (0..n).map(|l| out[i * n + l] * out[l * n + j]).sum();
+        mat_mul(n, out, out, next);
+        out.copy_from_slice(next);
+    }
+}
+
+/// `out = a b` of row-major `n x n` matrices, each entry summed over `l`
+/// in increasing order. The tangents of a Taylor step take dozens of
+/// these: sizes up to four get loops the compiler unrolls and checks no
+/// bounds in.
+fn mat_mul(n: usize, a: &[f64], b: &[f64], out: &mut [f64]) {
+    match n {
+        3 => mat_mul_fixed::<3>(a, b, out),
+        4 => mat_mul_fixed::<4>(a, b, out),
+        _ => {
+            for (row, o) in a.chunks_exact(n).zip(out.chunks_exact_mut(n)) {
+                for (j, o) in o.iter_mut().enumerate() {
+                    *o = row.iter().enumerate().map(|(l, x)| x * b[l * n + j]).sum();
+                }
             }
         }
-        out.copy_from_slice(next);
+    }
+}
+
+fn mat_mul_fixed<const N: usize>(a: &[f64], b: &[f64], out: &mut [f64]) {
+    let (a, b, out) = (&a[..N * N], &b[..N * N], &mut out[..N * N]);
+    for i in 0..N {
+        for j in 0..N {
+            let mut sum = a[i * N] * b[j];
+            for l in 1..N {
+                sum += a[i * N + l] * b[l * N + j];
+            }
+            out[i * N + j] = sum;
+        }
     }
 }
 
