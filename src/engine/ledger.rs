@@ -287,7 +287,14 @@ impl<'o> Ledger<'o> {
         self.audit(event.energy_after);
         observer
             .on_event(&event)
-            .map_err(|e| End::failed(format!("could not write the event log: {e}")))
+            .map_err(|e| End::failed(format!("could not write the event log: {e}")))?;
+        match observer.stop() {
+            Some(why) => Err(End {
+                status: Status::Interrupted,
+                reason: Some(format!("stopped by its observer: {why}")),
+            }),
+            None => Ok(()),
+        }
     }
 
     /// Audit one value of the energy.

@@ -237,6 +237,8 @@ impl<M: LocalModel + ?Sized> LocalRun<'_, M> {
             guard: name,
             mode_before: mode,
             mode_after: mode,
+            from: 0,
+            to: 0,
             energy_before,
             energy_after,
             names_before: &[],

@@ -7,6 +7,7 @@
 //! in [`crate::log`] streams them to disk.
 
 use crate::engine::labels::Labels;
+use crate::engine::model::Mode;
 
 /// One event, borrowed from the engine for the duration of the call.
 #[derive(Debug, Clone, Copy)]
@@ -21,6 +22,11 @@ pub struct EventRecord<'a> {
     pub mode_before: &'static str,
     /// Name of the mode after the reset.
     pub mode_after: &'static str,
+    /// The mode before the reset, by index (the model's `Mode`; its name is
+    /// `mode_before`).
+    pub from: Mode,
+    /// The mode after the reset, by index.
+    pub to: Mode,
     /// The model's energy just before the reset, if it has one.
     pub energy_before: Option<f64>,
     /// The model's energy just after the reset, if it has one.
@@ -47,6 +53,14 @@ pub trait Observer {
     /// simulated time reached and the events so far, for progress displays.
     fn on_progress(&mut self, t: f64, events: u64) {
         let _ = (t, events);
+    }
+
+    /// Why the run should end here, if the observer has seen what it came
+    /// for (asked after each event it receives): the run then ends at that
+    /// event, `interrupted` with this reason, its final state the one just
+    /// before the event's reset (as a run that fails at an event).
+    fn stop(&self) -> Option<String> {
+        None
     }
 
     /// Whether the observer looks at events at all. An event-local model
@@ -104,6 +118,10 @@ pub struct RecordedEvent {
     pub t: f64,
     /// Name of the guard that fired.
     pub guard: &'static str,
+    /// The mode before the reset, by index.
+    pub from: Mode,
+    /// The mode after the reset, by index.
+    pub to: Mode,
     /// The model's energy just before the reset, if it has one.
     pub energy_before: Option<f64>,
     /// The model's energy just after the reset, if it has one.
@@ -128,6 +146,8 @@ impl Observer for Recorder {
         self.events.push(RecordedEvent {
             t: e.t,
             guard: e.guard,
+            from: e.from,
+            to: e.to,
             energy_before: e.energy_before,
             energy_after: e.energy_after,
             before: e.before.to_vec(),

@@ -565,6 +565,8 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
             guard: name,
             mode_before: model.mode_name(mode),
             mode_after: model.mode_name(mode_after),
+            from: mode,
+            to: mode_after,
             energy_before: model.energy(mode, before),
             energy_after: model.energy(mode_after, &self.after),
             names_before: model.state_names(mode),

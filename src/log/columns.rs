@@ -219,6 +219,8 @@ mod tests {
             guard,
             mode_before: "m",
             mode_after: "n",
+            from: 0,
+            to: 1,
             energy_before: Some(1.0),
             energy_after: None,
             names_before: names,

@@ -239,6 +239,8 @@ mod tests {
             guard: "impact",
             mode_before: "flight",
             mode_after: "flight",
+            from: 0,
+            to: 0,
             energy_before: Some(0.025),
             energy_after: None,
             names_before: &["strain", "strain_rate"],

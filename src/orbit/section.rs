@@ -67,36 +67,29 @@ pub struct Return {
 }
 
 /// Keeps the `K`-th event of the section guard and stops the run there.
+/// Counts the section's events and ends the run at the `wanted`-th.
 struct Counter<'a> {
     guard: &'a str,
     wanted: usize,
     seen: usize,
-    modes: Vec<&'static str>,
     hit: Option<(f64, Mode, Vec<f64>)>,
-    stop: Arc<AtomicBool>,
-    /// The section's stop from outside: a long transient ends at the next
-    /// event once it is set.
-    outside: Option<&'a Arc<AtomicBool>>,
 }
 
 impl Observer for Counter<'_> {
     fn on_event(&mut self, e: &EventRecord) -> std::io::Result<()> {
-        if self.outside.is_some_and(|s| s.load(Ordering::Relaxed)) {
-            self.stop.store(true, Ordering::Relaxed);
-        }
         if e.guard == self.guard && self.hit.is_none() {
             self.seen += 1;
             if self.seen == self.wanted {
-                let mode = self
-                    .modes
-                    .iter()
-                    .position(|m| *m == e.mode_after)
-                    .unwrap_or(0);
-                self.hit = Some((e.t, mode, e.after.to_vec()));
-                self.stop.store(true, Ordering::Relaxed);
+                self.hit = Some((e.t, e.to, e.after.to_vec()));
             }
         }
         Ok(())
+    }
+
+    fn stop(&self) -> Option<String> {
+        self.hit
+            .as_ref()
+            .map(|(t, _, _)| format!("the section's event {} at t = {t}", self.wanted))
     }
 }
 
@@ -128,13 +121,12 @@ impl Section<'_> {
         if let Some(why) = self.spent() {
             return Err(why);
         }
-        let stop = Arc::new(AtomicBool::new(false));
         let options = Options {
             t_end: self.t_max,
             max_events: 100_000_000,
             method: self.method(model),
             tolerances: Tolerances::default(),
-            stop: Some(stop.clone()),
+            stop: self.stop.cloned(),
             max_wall_seconds: self
                 .deadline
                 .map(|d| d.saturating_duration_since(Instant::now()).as_secs_f64()),
@@ -143,12 +135,7 @@ impl Section<'_> {
             guard: self.guard,
             wanted: self.events,
             seen: 0,
-            modes: (0..self.family.modes())
-                .map(|m| self.model.mode_name(m))
-                .collect(),
             hit: None,
-            stop,
-            outside: self.stop,
         };
         let outcome = simulate(model, mode, x0, &options, &mut counter);
         match counter.hit {

@@ -28,6 +28,7 @@ mod invariants;
 mod lyapunov;
 mod mechanism_angle;
 mod mechanism_strain;
+mod observers;
 mod orbits;
 mod oscillator;
 mod phase;
