@@ -19,7 +19,7 @@ use std::time::Instant;
 use nalgebra::DMatrix;
 use serde_json::{Value, json};
 
-use crate::engine::integrator::tightest;
+use crate::engine::method::tightest;
 use crate::engine::variational::Variational;
 use crate::engine::{Family, Options, Status, simulate};
 

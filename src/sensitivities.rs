@@ -18,7 +18,7 @@
 
 use serde_json::{Map, Value, json};
 
-use crate::engine::integrator::tightest;
+use crate::engine::method::tightest;
 use crate::engine::variational::Variational;
 use crate::engine::{
     Family, HybridModel, Method, Mode, Observer, Sample, Tolerances, simulate_sampled,
@@ -315,7 +315,7 @@ pub fn run(
     }
     Ok(Report {
         outcome,
-        method: method.name(),
+        method,
         description: format!(
             "{description}; with the derivatives along {} (variational equations, saltation matrices at events)",
             setup.labels.join(", ")

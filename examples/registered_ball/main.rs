@@ -117,7 +117,7 @@ impl SceneModel for BallScene {
         ];
         Ok(Report {
             outcome,
-            method: "exact",
+            method: Method::Exact,
             description: "free flight in closed form, exact landing times".into(),
             final_state,
             fields: None,

@@ -5,13 +5,14 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
 
 use crate::engine::Status;
+use crate::engine::method::NAMES;
 use crate::log::JsonlWriter;
 use crate::log::field_files;
 use crate::log::summary::{summary, write_atomically};
 use crate::log::writer::LazyFile;
 use crate::runner::ensemble::EnsembleRequest;
 use crate::runner::{Control, Report, Trajectory};
-use crate::scene::solver::{METHODS, SolverSpec};
+use crate::scene::solver::SolverSpec;
 use crate::scene::{Registry, Scene};
 use crate::session::RunRequest;
 
@@ -90,7 +91,7 @@ pub struct EnsembleFlags {
 pub struct SolverFlags {
     /// Method (default: the scene's, else the cheapest exact description of
     /// the model).
-    #[arg(long, value_name = "M", value_parser = clap::builder::PossibleValuesParser::new(METHODS))]
+    #[arg(long, value_name = "M", value_parser = clap::builder::PossibleValuesParser::new(NAMES))]
     method: Option<String>,
     /// Relative tolerance (taylor, dopri5, dop853).
     #[arg(long, value_name = "R", allow_negative_numbers = true)]

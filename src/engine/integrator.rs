@@ -1,56 +1,19 @@
 //! The numerical methods behind one interface, and which one a mode gets.
 //!
 //! The event loop asks an [`Integrator`] for one step and for states inside
-//! it; it never asks which method is inside. [`Method`] is the user's choice;
-//! [`Motion`] is what it means for one mode: the model's exact flow, a
-//! frozen state, or steps of the chosen integrator.
+//! it; it never asks which method is inside. [`Method`] is the user's choice
+//! (`src/engine/method.rs`); [`Motion`] is what it means for one mode: the
+//! model's exact flow, a frozen state, or steps of the chosen integrator.
 
 use crate::engine::adaptive::{EmbeddedPair, StepFailure, Tolerances};
 use crate::engine::dop853::Dop853;
 use crate::engine::dopri5::Dopri5;
 use crate::engine::linear::Linear;
 use crate::engine::locate::{Interpolant, Start, StepScan};
+use crate::engine::method::Method;
 use crate::engine::model::{Flow, HybridModel, Mode};
 use crate::engine::taylor_method::Taylor;
 use crate::engine::verlet::Verlet;
-
-/// How to advance the flows.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Method {
-    /// The cheapest exact description each mode offers: its closed form
-    /// where it has one, Dormand-Prince otherwise.
-    Auto,
-    /// The model's closed forms only; a mode without one fails.
-    Exact,
-    /// The exact propagator of linear flows.
-    Linear,
-    /// Dormand-Prince 5(4) with these tolerances.
-    Dopri5(Tolerances),
-    /// Dormand and Prince's 8th-order pair DOP853 with these tolerances.
-    Dop853(Tolerances),
-    /// Taylor's method with these tolerances (order and step from them).
-    Taylor(Tolerances),
-    /// Stormer-Verlet with this fixed step.
-    Verlet {
-        /// The fixed step.
-        step: f64,
-    },
-}
-
-impl Method {
-    /// The name used in summaries and `compare.csv`.
-    pub fn name(&self) -> &'static str {
-        match self {
-            Method::Auto => "auto",
-            Method::Exact => "exact",
-            Method::Linear => "linear",
-            Method::Dopri5(_) => "dopri5",
-            Method::Dop853(_) => "dop853",
-            Method::Taylor(_) => "taylor",
-            Method::Verlet { .. } => "verlet",
-        }
-    }
-}
 
 /// How one mode moves under a method.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -71,6 +34,10 @@ pub fn motion<M: HybridModel + ?Sized>(
 ) -> Result<Motion, String> {
     let name = model.mode_name(mode);
     match (model.flow(mode), method) {
+        (_, Method::FiniteVolume) => Err(
+            "finite volumes are the homogenized continuum's own solver; no other model runs by them"
+                .into(),
+        ),
         (Flow::Frozen, _) => Ok(Motion::Frozen),
         (Flow::Exact, Method::Auto | Method::Exact) => Ok(Motion::Exact),
         (Flow::Ode, Method::Auto) => Ok(Motion::Stepped),
@@ -124,25 +91,6 @@ pub fn runs<M: HybridModel + ?Sized>(
         .try_for_each(|&mode| motion(model, mode, method).map(|_| ()))
 }
 
-/// The tightest method a tool can run `model`'s modes `0..modes` by
-/// without Taylor series (which derivatives carried as states do not
-/// have): the closed form where every mode has one (or is frozen), the
-/// exact linear propagator where every mode is linear (or frozen), DOP853
-/// at `tolerance` otherwise. What orbits, sensitivities and Lyapunov
-/// spectra run by.
-pub fn tightest<M: HybridModel + ?Sized>(model: &M, modes: usize, tolerance: f64) -> Method {
-    if (0..modes).all(|m| matches!(model.flow(m), Flow::Frozen | Flow::Exact)) {
-        Method::Auto
-    } else if (0..modes).all(|m| model.flow(m) == Flow::Frozen || model.is_linear(m)) {
-        Method::Linear
-    } else {
-        Method::Dop853(Tolerances {
-            rtol: tolerance,
-            atol: tolerance,
-        })
-    }
-}
-
 /// The names of the methods a user can choose that run every one of
 /// `modes` of `model` ([`runs`]), in the order exact, linear, taylor,
 /// dopri5, dop853, verlet: the one place that says which methods a model
@@ -191,7 +139,9 @@ impl Integrator {
             Method::Dopri5(tol) => Integrator::Dopri5(Dopri5::new(dimension, tol)),
             Method::Dop853(tol) => Integrator::Dop853(Dop853::new(dimension, tol)),
             Method::Taylor(tol) => Integrator::Taylor(Taylor::new(dimension, tol)),
-            Method::Auto | Method::Exact => Integrator::Dopri5(Dopri5::new(dimension, tolerances)),
+            Method::Auto | Method::Exact | Method::FiniteVolume => {
+                Integrator::Dopri5(Dopri5::new(dimension, tolerances))
+            }
         }
     }
 

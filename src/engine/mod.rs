@@ -15,6 +15,7 @@ mod ledger;
 pub mod linear;
 pub mod local;
 pub mod locate;
+pub mod method;
 pub mod model;
 pub mod names;
 pub mod observer;
@@ -33,9 +34,9 @@ pub mod zeno;
 
 pub use adaptive::Tolerances;
 pub use family::{Family, Promoted};
-pub use integrator::Method;
 pub use labels::{Label, Labels};
 pub use local::{Fired, LocalModel, simulate_local};
+pub use method::Method;
 pub use model::{Affects, Direction, Flow, Guard, HybridModel, Jump, Mode};
 pub use observer::{EachEvent, EventRecord, EventTimes, Observer, RecordedEvent, Recorder, SETTLE};
 pub use run::{FastForward, Options, Outcome, Status};

@@ -7,7 +7,7 @@ use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
 use crate::engine::adaptive::Tolerances;
-use crate::engine::integrator::Method;
+use crate::engine::method::Method;
 use crate::engine::model::Mode;
 
 /// How to run a model.

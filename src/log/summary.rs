@@ -37,7 +37,7 @@ pub fn summary(report: &Report, model: &str, scene: &Path, log: Option<&Path>) -
         "status": o.status.as_str(),
         "reason": o.reason,
         "model": model,
-        "method": report.method,
+        "method": report.method.name(),
         "method_description": report.description,
         "scene": scene.display().to_string(),
         "events": o.events,

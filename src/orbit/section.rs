@@ -17,7 +17,7 @@ use std::time::Instant;
 
 use nalgebra::DMatrix;
 
-use crate::engine::integrator::tightest;
+use crate::engine::method::tightest;
 use crate::engine::variational::Variational;
 use crate::engine::{
     EventRecord, Family, Flow, HybridModel, Method, Mode, Observer, Options, Status, Tolerances,

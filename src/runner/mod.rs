@@ -16,8 +16,8 @@ pub use fields::{CLASSICAL_MAX_UNITS, Classical, FieldOutputs, Profile, TraceRow
 pub struct Report {
     /// What the engine reported: how the run ended, its events, its errors.
     pub outcome: Outcome,
-    /// The method used, in the names `flicker compare` uses (`exact`, `dopri5`).
-    pub method: &'static str,
+    /// The method used (its [`Method::name`] is the summary's `method`).
+    pub method: Method,
     /// A sentence saying which description of the model was used and why.
     pub description: String,
     /// The final state in the scene's physical variables.

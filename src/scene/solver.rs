@@ -18,17 +18,14 @@
 
 use serde_json::Value;
 
-use crate::engine::{Method, Tolerances, taylor_method};
+use crate::engine::{Method, Tolerances};
 use crate::scene::SceneError;
 use crate::scene::fields::Fields;
-
-/// The method names a scene or `--method` may give.
-pub const METHODS: [&str; 6] = ["exact", "linear", "taylor", "dopri5", "dop853", "verlet"];
 
 /// The solver as written, before it is checked against the model.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct SolverSpec {
-    /// `method`: one of [`METHODS`]; `None` for the model's cheapest exact
+    /// `method`: one of [`NAMES`](crate::engine::method::NAMES); `None` for the model's cheapest exact
     /// description.
     pub method: Option<String>,
     /// `rtol`: relative tolerance, for `dopri5` and `dop853`.
@@ -68,9 +65,9 @@ impl SolverSpec {
         }
     }
 
-    /// The method and tolerances this spec asks for.
+    /// The method and tolerances this spec asks for ([`Method::parse`]),
+    /// each number a finite number > 0.
     pub fn resolve(&self) -> Result<(Method, Tolerances), SceneError> {
-        let default = Tolerances::default();
         let positive = |key: &str, x: Option<f64>| match x {
             Some(x) if !(x.is_finite() && x > 0.0) => Err(SceneError::field(
                 &format!("solver.{key}"),
@@ -78,51 +75,13 @@ impl SolverSpec {
             )),
             _ => Ok(x),
         };
-        let rtol = positive("rtol", self.rtol)?;
-        let atol = positive("atol", self.atol)?;
-        let step = positive("step", self.step)?;
-        let tolerances = Tolerances {
-            rtol: rtol.unwrap_or(default.rtol),
-            atol: atol.unwrap_or(default.atol),
-        };
-        let not_for = |key: &str, method: &str| {
-            SceneError::field(
-                &format!("solver.{key}"),
-                format!("does not apply to method {method:?}"),
-            )
-        };
-        let method = match self.method.as_deref() {
-            None | Some("dopri5" | "dop853" | "taylor") if step.is_some() => {
-                return Err(not_for("step", self.method.as_deref().unwrap_or("auto")));
-            }
-            None => Method::Auto,
-            Some("dopri5") => Method::Dopri5(tolerances),
-            Some("dop853") => Method::Dop853(tolerances),
-            Some("taylor") => Method::Taylor(Tolerances {
-                rtol: rtol.unwrap_or(taylor_method::DEFAULT_TOLERANCE),
-                atol: atol.unwrap_or(taylor_method::DEFAULT_TOLERANCE),
-            }),
-            Some(other @ ("verlet" | "linear" | "exact")) if rtol.is_some() || atol.is_some() => {
-                return Err(not_for(if rtol.is_some() { "rtol" } else { "atol" }, other));
-            }
-            Some("verlet") => Method::Verlet {
-                step: step.ok_or_else(|| {
-                    SceneError::field("solver.step", "is required by method \"verlet\"".into())
-                })?,
-            },
-            Some(other @ ("linear" | "exact")) if step.is_some() => {
-                return Err(not_for("step", other));
-            }
-            Some("linear") => Method::Linear,
-            Some("exact") => Method::Exact,
-            Some(other) => {
-                return Err(SceneError::field(
-                    "solver.method",
-                    format!("unknown method {other:?} (known: {})", METHODS.join(", ")),
-                ));
-            }
-        };
-        Ok((method, tolerances))
+        Method::parse(
+            self.method.as_deref(),
+            positive("rtol", self.rtol)?,
+            positive("atol", self.atol)?,
+            positive("step", self.step)?,
+        )
+        .map_err(|refused| SceneError::field(&format!("solver.{}", refused.key), refused.reason))
     }
 }
 

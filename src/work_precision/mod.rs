@@ -12,10 +12,11 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
+use crate::engine::method::NAMES;
 use crate::engine::{EventTimes, Status, zeno};
 use crate::runner;
 use crate::scene::Reference;
-use crate::scene::solver::{METHODS, SolverSpec};
+use crate::scene::solver::SolverSpec;
 use crate::scene::{Scene, SceneError};
 
 /// Default Dormand-Prince tolerances (`rtol = atol`).
@@ -86,10 +87,10 @@ impl Plan {
     ) -> Result<Plan, SceneError> {
         let methods =
             methods.unwrap_or_else(|| scene.methods().into_iter().map(str::to_string).collect());
-        if let Some(bad) = methods.iter().find(|m| !METHODS.contains(&m.as_str())) {
+        if let Some(bad) = methods.iter().find(|m| !NAMES.contains(&m.as_str())) {
             return Err(SceneError::field(
                 "methods",
-                format!("unknown method {bad:?} (known: {})", METHODS.join(", ")),
+                format!("unknown method {bad:?} (known: {})", NAMES.join(", ")),
             ));
         }
         for (key, values) in [("tolerances", &tolerances), ("steps", &steps)] {

@@ -116,7 +116,7 @@ fn a_homogenized_scene_runs_and_says_what_it_used() {
         "snapshots": [0.1], "samples": 5, "resolution": 100}"#;
     let scene = scene::parse(text).unwrap();
     let report = scene.run(&Default::default(), &mut ()).unwrap();
-    assert_eq!(report.method, "finite_volume");
+    assert_eq!(report.method, flicker::engine::Method::FiniteVolume);
     assert!(
         report.description.contains("100 cells"),
         "{}",

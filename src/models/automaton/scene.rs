@@ -4,6 +4,7 @@
 use std::sync::Arc;
 
 use crate::engine::integrator::{methods_for, runs};
+use crate::engine::method::cheapest;
 use crate::engine::zeno;
 use crate::engine::{
     EventTimes, Family, HybridModel, Method, Observer, Sample, Status, Tolerances,
@@ -122,71 +123,29 @@ impl AutomatonScene {
         said.join(", ")
     }
 
-    /// The method a run uses, and why: `Auto` resolves to the exact linear
-    /// propagator where every flow is affine, else to Taylor's method at
-    /// machine precision (unless told `rtol`/`atol`), else (a flow or guard
-    /// with `abs`, `min` or `max`) to Dormand-Prince.
+    /// The method a run uses, and why: `Auto` resolves by
+    /// [`cheapest`]: the exact linear propagator where every flow is
+    /// affine, else Taylor's method at machine precision (unless told
+    /// `rtol`/`atol`), else (a flow or guard with `abs`, `min` or `max`)
+    /// Dormand-Prince.
     pub fn resolved(&self) -> (Method, String) {
-        let tol = self.tolerances;
-        let modes = self.automaton.modes();
-        match self.method {
-            Method::Auto if self.automaton.all_linear() => (
-                Method::Linear,
-                "every mode's flow is affine: exact linear propagator, events located on it".into(),
-            ),
-            Method::Auto if runs(&*self.automaton, &modes, Method::Taylor(tol)).is_ok() => {
-                let tol = Tolerances {
-                    rtol: self.solver.rtol.unwrap_or(taylor_method::DEFAULT_TOLERANCE),
-                    atol: self.solver.atol.unwrap_or(taylor_method::DEFAULT_TOLERANCE),
-                };
-                (
-                    Method::Taylor(tol),
-                    format!(
-                        "a mode's flow is not affine: Taylor's method of order {}, rtol {:e}, atol {:e}, \
-                         events on each guard's series",
-                        taylor_method::order_for(tol),
-                        tol.rtol,
-                        tol.atol
-                    ),
-                )
-            }
-            Method::Auto => (
-                Method::Dopri5(tol),
-                format!(
-                    "a mode's flow is not affine, and {} reads abs, min or max (no Taylor series): \
-                     Dormand-Prince 5(4), rtol {:e}, atol {:e}",
-                    self.automaton.rough().unwrap_or("an expression"),
-                    tol.rtol,
-                    tol.atol
-                ),
-            ),
-            Method::Taylor(t) => (
-                self.method,
-                format!(
-                    "Taylor's method of order {}, rtol {:e}, atol {:e}, events on each guard's series",
-                    taylor_method::order_for(t),
-                    t.rtol,
-                    t.atol
-                ),
-            ),
-            Method::Linear => (
-                self.method,
-                "exact linear propagator, events located on it".into(),
-            ),
-            Method::Dopri5(t) => (
-                self.method,
-                format!("Dormand-Prince 5(4), rtol {:e}, atol {:e}", t.rtol, t.atol),
-            ),
-            Method::Dop853(t) => (
-                self.method,
-                format!(
-                    "DOP853 (Dormand-Prince 8(5,3)), rtol {:e}, atol {:e}",
-                    t.rtol, t.atol
-                ),
-            ),
-            Method::Verlet { step } => (self.method, format!("Stormer-Verlet, step {step:e}")),
-            Method::Exact => (self.method, "closed form".into()),
+        if self.method != Method::Auto {
+            return (self.method, self.method.describe());
         }
+        let taylor = Tolerances {
+            rtol: self.solver.rtol.unwrap_or(taylor_method::DEFAULT_TOLERANCE),
+            atol: self.solver.atol.unwrap_or(taylor_method::DEFAULT_TOLERANCE),
+        };
+        let modes = self.automaton.modes().len();
+        let (method, why) = cheapest(&*self.automaton, modes, self.tolerances, taylor);
+        let why = match method {
+            Method::Dopri5(_) => format!(
+                "a mode's flow is not affine, and {} reads abs, min or max (no Taylor series)",
+                self.automaton.rough().unwrap_or("an expression")
+            ),
+            _ => why.to_string(),
+        };
+        (method, format!("{why}: {}", method.describe()))
     }
 }
 
@@ -220,7 +179,7 @@ impl AutomatonScene {
             .collect();
         Ok(Report {
             outcome,
-            method: method.name(),
+            method,
             description,
             final_state,
             fields: None,

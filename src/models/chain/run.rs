@@ -179,7 +179,7 @@ fn run_exact(
     );
     Ok(report(
         outcome,
-        "exact",
+        Method::Exact,
         description,
         FieldOutputs {
             momentum,
@@ -237,12 +237,11 @@ fn run_ode(
         chain.momentum(&outcome.final_state),
         outcome.final_state[n - 1],
     );
-    let name = method.name();
     let description =
-        format!("chain of {n} units as a linear ODE in positions and velocities, by {name}");
+        format!("chain of {n} units as a linear ODE in positions and velocities, by {method}");
     Ok(report(
         outcome,
-        name,
+        method,
         description,
         FieldOutputs {
             momentum,
@@ -255,12 +254,7 @@ fn run_ode(
     ))
 }
 
-fn report(
-    outcome: Outcome,
-    method: &'static str,
-    description: String,
-    fields: FieldOutputs,
-) -> Report {
+fn report(outcome: Outcome, method: Method, description: String, fields: FieldOutputs) -> Report {
     Report {
         outcome,
         method,

@@ -3,7 +3,7 @@
 //! snapshot times, the trace at the sample times, and the classical string
 //! (constraint off) beside it.
 
-use crate::engine::{Observer, Outcome, Status, simulate_local};
+use crate::engine::{Method, Observer, Outcome, Status, simulate_local};
 use crate::models::continuum::scene::ContinuumScene;
 use crate::models::continuum::{FrontTracking, Homogenized, StringModel, Variant};
 use crate::runner::{Classical, Control, FieldOutputs, Profile, Report, TraceRow};
@@ -39,8 +39,8 @@ pub(crate) fn run(
     Ok(Report {
         outcome,
         method: match scene.variant {
-            Variant::Paper => "exact",
-            Variant::Homogenized => "finite_volume",
+            Variant::Paper => Method::Exact,
+            Variant::Homogenized => Method::FiniteVolume,
         },
         description: describe(scene),
         final_state: vec![

@@ -53,26 +53,10 @@ pub(crate) fn run_sampled(
                 .collect();
             let (method, description) = match scene.method {
                 Method::Auto | Method::Exact => (
-                    "exact",
+                    Method::Exact,
                     "strain formulation: closed-form flow (46) between impacts, impact times in closed form".to_string(),
                 ),
-                Method::Linear => (
-                    "linear",
-                    "strain formulation: exact linear propagator (matrix exponential), impacts located on it".into(),
-                ),
-                Method::Dopri5(tol) => (
-                    "dopri5",
-                    format!("strain formulation: Dormand-Prince 5(4), rtol {:e}, atol {:e}", tol.rtol, tol.atol),
-                ),
-                Method::Dop853(tol) => (
-                    "dop853",
-                    format!("strain formulation: DOP853 (Dormand-Prince 8(5,3)), rtol {:e}, atol {:e}", tol.rtol, tol.atol),
-                ),
-                Method::Verlet { step } => ("verlet", format!("strain formulation: Stormer-Verlet, step {step:e}")),
-                Method::Taylor(tol) => (
-                    "taylor",
-                    format!("strain formulation: Taylor's method, rtol {:e}, atol {:e}", tol.rtol, tol.atol),
-                ),
+                numerical => (numerical, format!("strain formulation: {}", numerical.describe())),
             };
             Ok(Report {
                 outcome,
@@ -105,8 +89,8 @@ pub(crate) fn run_sampled(
                 simulate_sampled(&model, mode, &x0, &options, times, &mut in_strain, observer);
             let (e, r) = model.strain(outcome.final_mode, &outcome.final_state);
             let (method, integrator) = match scene.method {
-                Method::Dop853(_) => ("dop853", "DOP853"),
-                _ => ("dopri5", "Dormand-Prince 5(4)"),
+                Method::Dop853(t) => (Method::Dop853(t), "DOP853"),
+                _ => (Method::Dopri5(scene.tolerances), "Dormand-Prince 5(4)"),
             };
             let description = match charts {
                 Charts::Switch => format!(
