@@ -7,7 +7,6 @@
 //! is the integrator's rule ([`motion`](crate::engine::integrator::motion)).
 
 use crate::engine::adaptive::Tolerances;
-use crate::engine::integrator::runs;
 use crate::engine::model::{Flow, HybridModel};
 use crate::engine::taylor_method;
 
@@ -170,14 +169,13 @@ pub fn cheapest<M: HybridModel + ?Sized>(
     taylor: Tolerances,
 ) -> (Method, &'static str) {
     let all = |ok: &dyn Fn(usize) -> bool| (0..modes).all(ok);
-    let modes_list: Vec<usize> = (0..modes).collect();
     if all(&|m| matches!(model.flow(m), Flow::Frozen | Flow::Exact)) {
         (Method::Exact, "every mode has a closed form")
     } else if !all(&|m| model.flow(m) != Flow::Exact) {
         (Method::Auto, "some modes have a closed form")
     } else if all(&|m| model.flow(m) == Flow::Frozen || model.is_linear(m)) {
         (Method::Linear, "every mode's flow is affine")
-    } else if runs(model, &modes_list, Method::Taylor(taylor)).is_ok() {
+    } else if all(&|m| model.flow(m) == Flow::Frozen || model.has_series(m)) {
         (Method::Taylor(taylor), "a mode's flow is not affine")
     } else {
         (
