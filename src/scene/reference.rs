@@ -1,8 +1,27 @@
-//! The exact answer a scene offers to measure runs against (`flicker
-//! compare`, `flicker stress`).
+//! The exact answer a scene offers to measure runs against, and the one
+//! measurement of a run against it (`flicker compare`, `flicker stress`).
 
 use std::fmt;
 use std::sync::Arc;
+
+use crate::engine::{EventTimes, Status, zeno};
+use crate::runner::{Control, Report};
+use crate::scene::{Scene, SceneError};
+
+/// A run measured against a [`Reference`] ([`Reference::measure`]).
+#[derive(Debug, Clone)]
+pub struct Against {
+    /// The run.
+    pub report: Report,
+    /// Its event times, Zeno settlings left out.
+    pub times: Vec<f64>,
+    /// The largest error of its final state, component by component.
+    pub final_error: f64,
+    /// The largest error of its event times, over the events both have (a
+    /// run that stopped at a Zeno point without its last, unresolvable
+    /// ones); `None` if either has none.
+    pub time_error: Option<f64>,
+}
 
 /// The final state and event times of the exact solution, as a scene's
 /// model gives them ([`SceneModel::reference`]).
@@ -56,6 +75,28 @@ impl Reference {
     /// The time of event number `k` (from 0).
     pub fn event_time(&self, k: u64) -> f64 {
         (self.event_time)(k)
+    }
+
+    /// Run `scene` under `control` and measure it against this reference.
+    pub fn measure(&self, scene: &Scene, control: &Control) -> Result<Against, SceneError> {
+        let mut times = EventTimes::default();
+        let report = scene.run(control, &mut times)?;
+        let final_error = report
+            .final_state
+            .iter()
+            .zip(&self.final_state)
+            .map(|((_, a), b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        let time_error = self.largest_time_error(match report.outcome.status {
+            Status::Zeno => zeno::resolved(&times.0),
+            _ => &times.0,
+        });
+        Ok(Against {
+            report,
+            times: times.0,
+            final_error,
+            time_error,
+        })
     }
 
     /// The largest difference between `times` and the reference's event

@@ -12,7 +12,7 @@ use std::time::Instant;
 
 pub mod closed_forms;
 
-use crate::engine::{EventTimes, Status, zeno};
+use crate::engine::Status;
 use crate::runner::Control;
 use crate::scene::solver::SolverSpec;
 use crate::scene::{Registry, Scene, SceneError};
@@ -189,31 +189,22 @@ pub fn run_case(
     let mut scene = scene.clone();
     scene.set_solver(setting.clone())?;
     let reference = closed_forms::reference(case, &scene).unwrap_or_else(|| scene.reference())?;
-    let mut times = EventTimes::default();
     let control = Control {
         stop: None,
         max_wall_seconds: Some(wall_seconds),
         deadline: None,
     };
     let start = Instant::now();
-    let report = scene.run(&control, &mut times)?;
+    let run = reference.measure(&scene, &control)?;
     let wall = start.elapsed().as_secs_f64();
-    let o = &report.outcome;
+    let (report, o) = (&run.report, &run.report.outcome);
     let measured = Measured {
         status: o.status,
         reason: o.reason.clone(),
-        events: times.0.len() as u64,
+        events: run.times.len() as u64,
         reference_events: reference.events,
-        final_error: report
-            .final_state
-            .iter()
-            .zip(&reference.final_state)
-            .map(|((_, a), b)| (a - b).abs())
-            .fold(0.0, f64::max),
-        time_error: reference.largest_time_error(match o.status {
-            Status::Zeno => zeno::resolved(&times.0),
-            _ => &times.0,
-        }),
+        final_error: run.final_error,
+        time_error: run.time_error,
         // A reference that is itself a run is off by its own bound too.
         error_bound: o.error_bound + reference.error_bound,
         event_time_bound: o.event_time_bound.map(|b| b + reference.event_time_bound),

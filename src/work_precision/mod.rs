@@ -13,7 +13,7 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 
 use crate::engine::method::NAMES;
-use crate::engine::{EventTimes, Status, zeno};
+use crate::engine::{EachEvent, Status};
 use crate::runner;
 use crate::scene::Reference;
 use crate::scene::solver::SolverSpec;
@@ -195,37 +195,30 @@ fn measure(
     reference: &Reference,
     control: &runner::Control,
 ) -> Result<Row, SceneError> {
-    let mut times = EventTimes::default();
     let start = Instant::now();
-    let report = scene.run(control, &mut times)?;
+    let run = reference.measure(scene, control)?;
     let mut walls = vec![start.elapsed().as_secs_f64()];
     while !control.stopped()
         && (walls.len() < 3 || (walls.iter().sum::<f64>() < 0.05 && walls.len() < 1000))
     {
         let start = Instant::now();
-        scene.run(control, &mut ())?;
+        // Every event fired, as in the measured run: a run that looks at
+        // none would jump over a periodic orbit's periods.
+        scene.run(control, &mut EachEvent)?;
         walls.push(start.elapsed().as_secs_f64());
     }
     walls.sort_by(f64::total_cmp);
+    let (report, times) = (&run.report, &run.times);
     let o = &report.outcome;
-    let final_state: Vec<f64> = report.final_state.iter().map(|(_, x)| *x).collect();
-    let final_error = final_state
-        .iter()
-        .zip(&reference.final_state)
-        .map(|(a, b)| (a - b).abs())
-        .fold(0.0, f64::max);
-    let max_event_time_error = reference.largest_time_error(match o.status {
-        Status::Zeno => zeno::resolved(&times.0),
-        _ => &times.0,
-    });
+    let (final_error, max_event_time_error) = (run.final_error, run.time_error);
     let status = match (o.status, &o.reason) {
         (Status::Failed, Some(reason)) => format!("failed: {reason}"),
         // The run stopped at the accumulation it could no longer resolve;
         // the exact answer counts on without end.
         (Status::Zeno, _) if reference.events == u64::MAX => "zeno".into(),
-        _ if times.0.len() as u64 != reference.events => format!(
+        _ if times.len() as u64 != reference.events => format!(
             "events differ: {} against {} in the reference",
-            times.0.len(),
+            times.len(),
             reference.events
         ),
         (status, _) => status.as_str().to_string(),
