@@ -276,6 +276,7 @@ def orbit(
     events: int = 1,
     settle: float = 0.0,
     forcing_period: Optional[float] = None,
+    wall: float = 600.0,
 ) -> Dict[str, Any]:
     """`flicker orbit`: a periodic orbit through the Poincare section of the
     events of transition `section` (`events` of them per period), by
@@ -284,12 +285,19 @@ def orbit(
     `forcing_period`. Returns what `orbit.json` holds: `status`,
     `converged`, `period`, `section_state`, `multipliers` (`[re, im]`, the
     trivial 1 first), `stable`, `residual` (recomputed by a plain run),
-    `iterations`. A search that does not converge returns, saying why in
-    `status`."""
+    `iterations`. A search that does not converge, or is still running
+    after `wall` seconds (the whole search, transient included), returns,
+    saying why in `status`."""
     text, path = _source(scene)
     return json.loads(
         _flicker.orbit(
-            text, path, section=section, events=events, settle=float(settle), forcing_period=forcing_period
+            text,
+            path,
+            section=section,
+            events=events,
+            settle=float(settle),
+            forcing_period=forcing_period,
+            wall=float(wall),
         )
     )
 
@@ -338,6 +346,7 @@ def continuation(
     forcing_period: Optional[float] = None,
     points: int = 200,
     max_step: float = 0.05,
+    wall: float = 600.0,
 ) -> Dict[str, Any]:
     """`flicker continue`: the orbit `orbit` finds, followed in parameter
     `param` to `to` by pseudo-arclength continuation (at most `points`
@@ -345,7 +354,7 @@ def continuation(
     columns: `parameter`, `period`, each state at the section (float64
     arrays), `largest_multiplier`, `stable` and `label` (`fold`, `period
     doubling`, `torus`, `grazing`, `end` or empty), and `ended`, why the
-    branch ended."""
+    branch ended (past `wall` seconds of wall time among the reasons)."""
     text, path = _source(scene)
     return _flicker.continuation(
         text,
@@ -358,4 +367,5 @@ def continuation(
         forcing_period=forcing_period,
         points=points,
         max_step=float(max_step),
+        wall=float(wall),
     )

@@ -201,27 +201,30 @@ fn rayon_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, String> {
         .map_err(|e| e.to_string())
 }
 
-/// The orbit request of `flicker orbit`'s flags.
+/// The orbit request of `flicker orbit`'s flags, `wall` seconds of wall
+/// time for the whole search (`--wall`).
 fn request(
+    py: Python<'_>,
     section: String,
-    events: usize,
-    settle: f64,
-    forcing_period: Option<f64>,
-) -> OrbitRequest {
-    OrbitRequest {
+    (events, settle, forcing_period): (usize, f64, Option<f64>),
+    wall: f64,
+) -> PyResult<OrbitRequest> {
+    Ok(OrbitRequest {
         guard: section,
         events,
         settle,
         forcing_period,
         stop: None,
-        deadline: None,
-    }
+        deadline: flicker::runner::deadline_in(wall)
+            .map_err(|why| override_error(py, "wall", why))?,
+    })
 }
 
 /// `flicker orbit`: the JSON text of `orbit.json` for the orbit found (or
 /// why none was).
 #[pyfunction]
-#[pyo3(signature = (text=None, path=None, section=String::new(), events=1, settle=0.0, forcing_period=None))]
+#[pyo3(signature = (text=None, path=None, section=String::new(), events=1, settle=0.0, forcing_period=None, wall=600.0))]
+#[allow(clippy::too_many_arguments)]
 pub fn orbit(
     py: Python<'_>,
     text: Option<&str>,
@@ -230,9 +233,10 @@ pub fn orbit(
     events: usize,
     settle: f64,
     forcing_period: Option<f64>,
+    wall: f64,
 ) -> PyResult<String> {
     let (scene, label) = load(py, text, path)?;
-    let request = request(section.clone(), events, settle, forcing_period);
+    let request = request(py, section.clone(), (events, settle, forcing_period), wall)?;
     let started = std::time::Instant::now();
     let family = scene
         .family()
@@ -254,7 +258,7 @@ pub fn orbit(
 /// state at the section, `largest_multiplier`, `stable`, `label`), and
 /// `ended`, why it ended.
 #[pyfunction]
-#[pyo3(signature = (text=None, path=None, section=String::new(), param=String::new(), to=0.0, events=1, settle=0.0, forcing_period=None, points=200, max_step=0.05))]
+#[pyo3(signature = (text=None, path=None, section=String::new(), param=String::new(), to=0.0, events=1, settle=0.0, forcing_period=None, points=200, max_step=0.05, wall=600.0))]
 #[allow(clippy::too_many_arguments)]
 pub fn continuation<'py>(
     py: Python<'py>,
@@ -268,9 +272,10 @@ pub fn continuation<'py>(
     forcing_period: Option<f64>,
     points: usize,
     max_step: f64,
+    wall: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (scene, _) = load(py, text, path)?;
-    let request = request(section, events, settle, forcing_period);
+    let request = request(py, section, (events, settle, forcing_period), wall)?;
     let family = scene
         .family()
         .map_err(|e| override_error(py, "model", e.reason))?;

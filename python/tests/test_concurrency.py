@@ -112,3 +112,24 @@ def test_ctrl_c_stops_an_orbit_search_and_a_continuation():
     _interrupted_within_a_second(
         lambda: flicker.continuation(table, "impact", "A", 0.16, settle=1e7,
                                      forcing_period=2 * np.pi / 10))
+
+
+def test_orbit_searches_and_continuations_keep_their_wall_budget():
+    """`wall` bounds the whole search in seconds, as `--wall` does: the
+    search returns, saying why, once it is spent; a budget that is not a
+    time > 0 is refused, naming `wall`."""
+    mechanism = json.loads((MODELS / "automata/mechanism.json").read_text())
+    mechanism["t_end"] = 1e13
+    mechanism["max_events"] = 10**15
+    for call, why in (
+        (lambda wall: flicker.orbit(mechanism, "impact", settle=1e8, wall=wall),
+         lambda found: found["status"]),
+        (lambda wall: flicker.continuation(mechanism, "impact", "eta", 0.9, settle=1e8, wall=wall),
+         lambda branch: branch["ended"]),
+    ):
+        started = time.perf_counter()
+        said = why(call(0.3))
+        assert time.perf_counter() - started < 2.0
+        assert "wall-time budget" in said, said
+        with pytest.raises(Exception, match="wall"):
+            call(-1.0)
