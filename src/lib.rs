@@ -40,7 +40,8 @@
 //!     }
 //! }
 //!
-//! let outcome = simulate(&Sawtooth, 0, &[0.25], &Options::until(10.0), &mut ());
+//! let problem = Problem::new(&Sawtooth, 0, &[0.25], 10.0);
+//! let outcome = problem.solve(Method::Exact, &Limits::default(), &mut ());
 //! assert_eq!(outcome.events, 10); // at t = 0.75, 1.75, ..., 9.75
 //! assert!((outcome.final_state[0] - 0.25).abs() < 1e-12);
 //! ```

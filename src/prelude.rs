@@ -2,18 +2,20 @@
 //!
 //! - writing a model: [`HybridModel`] and what it returns ([`Flow`],
 //!   [`Guard`], [`Direction`], [`Jump`], [`Mode`]);
-//! - running it: [`simulate`] (or [`simulate_sampled`]) under [`Options`]
-//!   with a [`Method`] and [`Tolerances`], giving an [`Outcome`] whose
-//!   [`Status`] says how it ended; events to an [`Observer`] (a
-//!   [`Recorder`] keeps them, each an [`EventRecord`]);
+//! - running it: a [`Problem`] (the model, its start, its end) solved by
+//!   a [`Method`] (with its [`Tolerances`]) under [`Limits`], or
+//!   [`simulate`] (and [`simulate_sampled`]) under [`Options`], which hold
+//!   all three; either gives an [`Outcome`] whose [`Status`] says how it
+//!   ended; events to an [`Observer`] (a [`Recorder`] keeps them, each an
+//!   [`EventRecord`]);
 //! - scenes: [`Registry`] (the crate's own kinds:
 //!   [`Registry::builtin`]), [`Scene`], run under a [`Control`] as a
 //!   [`RunRequest`] asks;
 //! - tools on any model: its [`Family`].
 
 pub use crate::engine::{
-    Direction, EventRecord, Family, Flow, Guard, HybridModel, Jump, Method, Mode, Observer,
-    Options, Outcome, Recorder, Status, Tolerances, simulate, simulate_sampled,
+    Direction, EventRecord, Family, Flow, Guard, HybridModel, Jump, Limits, Method, Mode, Observer,
+    Options, Outcome, Problem, Recorder, Status, Tolerances, simulate, simulate_sampled,
 };
 pub use crate::runner::Control;
 pub use crate::scene::{Registry, Scene};
