@@ -15,10 +15,12 @@
 //! - Events closer than the run can resolve are the Zeno watch's to judge,
 //!   not the bound's.
 //! - Exact flows add no error: their bound is a round-off allowance of
-//!   [`ROUNDOFF_ULPS`] ulps of the state's size per event (an estimate of
-//!   how round-off grows, not a bound), and of each event's time, where a
-//!   slow crossing turns the state's rounding into a larger time error (its
-//!   size over the closing speed); an exact run pays for nothing else.
+//!   [`ROUNDOFF_ULPS`] ulps per event of the state's size, or of the
+//!   model's rounding scale where larger (a closed form about a centre;
+//!   an estimate of how round-off grows, not a bound), and of each event's
+//!   time, where a slow crossing turns the state's rounding into a larger
+//!   time error (its size over the closing speed); an exact run pays for
+//!   nothing else.
 
 use crate::engine::error_set::{ErrorSet, TRACKED};
 use crate::engine::model::{HybridModel, Mode};
@@ -62,8 +64,10 @@ pub(crate) struct Bound {
 
 impl Bound {
     /// No error yet, for a run of dimension `n` from `x0`, whose component
-    /// `clock` (if any) is the run's time, which carries no error.
-    pub fn new(n: usize, x0: &[f64], clock: Option<usize>) -> Self {
+    /// `clock` (if any) is the run's time, which carries no error, and
+    /// whose flows round to ulps of `rounding` at least
+    /// ([`HybridModel::exact_flow_scale`]).
+    pub fn new(n: usize, x0: &[f64], clock: Option<usize>, rounding: f64) -> Self {
         Bound {
             errors: ErrorSet::new(n).with_exact(clock),
             tangents: Tangents::new(n),
@@ -78,7 +82,7 @@ impl Bound {
                 .iter()
                 .enumerate()
                 .filter(|(i, _)| Some(*i) != clock)
-                .fold(0.0, |m: f64, (_, v)| m.max(v.abs())),
+                .fold(rounding.abs(), |m: f64, (_, v)| m.max(v.abs())),
             clock,
             rate: vec![0.0; n],
             crossing_rounding: 0.0,

@@ -306,6 +306,16 @@ pub trait HybridModel {
         true
     }
 
+    /// The size of the numbers the model's exact flows
+    /// ([`advance`](HybridModel::advance)) compute with, where it exceeds
+    /// the state's own (0 otherwise): a closed form about a centre rounds
+    /// to ulps of the centre, however small the state. The round-off
+    /// allowance of a run by the closed forms is scaled by the larger of
+    /// the two ([`bound`](crate::engine::bound)).
+    fn exact_flow_scale(&self) -> f64 {
+        0.0
+    }
+
     /// The scale that relative energy errors are measured against, given
     /// the initial energy.
     fn energy_scale(&self, initial_energy: f64) -> f64 {

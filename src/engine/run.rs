@@ -113,7 +113,7 @@ pub struct Outcome {
     /// The largest error any state component may carry at the end: the
     /// numerical steps' local errors carried through the flow and across
     /// every event (see [`bound`](crate::engine::bound)), plus a round-off allowance of
-    /// [`ROUNDOFF_ULPS`](crate::engine::bound::ROUNDOFF_ULPS) ulps of the state's size per event. Above
+    /// [`ROUNDOFF_ULPS`](crate::engine::bound::ROUNDOFF_ULPS) ulps of the state's size (or the model's rounding scale) per event. Above
     /// [`TRACKED`](crate::engine::error_set::TRACKED) state components,
     /// the plain sum of the local errors instead.
     pub error_bound: f64,

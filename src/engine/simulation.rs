@@ -21,6 +21,7 @@ use crate::engine::integrator::{Crossing, Integrator, Motion, motion};
 use crate::engine::labels::Labels;
 use crate::engine::ledger::{Final, Ledger};
 use crate::engine::locate::{Start, scan_step};
+use crate::engine::method::Method;
 use crate::engine::model::{Affects, Direction, HybridModel, Mode};
 use crate::engine::observer::{EventRecord, Observer, SETTLE};
 use crate::engine::periodic::Returns;
@@ -455,7 +456,16 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
             motion: Motion::Frozen,
             motions: Vec::new(),
             exact_evaluations: 0,
-            bound: Bound::new(n, x0, model.clock()),
+            bound: Bound::new(
+                n,
+                x0,
+                model.clock(),
+                // Only the closed forms round about their own scale.
+                match options.method {
+                    Method::Auto | Method::Exact => model.exact_flow_scale(),
+                    _ => 0.0,
+                },
+            ),
             stepped: false,
             step_end: None,
             starts: Vec::new(),
