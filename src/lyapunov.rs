@@ -19,7 +19,7 @@ use std::time::Instant;
 use nalgebra::DMatrix;
 use serde_json::{Value, json};
 
-use crate::engine::method::tightest;
+use crate::engine::method::{Method, tightest};
 use crate::engine::variational::Variational;
 use crate::engine::{Family, Options, Status, simulate};
 
@@ -62,7 +62,7 @@ pub struct Spectrum {
     /// evenly spread): `(t, exponents)`.
     pub history: Vec<(f64, Vec<f64>)>,
     /// The method the tangents were carried by.
-    pub method: &'static str,
+    pub method: Method,
     /// `completed`, or why the spectrum stopped short.
     pub status: String,
 }
@@ -85,7 +85,7 @@ impl Spectrum {
             "events": self.events,
             "transient": request.transient,
             "interval": request.interval,
-            "method": self.method,
+            "method": self.method.name(),
             "history": history,
         })
     }
@@ -156,7 +156,7 @@ pub fn spectrum(
         t_span: 0.0,
         events: 0,
         history: Vec::new(),
-        method: method.name(),
+        method,
         status: "completed".into(),
     };
     let (mut mode, mut x) = family.start();
