@@ -80,11 +80,14 @@ def _endless_mechanism():
     return scene
 
 
-def test_an_endless_periodic_orbit_without_events_is_jumped_over():
-    run = flicker.run(_endless_mechanism(), events=False)
+def test_a_periodic_orbit_run_without_events_is_jumped_over():
+    # 2.3e7 impacts: seconds fired one by one, microseconds jumped.
+    scene = _endless_mechanism()
+    scene["t_end"] = 1e8
+    run = flicker.run(scene, events=False)
     assert run.status == "completed", run.summary
     jumped = run.summary["fast_forward"]
-    assert jumped["periods"] + 5 >= run.summary["events"] > 2e11
+    assert jumped["periods"] + 5 >= run.summary["events"] > 2e7
     assert run.summary["wall_seconds"] < 1.0
 
 

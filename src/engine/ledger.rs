@@ -233,10 +233,7 @@ impl<'o> Ledger<'o> {
         }
         match named {
             Some(name) => *self.named.entry(name).or_insert(0) += periods,
-            None => {
-                self.count(mode, slot);
-                self.counts[mode][slot] += periods - 1;
-            }
+            None => self.count_many(mode, slot, periods),
         }
         let jump = self.fast_forward.get_or_insert(FastForward {
             periods: 0,
@@ -251,6 +248,12 @@ impl<'o> Ledger<'o> {
     /// Count a non-internal event of guard `slot` in `mode`.
     #[inline]
     pub fn count(&mut self, mode: Mode, slot: usize) {
+        self.count_many(mode, slot, 1);
+    }
+
+    /// Count `n` non-internal events of guard `slot` in `mode`.
+    #[inline]
+    fn count_many(&mut self, mode: Mode, slot: usize, n: u64) {
         if self.counts.len() <= mode {
             self.counts.resize(mode + 1, Vec::new());
         }
@@ -258,7 +261,7 @@ impl<'o> Ledger<'o> {
         if counts.len() <= slot {
             counts.resize(slot + 1, 0);
         }
-        counts[slot] += 1;
+        counts[slot] += n;
     }
 
     /// Log `event` (its `seq` is the ledger's to number), auditing the

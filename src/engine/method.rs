@@ -192,15 +192,15 @@ pub fn cheapest<M: HybridModel + ?Sized>(
 /// at `tolerance` otherwise. What orbits, sensitivities and Lyapunov
 /// spectra run by.
 pub fn tightest<M: HybridModel + ?Sized>(model: &M, modes: usize, tolerance: f64) -> Method {
-    if (0..modes).all(|m| matches!(model.flow(m), Flow::Frozen | Flow::Exact)) {
-        Method::Auto
-    } else if (0..modes).all(|m| model.flow(m) == Flow::Frozen || model.is_linear(m)) {
-        Method::Linear
-    } else {
-        Method::Dop853(Tolerances {
-            rtol: tolerance,
-            atol: tolerance,
-        })
+    let tolerances = Tolerances {
+        rtol: tolerance,
+        atol: tolerance,
+    };
+    match cheapest(model, modes, tolerances, tolerances).0 {
+        // Every mode exact: its closed forms, under the engine's own name.
+        Method::Exact => Method::Auto,
+        Method::Linear => Method::Linear,
+        _ => Method::Dop853(tolerances),
     }
 }
 

@@ -31,51 +31,39 @@ pub const RETURN_ULPS: f64 = 8.0;
 const MARGIN_PERIODS: f64 = 2.0;
 
 /// The state after the last event, to tell whether the next one returns
-/// to it.
+/// to it. Its buffer is kept across [`Returns::forget`]: no allocation per
+/// event.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Returns {
-    last: Option<Visit>,
-    /// Whether the last event returned to the one before it.
-    returned: bool,
-}
-
-#[derive(Debug, Clone)]
-struct Visit {
+    /// Whether the fields below describe the last event.
+    known: bool,
     mode: Mode,
     slot: usize,
     t: Time,
     state: Vec<f64>,
+    /// Whether the last event returned to the one before it.
+    returned: bool,
 }
 
 impl Returns {
     /// Forget the last event: what follows is not a repeat of it (a step
     /// of a numerical method, a settling, a flow that is not exact).
     pub fn forget(&mut self) {
-        self.last = None;
+        self.known = false;
         self.returned = false;
     }
 
     /// Guard `slot` of `mode` fired at `t` and left the run in `mode` at
     /// `state`: note whether that is where the previous event left it.
     pub fn visit(&mut self, mode: Mode, slot: usize, t: Time, state: &[f64]) {
-        self.returned = self.last.as_ref().is_some_and(|last| {
-            last.mode == mode && last.slot == slot && last.t < t && same(&last.state, state)
-        });
-        match &mut self.last {
-            Some(last) => {
-                (last.mode, last.slot, last.t) = (mode, slot, t);
-                last.state.clear();
-                last.state.extend_from_slice(state);
-            }
-            None => {
-                self.last = Some(Visit {
-                    mode,
-                    slot,
-                    t,
-                    state: state.to_vec(),
-                })
-            }
-        }
+        self.returned = self.known
+            && self.mode == mode
+            && self.slot == slot
+            && self.t < t
+            && same(&self.state, state);
+        (self.known, self.mode, self.slot, self.t) = (true, mode, slot, t);
+        self.state.clear();
+        self.state.extend_from_slice(state);
     }
 
     /// Whether the last event returned the state to where the event

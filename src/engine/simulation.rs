@@ -336,8 +336,10 @@ impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
         };
         predicted?;
         // An exact, autonomous flow with nothing to carry repeats from a
-        // repeated state (see `periodic`).
-        if !guard.internal
+        // repeated state (see `periodic`); only a run whose observer looks
+        // at no event may jump, so only such a run keeps the state.
+        if !observer.wants_details()
+            && !guard.internal
             && jump.mode == mode
             && self.motion == Motion::Exact
             && self.clock.is_none()

@@ -114,11 +114,15 @@ fn samples_are_taken_on_the_arc_between_jumps() {
     let t_end = 100.0;
     let times = [1e-3, 12.5, 50.0, 99.99];
     let mut samples = Vec::new();
+    // Firing each impact would take 40 s: the budget holds the test to
+    // the jumps.
+    let mut options = Options::until(t_end);
+    options.max_wall_seconds = Some(5.0);
     let outcome = simulate_sampled(
         &model(CHATTER),
         FLIGHT,
         &[CHATTER_START.0, CHATTER_START.1],
-        &Options::until(t_end),
+        &options,
         &times,
         &mut |s| samples.push((s.t, s.state.to_vec(), s.events, s.bound)),
         &mut (),
@@ -154,10 +158,10 @@ fn the_event_budget_stops_a_jumping_run_at_the_same_event() {
     // A budget the projection (which counts the fraction of a period to
     // the end too) finds enough lets it finish.
     options.max_events = CHATTER.impacts_until(CHATTER_START, 100.0) + 1;
-    assert_eq!(
-        run_quietly(CHATTER, CHATTER_START, &options).status,
-        Status::Completed
-    );
+    options.max_wall_seconds = Some(5.0);
+    let outcome = run_quietly(CHATTER, CHATTER_START, &options);
+    assert_eq!(outcome.status, Status::Completed, "{:?}", outcome.reason);
+    assert!(outcome.fast_forward.is_some());
     // The budget is projected every 2^20 events, jumped or fired: a run
     // that would need far more says so there.
     options.max_events = 10_000_000;
