@@ -3,50 +3,53 @@
 //! With the augmented matrix `M = [[A, b], [0, 0]]`, the flow from `y` is
 //! `exp(M tau) y = sum_k M^k y tau^k / k!`. Steps are bounded so that
 //! `|M| h <= 1`; over a step the series is then summed to round-off by its
-//! first [`ORDER`] + 1 terms (the rest is below `1 / 25!` of the state), so
-//! each step computes them once, `ORDER` matrix-vector products, and the
-//! state anywhere in the step is that polynomial summed by compensated
-//! Horner: exact to a few ulps, with no matrix exponential.
+//! first [`ORDER`] + 1 terms (the rest is below `1 / 25!` of the state).
 //!
-//! Events are found on the same polynomials: where the model gives its
-//! guards' Taylor series along a flow's ([`HybridModel::guard_series`]), by
+//! A small mode is solved once ([`AffineMode`]): a whole step is one
+//! product with its propagator `exp(M h)`, and an affine guard's series
+//! along the step are products of its cached rows with the state. The
+//! state's own series (`ORDER` matrix-vector products) is summed only where
+//! the run asks for a state inside the step (an event, the error bound) or
+//! for a step cut short, by compensated Horner: exact to a few ulps, with
+//! no matrix exponential.
+//!
+//! Events are found on the guards' polynomials: where the model gives its
+//! guards' Taylor series along a flow ([`HybridModel::guard_series`]), by
 //! the certified root search Taylor's method uses (no root in the step
 //! missed); elsewhere (a chain's ODE) by the engine's scan of the state
 //! along the step ([`locate`](crate::engine::locate)), each bracket refined
 //! on the propagator itself.
 
-use std::cell::Cell;
+use std::cell::{Cell, RefCell};
 
 use nalgebra::{DMatrix, DVector};
 
 use crate::engine::adaptive::StepFailure;
+pub use crate::engine::affine_mode::ORDER;
+use crate::engine::affine_mode::{AffineMode, state_series};
 use crate::engine::locate::{Start, StepScan};
 use crate::engine::model::{HybridModel, Mode};
+use crate::numerics::double_double::dot;
 use crate::numerics::polynomial::eval_compensated;
 
-/// The degree of a step's series: with `|M| h <= 1`, the first term left
-/// out is below `1 / 25!` (7e-26) of the state.
-pub const ORDER: usize = 24;
-
-/// The exact propagator's working state: the augmented matrix of the
-/// current mode, and the current step's series.
+/// The exact propagator's working state: each mode met so far solved once,
+/// and the current step.
 #[derive(Debug, Clone)]
 pub struct Linear {
-    /// The mode whose `M` is cached.
-    mode: Option<Mode>,
-    augmented: DMatrix<f64>,
-    /// The same, row by row, for the series' products.
-    rows: Vec<f64>,
-    h_bound: f64,
+    /// Per mode index, once met.
+    modes: Vec<Option<AffineMode>>,
+    /// The mode of the current step.
+    mode: Mode,
     h: f64,
-    y0: DVector<f64>,
-    /// The step's series, component by component: `series[i * (ORDER + 1)
-    /// + k]` is `(M^k y0)_i / k!`, the layout of
-    /// [`HybridModel::flow_series`].
-    series: Vec<f64>,
-    /// Scratch: one term of the augmented series and the next.
-    term: Vec<f64>,
-    next: Vec<f64>,
+    /// `[x0, 1]` of the current step.
+    y0: Vec<f64>,
+    /// The step's state series, summed on first need.
+    series: RefCell<Vec<f64>>,
+    /// Whether `series` is the current step's.
+    series_ready: Cell<bool>,
+    /// Scratch for the series: one term of the augmented series and the
+    /// next.
+    terms: RefCell<(Vec<f64>, Vec<f64>)>,
     /// Each guard's series along the step, one after another (where the
     /// model gives them).
     guards: Vec<f64>,
@@ -57,27 +60,17 @@ pub struct Linear {
     evaluations: Cell<u64>,
 }
 
-/// `out = a v` for a square matrix `a` laid out row by row.
-fn mat_vec(a: &[f64], v: &[f64], out: &mut [f64]) {
-    let m = v.len();
-    for (o, row) in out[..m].iter_mut().zip(a.chunks_exact(m)) {
-        *o = row.iter().zip(v).map(|(x, y)| x * y).sum();
-    }
-}
-
 impl Linear {
     /// A propagator for states of `dimension` components.
     pub fn new(dimension: usize) -> Self {
         Linear {
-            mode: None,
-            augmented: DMatrix::zeros(dimension + 1, dimension + 1),
-            rows: vec![0.0; (dimension + 1) * (dimension + 1)],
-            h_bound: f64::INFINITY,
+            modes: Vec::new(),
+            mode: 0,
             h: 0.0,
-            y0: DVector::zeros(dimension + 1),
-            series: vec![0.0; dimension * (ORDER + 1)],
-            term: vec![0.0; dimension + 1],
-            next: vec![0.0; dimension + 1],
+            y0: vec![0.0; dimension + 1],
+            series: RefCell::new(vec![0.0; dimension * (ORDER + 1)]),
+            series_ready: Cell::new(false),
+            terms: RefCell::new((vec![0.0; dimension + 1], vec![0.0; dimension + 1])),
             guards: Vec::new(),
             guard: vec![0.0; ORDER + 1],
             y1: vec![0.0; dimension],
@@ -93,6 +86,22 @@ impl Linear {
         self.h
     }
 
+    /// `mode` solved once, on first meeting it.
+    fn solved<M: HybridModel + ?Sized>(
+        &mut self,
+        model: &M,
+        mode: Mode,
+    ) -> Result<&AffineMode, StepFailure> {
+        if self.modes.len() <= mode {
+            self.modes.resize(mode + 1, None);
+        }
+        if self.modes[mode].is_none() {
+            let n = self.y1.len();
+            self.modes[mode] = Some(AffineMode::new(model, mode, n)?);
+        }
+        Ok(self.modes[mode].as_ref().expect("solved above"))
+    }
+
     /// One step from `y0` in `mode`, as long as `h_max` and the bound
     /// `|M| h <= 1` allow; fails if the mode's flow is not linear or the
     /// state stops being finite.
@@ -105,55 +114,12 @@ impl Linear {
         h_min: f64,
     ) -> Result<(), StepFailure> {
         let n = y0.len();
-        if self.mode != Some(mode) {
-            let Some((a, b)) = model.linear(mode) else {
-                return Err(StepFailure::NotApplicable(format!(
-                    "mode `{}` is not a linear flow x' = A x + b",
-                    model.mode_name(mode)
-                )));
-            };
-            self.augmented.fill(0.0);
-            self.augmented.view_mut((0, 0), (n, n)).copy_from(&a);
-            self.augmented.view_mut((0, n), (n, 1)).copy_from(&b);
-            if !self.augmented.iter().all(|x| x.is_finite()) {
-                return Err(StepFailure::NonFinite);
-            }
-            let norm = self
-                .augmented
-                .column_iter()
-                .map(|c| c.lp_norm(1))
-                .fold(0.0, f64::max);
-            self.h_bound = if norm > 0.0 {
-                1.0 / norm
-            } else {
-                f64::INFINITY
-            };
-            let m = n + 1;
-            for i in 0..m {
-                for j in 0..m {
-                    self.rows[i * m + j] = self.augmented[(i, j)];
-                }
-            }
-            self.mode = Some(mode);
-        }
-        self.y0.rows_mut(0, n).copy_from_slice(y0);
+        let h_bound = self.solved(model, mode)?.h_bound;
+        self.mode = mode;
+        self.y0[..n].copy_from_slice(y0);
         self.y0[n] = 1.0;
-        self.h = self.h_bound.min(h_max);
-        // The series: term k is M^k y0 / k!.
-        let w = ORDER + 1;
-        self.term.copy_from_slice(self.y0.as_slice());
-        for k in 0..w {
-            for i in 0..n {
-                self.series[i * w + k] = self.term[i];
-            }
-            if k < ORDER {
-                mat_vec(&self.rows, &self.term, &mut self.next);
-                let scale = 1.0 / (k + 1) as f64;
-                for (t, v) in self.term.iter_mut().zip(&self.next) {
-                    *t = v * scale;
-                }
-            }
-        }
+        self.h = h_bound.min(h_max);
+        self.series_ready.set(false);
         self.evaluations.set(self.evaluations.get() + 1);
         if model.has_series(mode) {
             let shortened_by = self.fit_guards(model, mode);
@@ -165,12 +131,45 @@ impl Linear {
             }
         }
         let mut y1 = std::mem::take(&mut self.y1);
-        self.eval(self.h, &mut y1);
+        let whole = self.h == h_bound;
+        match self.modes[mode]
+            .as_mut()
+            .filter(|_| whole)
+            .and_then(AffineMode::whole_step)
+        {
+            Some(p) => {
+                // y1 = the first n rows of exp(M h) y0, each rounded once.
+                for (o, row) in y1.iter_mut().zip(p.chunks_exact(n + 1)) {
+                    *o = dot(row, &self.y0);
+                }
+            }
+            None => self.eval(self.h, &mut y1),
+        }
         self.y1 = y1;
         if self.y1.iter().any(|x| !x.is_finite()) {
             return Err(StepFailure::NonFinite);
         }
         Ok(())
+    }
+
+    /// The step's state series, summed now if the step has not yet needed
+    /// it.
+    fn ensure_series(&self) {
+        if self.series_ready.get() {
+            return;
+        }
+        let solved = self.modes[self.mode]
+            .as_ref()
+            .expect("a step solved its mode");
+        let (term, next) = &mut *self.terms.borrow_mut();
+        state_series(
+            &solved.rows,
+            &self.y0,
+            &mut self.series.borrow_mut(),
+            term,
+            next,
+        );
+        self.series_ready.set(true);
     }
 
     /// Each guard's series along the step (kept for [`Linear::locate`]),
@@ -181,6 +180,7 @@ impl Linear {
     /// to blame where the step collapses (`sqrt(x)` near `x = 0`).
     fn fit_guards<M: HybridModel + ?Sized>(&mut self, model: &M, mode: Mode) -> Option<usize> {
         let w = ORDER + 1;
+        let m = self.y0.len();
         let guards = model.guards(mode).len();
         self.guards.resize(guards * w, 0.0);
         // Measured as the state's own series are: against the state's size
@@ -188,9 +188,23 @@ impl Linear {
         // excuse any step).
         let scale = self.y0.iter().fold(1.0_f64, |m, v| m.max(v.abs()));
         let mut shortened_by = None;
+        let mut series = std::mem::take(&mut self.guards);
         for g in 0..guards {
-            let c = &mut self.guards[g * w..(g + 1) * w];
-            model.guard_series(mode, g, &self.series, ORDER, c);
+            let c = &mut series[g * w..(g + 1) * w];
+            let rows = self.modes[mode]
+                .as_ref()
+                .and_then(|s| s.guard_rows[g].as_ref());
+            match rows {
+                Some(rows) => {
+                    for (ck, row) in c.iter_mut().zip(rows.chunks_exact(m)) {
+                        *ck = row.iter().zip(&self.y0).map(|(a, b)| a * b).sum();
+                    }
+                }
+                None => {
+                    self.ensure_series();
+                    model.guard_series(mode, g, &self.series.borrow(), ORDER, c);
+                }
+            }
             // The last two terms at the step's length far below round-off
             // (1e-20 of the state's size: as far as the state's own, whose
             // last term is at most 1 / 24! of it).
@@ -203,6 +217,7 @@ impl Linear {
                 shortened_by = Some(g);
             }
         }
+        self.guards = series;
         shortened_by
     }
 
@@ -210,13 +225,20 @@ impl Linear {
     /// inside it, an exponential of its own beyond.
     pub fn eval(&self, tau: f64, x: &mut [f64]) {
         if tau <= self.h * (1.0 + 4.0 * f64::EPSILON) {
-            for (xi, c) in x.iter_mut().zip(self.series.chunks_exact(ORDER + 1)) {
+            self.ensure_series();
+            let series = self.series.borrow();
+            for (xi, c) in x.iter_mut().zip(series.chunks_exact(ORDER + 1)) {
                 *xi = eval_compensated(c, tau);
             }
             return;
         }
-        let propagator = (&self.augmented * tau).exp();
-        let y = propagator * &self.y0;
+        let m = self.y0.len();
+        let rows = &self.modes[self.mode]
+            .as_ref()
+            .expect("a step solved its mode")
+            .rows;
+        let propagator = (DMatrix::from_row_slice(m, m, rows) * tau).exp();
+        let y = propagator * DVector::from_column_slice(&self.y0);
         x.copy_from_slice(&y.as_slice()[..x.len()]);
         self.evaluations.set(self.evaluations.get() + 1);
     }
@@ -249,7 +271,7 @@ impl Linear {
         ))
     }
 
-    /// Propagator evaluations so far: the series and exponentials taken.
+    /// Propagator evaluations so far: the steps and exponentials taken.
     pub fn evaluations(&self) -> u64 {
         self.evaluations.get()
     }

@@ -188,3 +188,44 @@ fn no_crossing_is_missed_or_misplaced_without_a_word() {
         "only {completed} of {runs} runs completed"
     );
 }
+
+/// The linear propagator finds an affine guard's crossings on rows cached
+/// once per mode (`src/engine/affine_mode.rs`), not on the state's series:
+/// a guard that mixes the states and has a constant, `x - v / 2 - 0.3`
+/// on `x = cos t`, `v = -sin t`, i.e. `R cos(t - phi) - 0.3` with `R =
+/// sqrt(5) / 2` and `tan(phi) = 1 / 2`, must fire at exactly its closed
+/// form's crossings, both ways, each within the stated bound. A row built
+/// from the wrong component, a lost constant or a wrong power of `M` moves
+/// every crossing by far more than the bound.
+#[test]
+fn a_mixed_affine_guard_fires_at_its_closed_form_under_the_linear_propagator() {
+    use flicker::models::automaton::{AutomatonBuilder, TransitionBuilder};
+    let model = AutomatonBuilder::new()
+        .state("x", 1.0)
+        .state("v", 0.0)
+        .mode(
+            "free",
+            [("x", "v"), ("v", "-x")],
+            [TransitionBuilder::new("mark", "x - v / 2 - 0.3")],
+        )
+        .build()
+        .expect("the model compiles");
+    let t_end = 60.0;
+    let mut options = Options::until(t_end);
+    options.method = Method::Linear;
+    let mut log = Recorder::default();
+    let outcome = simulate(&model, 0, &[1.0, 0.0], &options, &mut log);
+    assert_eq!(outcome.status, Status::Completed, "{:?}", outcome.reason);
+    let times: Vec<f64> = log.events.iter().map(|e| e.t).collect();
+    let (r, phi) = (1.25_f64.sqrt(), 0.5_f64.atan2(1.0));
+    let half = (0.3 / r).acos();
+    let tau = std::f64::consts::TAU;
+    let mut exact: Vec<f64> = (-1..12)
+        .flat_map(|k| [phi + half + k as f64 * tau, phi - half + k as f64 * tau])
+        .filter(|t| *t > 0.0 && *t <= t_end)
+        .collect();
+    exact.sort_by(f64::total_cmp);
+    assert_exact_crossings(&outcome, &times, &exact);
+    let bound = outcome.event_time_bound.expect("a stated event-time bound");
+    assert!(bound < 1e-9, "a loose bound proves little: {bound:.2e}");
+}
