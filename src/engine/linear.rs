@@ -13,6 +13,13 @@
 //! for a step cut short, by compensated Horner: exact to a few ulps, with
 //! no matrix exponential.
 //!
+//! A whole step keeps what rounding its end left out, and the next step,
+//! if it starts there, starts from the end unrounded (its guards' series,
+//! its states and its own end): an exactly periodic orbit otherwise rounds
+//! the same way at the same step of every period, and its phase drifts by
+//! a fraction of an ulp per period (the paper's mechanism as an automaton,
+//! 43,468 impacts: 8e-13 off at the end instead of 8e-14).
+//!
 //! Events are found on the guards' polynomials: where the model gives its
 //! guards' Taylor series along a flow ([`HybridModel::guard_series`]), by
 //! the certified root search Taylor's method uses (no root in the step
@@ -26,11 +33,11 @@ use nalgebra::{DMatrix, DVector};
 
 use crate::engine::adaptive::StepFailure;
 pub use crate::engine::affine_mode::ORDER;
-use crate::engine::affine_mode::{AffineMode, state_series};
+use crate::engine::affine_mode::{AffineMode, mat_vec, state_series};
 use crate::engine::locate::{Start, StepScan};
 use crate::engine::model::{HybridModel, Mode};
 use crate::numerics::double_double::dot;
-use crate::numerics::polynomial::eval_compensated;
+use crate::numerics::polynomial::eval_compensated_plus;
 
 /// The exact propagator's working state: each mode met so far solved once,
 /// and the current step.
@@ -56,6 +63,14 @@ pub struct Linear {
     /// A guard's series, scratch for its search.
     guard: Vec<f64>,
     y1: Vec<f64>,
+    /// What rounding `y1` to double left out, where a whole step gave it
+    /// (zero elsewhere).
+    carry: Vec<f64>,
+    /// The same for `y0`, where the step continues from the last one's
+    /// end; and (lazily, with the series) `M` and `M^2` times it, which
+    /// carry it along the step to well below an ulp.
+    y0_lo: Vec<f64>,
+    lo_terms: RefCell<(Vec<f64>, Vec<f64>)>,
     /// Propagator evaluations; a `Cell` because evaluation reads `&self`.
     evaluations: Cell<u64>,
 }
@@ -74,6 +89,9 @@ impl Linear {
             guards: Vec::new(),
             guard: vec![0.0; ORDER + 1],
             y1: vec![0.0; dimension],
+            carry: vec![0.0; dimension],
+            y0_lo: vec![0.0; dimension + 1],
+            lo_terms: RefCell::new((vec![0.0; dimension + 1], vec![0.0; dimension + 1])),
             evaluations: Cell::new(0),
         }
     }
@@ -118,6 +136,14 @@ impl Linear {
         self.mode = mode;
         self.y0[..n].copy_from_slice(y0);
         self.y0[n] = 1.0;
+        // A step that continues from the last one's end starts from the
+        // end unrounded: the state of an exactly periodic orbit otherwise
+        // rounds the same way at the same step of every period, and its
+        // phase drifts with the number of periods.
+        let continues = y0 == &self.y1[..];
+        for (l, c) in self.y0_lo.iter_mut().zip(&self.carry) {
+            *l = if continues { *c } else { 0.0 };
+        }
         self.h = h_bound.min(h_max);
         self.series_ready.set(false);
         self.evaluations.set(self.evaluations.get() + 1);
@@ -138,12 +164,18 @@ impl Linear {
             .and_then(AffineMode::whole_step)
         {
             Some(p) => {
-                // y1 = the first n rows of exp(M h) y0, each rounded once.
-                for (o, row) in y1.iter_mut().zip(p.chunks_exact(n + 1)) {
-                    *o = dot(row, &self.y0);
+                // y1 = the first n rows of exp(M h) y0, each rounded once,
+                // and what the rounding left out.
+                let ends = y1.iter_mut().zip(self.carry.iter_mut());
+                for ((o, c), row) in ends.zip(p.chunks_exact(n + 1)) {
+                    let end = dot(row, &self.y0, &self.y0_lo);
+                    (*o, *c) = (end.hi, end.lo);
                 }
             }
-            None => self.eval(self.h, &mut y1),
+            None => {
+                self.eval(self.h, &mut y1);
+                self.carry.fill(0.0);
+            }
         }
         self.y1 = y1;
         if self.y1.iter().any(|x| !x.is_finite()) {
@@ -169,6 +201,9 @@ impl Linear {
             term,
             next,
         );
+        let (once, twice) = &mut *self.lo_terms.borrow_mut();
+        mat_vec(&solved.rows, &self.y0_lo, once);
+        mat_vec(&solved.rows, once, twice);
         self.series_ready.set(true);
     }
 
@@ -196,8 +231,11 @@ impl Linear {
                 .and_then(|s| s.guard_rows[g].as_ref());
             match rows {
                 Some(rows) => {
+                    let product = |row: &[f64], y: &[f64]| -> f64 {
+                        row.iter().zip(y).map(|(a, b)| a * b).sum()
+                    };
                     for (ck, row) in c.iter_mut().zip(rows.chunks_exact(m)) {
-                        *ck = row.iter().zip(&self.y0).map(|(a, b)| a * b).sum();
+                        *ck = product(row, &self.y0) + product(row, &self.y0_lo);
                     }
                 }
                 None => {
@@ -227,8 +265,13 @@ impl Linear {
         if tau <= self.h * (1.0 + 4.0 * f64::EPSILON) {
             self.ensure_series();
             let series = self.series.borrow();
-            for (xi, c) in x.iter_mut().zip(series.chunks_exact(ORDER + 1)) {
-                *xi = eval_compensated(c, tau);
+            let (once, twice) = &*self.lo_terms.borrow();
+            // The start's residual along the step, to its second order
+            // (the third is below 1 / 6 of the residual, itself below half
+            // an ulp), added before the one rounding.
+            let lo = self.y0_lo.iter().zip(once.iter().zip(twice));
+            for ((xi, c), (l, (a, b))) in x.iter_mut().zip(series.chunks_exact(ORDER + 1)).zip(lo) {
+                *xi = eval_compensated_plus(c, tau, l + tau * (a + 0.5 * tau * b));
             }
             return;
         }

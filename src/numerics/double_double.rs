@@ -5,9 +5,9 @@
 //! Only what a matrix used thousands of times needs: a step's propagator
 //! rounded once to double carries a bias of up to half an ulp per entry,
 //! which applying it step after step turns into a drift growing with the
-//! number of steps (a rotation's phase); built in double-double and applied
-//! by [`dot`], each step rounds its result once, and the roundings no
-//! longer add up one way.
+//! number of steps (a rotation's phase). Built in double-double and applied
+//! by [`dot`] to a state and the residual its last rounding left, a run of
+//! steps rounds as if the state were carried to twice the precision.
 
 use std::ops::{Add, Mul};
 
@@ -94,18 +94,19 @@ impl Mul for DoubleDouble {
     }
 }
 
-/// `sum_j a_j y_j` for double-double `a` and double `y`, rounded once at
-/// the end (the products and sums carried to about 106 bits).
+/// `sum_j a_j (y_j + r_j)` for double-double `a`, a double `y` and its
+/// residual `r` (what rounding `y` left out), carried to about 106 bits
+/// and normalised: `hi` is the sum rounded once, `lo` what that left out.
 #[inline(always)]
-pub fn dot(a: &[DoubleDouble], y: &[f64]) -> f64 {
+pub fn dot(a: &[DoubleDouble], y: &[f64], r: &[f64]) -> DoubleDouble {
     let (mut hi, mut lo) = (0.0, 0.0);
-    for (a, &y) in a.iter().zip(y) {
+    for ((a, &y), &r) in a.iter().zip(y).zip(r) {
         let (p, e) = two_prod(a.hi, y);
         let (s, f) = two_sum(hi, p);
         hi = s;
-        lo += f + e + a.lo * y;
+        lo += f + e + a.lo * y + a.hi * r;
     }
-    hi + lo
+    DoubleDouble::new(hi, lo)
 }
 
 #[cfg(test)]
@@ -130,7 +131,11 @@ mod tests {
             DoubleDouble::new(1.0, 2f64.powi(-60)),
             DoubleDouble::from(-1.0),
         ];
-        assert_eq!(dot(&a, &[1.0, 1.0]), 2f64.powi(-60));
+        assert_eq!(dot(&a, &[1.0, 1.0], &[0.0, 0.0]).round(), 2f64.powi(-60));
+        // A residual of y counts as well.
+        let one = [DoubleDouble::from(1.0)];
+        let sum = dot(&one, &[1.0], &[2f64.powi(-60)]);
+        assert_eq!((sum.hi, sum.lo), (1.0, 2f64.powi(-60)));
         assert_eq!(1.0 + 2f64.powi(-60) - 1.0, 0.0);
     }
 }

@@ -31,8 +31,15 @@ pub fn eval_plain(c: &[f64], s: f64) -> f64 {
 /// in twice the working precision, rounded once: what a Taylor step's state
 /// needs, whose terms cancel to a few times less than their sum.
 pub fn eval_compensated(c: &[f64], s: f64) -> f64 {
+    eval_compensated_plus(c, s, -0.0)
+}
+
+/// `p(s) + extra` by compensated Horner (see [`eval_compensated`]), with
+/// `extra` (a term far below `p(s)`: a residual the coefficients could not
+/// hold) added to the error terms before the one rounding.
+pub fn eval_compensated_plus(c: &[f64], s: f64, extra: f64) -> f64 {
     let Some((&last, rest)) = c.split_last() else {
-        return 0.0;
+        return extra;
     };
     let (mut sum, mut error) = (last, 0.0);
     for &ck in rest.iter().rev() {
@@ -44,7 +51,7 @@ pub fn eval_compensated(c: &[f64], s: f64) -> f64 {
         error = error * s + (product_error + sum_error);
         sum = next;
     }
-    sum + error
+    sum + (error + extra)
 }
 
 #[cfg(test)]
