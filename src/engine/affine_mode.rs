@@ -65,7 +65,8 @@ pub fn mat_vec(a: &[f64], v: &[f64], out: &mut [f64]) {
 /// The series of `exp(M tau) y`, component by component: `series[i *
 /// (ORDER + 1) + k]` is `(M^k y)_i / k!` for the first `series.len() /
 /// (ORDER + 1)` components (the layout of [`HybridModel::flow_series`]).
-/// `term` and `next` are scratch of `y`'s length.
+/// `term` and `next` are scratch of `y`'s length. Small states take a loop
+/// unrolled for their size (the same sums in the same order).
 pub fn state_series(
     rows: &[f64],
     y: &[f64],
@@ -73,20 +74,101 @@ pub fn state_series(
     term: &mut [f64],
     next: &mut [f64],
 ) {
+    match y.len() {
+        2 => state_series_of::<2>(rows, y, series),
+        3 => state_series_of::<3>(rows, y, series),
+        4 => state_series_of::<4>(rows, y, series),
+        5 => state_series_of::<5>(rows, y, series),
+        _ => {
+            let w = ORDER + 1;
+            let n = series.len() / w;
+            term.copy_from_slice(y);
+            for k in 0..w {
+                for i in 0..n {
+                    series[i * w + k] = term[i];
+                }
+                if k < ORDER {
+                    mat_vec(rows, term, next);
+                    let scale = 1.0 / (k + 1) as f64;
+                    for (t, v) in term.iter_mut().zip(next.iter()) {
+                        *t = v * scale;
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// [`state_series`] for an augmented state of `M` components.
+fn state_series_of<const M: usize>(rows: &[f64], y: &[f64], series: &mut [f64]) {
     let w = ORDER + 1;
     let n = series.len() / w;
+    let mut a = [[0.0; M]; M];
+    for (i, row) in a.iter_mut().enumerate() {
+        row.copy_from_slice(&rows[i * M..(i + 1) * M]);
+    }
+    let mut term = [0.0; M];
     term.copy_from_slice(y);
     for k in 0..w {
         for i in 0..n {
             series[i * w + k] = term[i];
         }
         if k < ORDER {
-            mat_vec(rows, term, next);
             let scale = 1.0 / (k + 1) as f64;
-            for (t, v) in term.iter_mut().zip(next.iter()) {
-                *t = v * scale;
+            let mut next = [0.0; M];
+            for (o, row) in next.iter_mut().zip(&a) {
+                let mut sum = 0.0;
+                for (x, t) in row.iter().zip(&term) {
+                    sum += x * t;
+                }
+                *o = sum * scale;
+            }
+            term = next;
+        }
+    }
+}
+
+/// An affine guard's series along a step that starts from `y` (and the
+/// residual `y_lo` of its rounding): `out[k] = row_k . y + row_k . y_lo`
+/// for the rows of [`AffineMode::guard_rows`]. Small states take a loop
+/// unrolled for their size.
+pub fn guard_series(rows: &[f64], y: &[f64], y_lo: &[f64], out: &mut [f64]) {
+    match y.len() {
+        2 => guard_series_of::<2>(rows, y, y_lo, out),
+        3 => guard_series_of::<3>(rows, y, y_lo, out),
+        4 => guard_series_of::<4>(rows, y, y_lo, out),
+        5 => guard_series_of::<5>(rows, y, y_lo, out),
+        m => {
+            let product =
+                |row: &[f64], y: &[f64]| -> f64 { row.iter().zip(y).map(|(a, b)| a * b).sum() };
+            for (o, row) in out.iter_mut().zip(rows.chunks_exact(m)) {
+                *o = product(row, y) + product(row, y_lo);
             }
         }
+    }
+}
+
+/// [`guard_series`] for an augmented state of `M` components.
+fn guard_series_of<const M: usize>(rows: &[f64], y: &[f64], y_lo: &[f64], out: &mut [f64]) {
+    let mut start = [0.0; M];
+    start.copy_from_slice(y);
+    let mut lo = [0.0; M];
+    lo.copy_from_slice(y_lo);
+    // Most steps start from a state that was not a whole step's end.
+    let carried = lo.iter().any(|l| *l != 0.0);
+    for (o, row) in out.iter_mut().zip(rows.chunks_exact(M)) {
+        let mut sum = 0.0;
+        for (a, b) in row.iter().zip(&start) {
+            sum += a * b;
+        }
+        if carried {
+            let mut residual = 0.0;
+            for (a, b) in row.iter().zip(&lo) {
+                residual += a * b;
+            }
+            sum += residual;
+        }
+        *o = sum;
     }
 }
 

@@ -33,7 +33,7 @@ use nalgebra::{DMatrix, DVector};
 
 use crate::engine::adaptive::StepFailure;
 pub use crate::engine::affine_mode::ORDER;
-use crate::engine::affine_mode::{AffineMode, mat_vec, state_series};
+use crate::engine::affine_mode::{AffineMode, guard_series, mat_vec, state_series};
 use crate::engine::locate::{Start, StepScan};
 use crate::engine::model::{HybridModel, Mode};
 use crate::numerics::double_double::dot;
@@ -215,7 +215,6 @@ impl Linear {
     /// to blame where the step collapses (`sqrt(x)` near `x = 0`).
     fn fit_guards<M: HybridModel + ?Sized>(&mut self, model: &M, mode: Mode) -> Option<usize> {
         let w = ORDER + 1;
-        let m = self.y0.len();
         let guards = model.guards(mode).len();
         self.guards.resize(guards * w, 0.0);
         // Measured as the state's own series are: against the state's size
@@ -230,14 +229,7 @@ impl Linear {
                 .as_ref()
                 .and_then(|s| s.guard_rows[g].as_ref());
             match rows {
-                Some(rows) => {
-                    let product = |row: &[f64], y: &[f64]| -> f64 {
-                        row.iter().zip(y).map(|(a, b)| a * b).sum()
-                    };
-                    for (ck, row) in c.iter_mut().zip(rows.chunks_exact(m)) {
-                        *ck = product(row, &self.y0) + product(row, &self.y0_lo);
-                    }
-                }
+                Some(rows) => guard_series(rows, &self.y0, &self.y0_lo, c),
                 None => {
                     self.ensure_series();
                     model.guard_series(mode, g, &self.series.borrow(), ORDER, c);

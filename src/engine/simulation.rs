@@ -28,6 +28,7 @@ use crate::engine::periodic::Returns;
 use crate::engine::queue::EventQueue;
 use crate::engine::run::{Options, Outcome, Status};
 use crate::engine::run_loop::{End, Segments, drive, end_window};
+use crate::numerics::central_difference::{CBRT_EPSILON, step_for};
 use crate::time::Time;
 
 /// The state at one of the sample times a run was asked for.
@@ -1053,7 +1054,7 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
         let t = self.state[c];
         // A difference over a small part of the step (which resolves the
         // forcing), and far above the ulps of t.
-        let dt = (f64::EPSILON.cbrt() * h).max(1e3 * f64::EPSILON * t.abs());
+        let dt = (CBRT_EPSILON * h).max(1e3 * f64::EPSILON * t.abs());
         let (mut up, mut down) = std::mem::take(&mut self.rates);
         let mut x = std::mem::take(&mut self.probe);
         x.copy_from_slice(&self.state);
@@ -1282,7 +1283,7 @@ fn normal<M: HybridModel + ?Sized>(
     }
     probe.copy_from_slice(x);
     for j in 0..x.len() {
-        let h = f64::EPSILON.cbrt() * x[j].abs().max(1.0);
+        let h = step_for(x[j]);
         probe[j] = x[j] + h;
         let up = model.guard(mode, g, probe);
         probe[j] = x[j] - h;
@@ -1316,7 +1317,7 @@ fn guard_rate(
     if speed == 0.0 || !speed.is_finite() {
         return 0.0;
     }
-    let h = f64::EPSILON.cbrt() * size_of(x, clock) / speed;
+    let h = CBRT_EPSILON * size_of(x, clock) / speed;
     let mut at = |sign: f64| {
         for ((p, a), r) in probe.iter_mut().zip(x).zip(rate) {
             *p = a + sign * h * r;

@@ -13,6 +13,7 @@
 use crate::engine::error_set::TRACKED;
 use crate::engine::model::{Flow, HybridModel, Mode};
 use crate::engine::saltation;
+use crate::numerics::central_difference::step_for;
 
 /// Scratch for the linearisations of one run; matrices are row-major
 /// `n x n`.
@@ -47,11 +48,6 @@ fn row_norm(n: usize, a: &[f64]) -> f64 {
     (0..n)
         .map(|i| (0..n).map(|j| a[i * n + j].abs()).sum::<f64>())
         .fold(0.0, f64::max)
-}
-
-/// Relative step of the central differences.
-fn step_for(x: f64) -> f64 {
-    f64::EPSILON.cbrt() * x.abs().max(1.0)
 }
 
 impl Tangents {

@@ -32,6 +32,7 @@ use crate::engine::labels::Labels;
 use crate::engine::model::{Flow, Guard, HybridModel, Jump, Mode};
 use crate::engine::names::intern;
 use crate::engine::saltation;
+use crate::numerics::central_difference::step_for;
 
 /// A model with the derivatives of its state along `m` directions.
 #[derive(Debug)]
@@ -42,11 +43,6 @@ pub struct Variational<'m, M: HybridModel + ?Sized> {
     /// Each mode's state names: the model's, then `d{x}/d{p}` for each
     /// direction `p`, then `dt/d{p}`.
     names: Vec<Vec<&'static str>>,
-}
-
-/// Central-difference step for a component of size `x`.
-fn step_for(x: f64) -> f64 {
-    f64::EPSILON.cbrt() * x.abs().max(1.0)
 }
 
 impl<'m, M: HybridModel + ?Sized> Variational<'m, M> {

@@ -13,6 +13,7 @@
 use crate::engine::labels::Labels;
 use crate::engine::model::{Flow, Guard, HybridModel, Jump, Mode};
 use crate::engine::names::intern;
+use crate::numerics::central_difference::step_for;
 
 /// `base`'s structure, with its numbers from `build(p)`.
 pub struct WithParameters<M, F> {
@@ -174,7 +175,7 @@ impl<M: HybridModel, F: Fn(&[f64]) -> M> HybridModel for WithParameters<M, F> {
         }
         for k in n..dim {
             out[k * dim + k] = 1.0;
-            let h = f64::EPSILON.cbrt() * x[k].abs().max(1.0);
+            let h = step_for(x[k]);
             let (mut up, mut down) = (x.to_vec(), x.to_vec());
             up[k] += h;
             down[k] -= h;
@@ -198,7 +199,7 @@ impl<M: HybridModel, F: Fn(&[f64]) -> M> HybridModel for WithParameters<M, F> {
             return false;
         }
         for k in n..n + self.p {
-            let h = f64::EPSILON.cbrt() * x[k].abs().max(1.0);
+            let h = step_for(x[k]);
             let (mut up, mut down) = (x.to_vec(), x.to_vec());
             up[k] += h;
             down[k] -= h;

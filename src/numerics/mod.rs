@@ -6,6 +6,7 @@
 //! real root of a step's low-degree dense output on `(0, 1)`
 //! ([`real_roots`]), which the scan of a numerical step is made of.
 
+pub mod central_difference;
 pub mod double_double;
 pub mod first_crossing;
 pub mod fused;

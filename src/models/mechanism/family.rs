@@ -14,6 +14,7 @@ use crate::models::mechanism::angle::{self, AngleMechanism};
 use crate::models::mechanism::scene::{Formulation, Initial, MechanismScene};
 use crate::models::mechanism::strain::{self, FLIGHT, StrainMechanism};
 use crate::models::mechanism::{Charts, Mechanism};
+use crate::numerics::central_difference::step_for;
 
 const PARAMETERS: [&str; 2] = ["eta", "omega"];
 
@@ -112,7 +113,7 @@ impl Family for MechanismFamily {
         // (an energy's start moves with eta; the others do not move).
         let slopes = (0..which.len())
             .map(|j| {
-                let h = f64::EPSILON.cbrt() * values[j].abs().max(1.0);
+                let h = step_for(values[j]);
                 let moved = |d: f64| {
                     let mut v = values.clone();
                     v[j] += d;
