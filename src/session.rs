@@ -1,9 +1,14 @@
-//! One run of a scene as a user asks for it, beyond the scene itself:
-//! derivatives along some directions, samples of the state at some times.
-//! The command line and the Python binding both run scenes through here,
-//! so a request means the same from either.
+//! What a user asks of a scene beyond the scene itself, resolved once for
+//! the command line and the Python binding alike, so a request means the
+//! same from either: a run with derivatives along some directions or
+//! samples of the state at some times ([`RunRequest`]), and a Lyapunov
+//! spectrum whose unset settings follow the scene ([`SpectrumRequest`]).
 
-use crate::engine::Observer;
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
+
+use crate::engine::{Family, Observer};
+use crate::lyapunov;
 use crate::runner::{Control, Report, Trajectory};
 use crate::scene::{Scene, SceneError};
 
@@ -60,5 +65,49 @@ impl RunRequest {
                 )),
             },
         }
+    }
+}
+
+/// A Lyapunov spectrum as asked (`flicker lyapunov`'s flags, the keywords
+/// of Python's `lyapunov()`): what is not given follows the scene.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SpectrumRequest {
+    /// How many exponents; all of them (the state's dimension) if unset.
+    pub exponents: Option<usize>,
+    /// Time run first, for a transient to die out.
+    pub transient: f64,
+    /// Time averaged over; the scene's `t_end` if unset.
+    pub t_end: Option<f64>,
+    /// Time between re-orthonormalisations; a quarter of the scene's time
+    /// scale (at most the span) if unset.
+    pub interval: Option<f64>,
+    /// Seconds of wall time for the whole spectrum.
+    pub wall: f64,
+}
+
+impl SpectrumRequest {
+    /// The spectrum's settings for `scene`'s `family`, checked before
+    /// anything runs, stopped by `stop` where given; the error names the
+    /// field it is about (`exponents`, `interval`, `wall`...).
+    pub fn resolve(
+        &self,
+        scene: &Scene,
+        family: &dyn Family,
+        stop: Option<Arc<AtomicBool>>,
+    ) -> Result<lyapunov::Request, SceneError> {
+        let span = self.t_end.unwrap_or_else(|| scene.t_end());
+        let request = lyapunov::Request {
+            exponents: self.exponents.unwrap_or_else(|| family.model().dimension()),
+            transient: self.transient,
+            span,
+            interval: self
+                .interval
+                .unwrap_or_else(|| (scene.time_scale() / 4.0).min(span)),
+            stop,
+            deadline: crate::runner::deadline_in(self.wall)
+                .map_err(|why| SceneError::field("wall", why))?,
+        };
+        lyapunov::check(family, &request).map_err(|(field, why)| SceneError::field(field, why))?;
+        Ok(request)
     }
 }

@@ -12,6 +12,7 @@ use serde_json::Value;
 use flicker::orbit::OrbitRequest;
 use flicker::runner::Control;
 use flicker::scene::Registry;
+use flicker::session::SpectrumRequest;
 use flicker::sweep::{Row as SweepRow, Shard, Sweep, is_sweep, parse_text};
 use flicker::work_precision::{Plan, compare as run_compare};
 
@@ -347,19 +348,16 @@ pub fn lyapunov(
     let family = scene
         .family()
         .map_err(|e| override_error(py, "model", e.reason))?;
-    let request = flicker::lyapunov::Request {
-        exponents: exponents.unwrap_or_else(|| family.model().dimension()),
+    let asked = SpectrumRequest {
+        exponents,
         transient,
-        span: t_end.unwrap_or_else(|| scene.t_end()),
-        interval: interval.unwrap_or_else(|| {
-            (scene.time_scale() / 4.0).min(t_end.unwrap_or_else(|| scene.t_end()))
-        }),
-        stop: None,
-        deadline: flicker::runner::deadline_in(wall)
-            .map_err(|why| override_error(py, "wall", why))?,
+        t_end,
+        interval,
+        wall,
     };
-    flicker::lyapunov::check(&*family, &request)
-        .map_err(|(field, why)| override_error(py, field, why))?;
+    let request = asked
+        .resolve(&scene, &*family, None)
+        .map_err(|e| scene_error(py, &e))?;
     let found = interruptible(py, |stop| {
         let request = flicker::lyapunov::Request {
             stop: Some(stop.clone()),

@@ -9,9 +9,10 @@ use crate::cli::exit::{Code, Failure};
 use crate::cli::progress::WithProgress;
 use crate::engine::Observer;
 use crate::log::summary::write_atomically;
-use crate::lyapunov::{Request, Spectrum, check, spectrum};
+use crate::lyapunov::{Spectrum, spectrum};
 use crate::plot::draw::{Curve, Figure, Style};
 use crate::scene::Registry;
+use crate::session::SpectrumRequest;
 
 /// `flicker lyapunov`'s arguments.
 #[derive(Debug, clap::Args)]
@@ -91,19 +92,19 @@ pub fn lyapunov(args: LyapunovArgs, registry: &Registry) -> Result<Code, Failure
         .family()
         .map_err(|e| Failure::bad_input(format!("{}: {}", args.scene.display(), e.reason)))?;
     let stop = crate::cli::setup::stop_flag();
-    let request = Request {
-        exponents: args.exponents.unwrap_or_else(|| family.model().dimension()),
+    let asked = SpectrumRequest {
+        exponents: args.exponents,
         transient: args.transient,
-        span: args.t_end.unwrap_or_else(|| scene.t_end()),
-        interval: args.interval.unwrap_or_else(|| {
-            (scene.time_scale() / 4.0).min(args.t_end.unwrap_or_else(|| scene.t_end()))
-        }),
-        stop: Some(stop.clone()),
-        deadline: crate::cli::setup::deadline(args.wall)?,
+        t_end: args.t_end,
+        interval: args.interval,
+        wall: args.wall,
     };
-    check(&*family, &request).map_err(|(field, why)| {
-        Failure::bad_input(format!("--{}: {why}", field.replace('_', "-")))
-    })?;
+    let request = asked
+        .resolve(&scene, &*family, Some(stop.clone()))
+        .map_err(|e| {
+            let field = e.field.unwrap_or_default().replace('_', "-");
+            Failure::bad_input(format!("--{field}: {}", e.reason))
+        })?;
     let out = args.out.clone().unwrap_or_else(|| {
         let stem = args
             .scene

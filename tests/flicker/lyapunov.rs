@@ -205,3 +205,54 @@ fn the_largest_exponent_predicts_the_chain_s_horizon() {
         "the horizon moved by {gained}, ln(1000) / l1 = {predicted}"
     );
 }
+
+/// The spectrum's settings resolved once for the command line and Python
+/// (`flicker::session::SpectrumRequest`): unset, they follow the scene (all
+/// exponents of the state, averaged to its `t_end`, re-orthonormalised
+/// every quarter of its time scale); a wrong one is refused naming its
+/// field before anything runs.
+#[test]
+fn a_spectrum_request_follows_the_scene_where_unset_and_names_a_bad_field() {
+    use flicker::scene::Registry;
+    use flicker::session::SpectrumRequest;
+    let scene = Registry::builtin()
+        .load(std::path::Path::new(&models(
+            "automata/impact_oscillator.json",
+        )))
+        .expect("the bundled scene loads");
+    let family = scene.family().expect("an automaton has a family");
+    let asked = SpectrumRequest {
+        exponents: None,
+        transient: 0.0,
+        t_end: None,
+        interval: None,
+        wall: 60.0,
+    };
+    let request = asked.resolve(&scene, &*family, None).expect("resolves");
+    assert_eq!(request.exponents, family.model().dimension());
+    assert_eq!(request.span, scene.t_end());
+    assert_eq!(
+        request.interval,
+        (scene.time_scale() / 4.0).min(scene.t_end())
+    );
+    assert!(request.deadline.is_some());
+    for (bad, field) in [
+        (
+            SpectrumRequest {
+                exponents: Some(0),
+                ..asked.clone()
+            },
+            "exponents",
+        ),
+        (
+            SpectrumRequest {
+                wall: -1.0,
+                ..asked.clone()
+            },
+            "wall",
+        ),
+    ] {
+        let refused = bad.resolve(&scene, &*family, None).expect_err("refused");
+        assert_eq!(refused.field.as_deref(), Some(field), "{}", refused.reason);
+    }
+}
