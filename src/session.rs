@@ -1,14 +1,16 @@
 //! What a user asks of a scene beyond the scene itself, resolved once for
 //! the command line and the Python binding alike, so a request means the
 //! same from either: a run with derivatives along some directions or
-//! samples of the state at some times ([`RunRequest`]), and a Lyapunov
-//! spectrum whose unset settings follow the scene ([`SpectrumRequest`]).
+//! samples of the state at some times ([`RunRequest`]), a periodic-orbit
+//! search or branch ([`SearchRequest`]), and a Lyapunov spectrum whose
+//! unset settings follow the scene ([`SpectrumRequest`]).
 
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
 use crate::engine::{Family, Observer};
 use crate::lyapunov;
+use crate::orbit::OrbitRequest;
 use crate::runner::{Control, Report, Trajectory};
 use crate::scene::{Scene, SceneError};
 
@@ -109,5 +111,39 @@ impl SpectrumRequest {
         };
         lyapunov::check(family, &request).map_err(|(field, why)| SceneError::field(field, why))?;
         Ok(request)
+    }
+}
+
+/// A periodic-orbit search, or a branch of them, as asked (the flags of
+/// `flicker orbit` and `flicker continue`, the keywords of Python's
+/// `orbit()` and `continuation()`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SearchRequest {
+    /// The guard whose events are the section.
+    pub section: String,
+    /// Section events per period.
+    pub events: usize,
+    /// Time run before the search starts from the next section event.
+    pub settle: f64,
+    /// The forcing's period, where the model reads the clock.
+    pub forcing_period: Option<f64>,
+    /// Seconds of wall time for the whole search or branch.
+    pub wall: f64,
+}
+
+impl SearchRequest {
+    /// The search's settings, stopped by `stop` where given; the error
+    /// names `wall` (the section and the rest are checked by the search,
+    /// which names them too).
+    pub fn resolve(&self, stop: Option<Arc<AtomicBool>>) -> Result<OrbitRequest, SceneError> {
+        Ok(OrbitRequest {
+            guard: self.section.clone(),
+            events: self.events,
+            settle: self.settle,
+            forcing_period: self.forcing_period,
+            stop,
+            deadline: crate::runner::deadline_in(self.wall)
+                .map_err(|why| SceneError::field("wall", why))?,
+        })
     }
 }

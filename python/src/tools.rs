@@ -12,7 +12,7 @@ use serde_json::Value;
 use flicker::orbit::OrbitRequest;
 use flicker::runner::Control;
 use flicker::scene::Registry;
-use flicker::session::SpectrumRequest;
+use flicker::session::{SearchRequest, SpectrumRequest};
 use flicker::sweep::{Row as SweepRow, Shard, Sweep, is_sweep, parse_text};
 use flicker::work_precision::{Plan, compare as run_compare};
 
@@ -202,23 +202,21 @@ fn rayon_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, String> {
         .map_err(|e| e.to_string())
 }
 
-/// The orbit request of `flicker orbit`'s flags, `wall` seconds of wall
-/// time for the whole search (`--wall`).
+/// The search as asked (see [`SearchRequest`]), stopped by the caller.
 fn request(
     py: Python<'_>,
     section: String,
     (events, settle, forcing_period): (usize, f64, Option<f64>),
     wall: f64,
 ) -> PyResult<OrbitRequest> {
-    Ok(OrbitRequest {
-        guard: section,
+    let asked = SearchRequest {
+        section,
         events,
         settle,
         forcing_period,
-        stop: None,
-        deadline: flicker::runner::deadline_in(wall)
-            .map_err(|why| override_error(py, "wall", why))?,
-    })
+        wall,
+    };
+    asked.resolve(None).map_err(|e| scene_error(py, &e))
 }
 
 /// `flicker orbit`: the JSON text of `orbit.json` for the orbit found (or

@@ -6,11 +6,11 @@
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
-use crate::orbit::OrbitRequest;
 use crate::orbit::continuation::{Branch, Point};
 use crate::orbit::diagram::Column;
 use crate::plot::draw::{Curve, Figure, Style};
 use crate::scene::Registry;
+use crate::session::SearchRequest;
 
 use crate::cli::exit::{Code, Failure};
 
@@ -76,21 +76,15 @@ pub struct ContinueArgs {
 /// Run `flicker continue`.
 pub fn continue_orbit(args: ContinueArgs, registry: &Registry) -> Result<Code, Failure> {
     let scene = registry.load(&args.scene).map_err(Failure::bad_input)?;
-    let request = OrbitRequest {
-        guard: args.section.clone(),
+    let request = SearchRequest {
+        section: args.section.clone(),
         events: args.events,
         settle: args.settle,
         forcing_period: args.forcing_period,
-        stop: Some(crate::cli::setup::stop_flag()),
-        deadline: crate::cli::setup::deadline(args.wall)?,
-    };
-    let flag = |e: crate::scene::SceneError| {
-        Failure::bad_input(format!(
-            "--{}: {}",
-            e.field.unwrap_or_default().replace('_', "-"),
-            e.reason
-        ))
-    };
+        wall: args.wall,
+    }
+    .resolve(Some(crate::cli::setup::stop_flag()))
+    .map_err(Failure::flag)?;
     let family = scene
         .family()
         .map_err(|e| Failure::bad_input(format!("{}: {}", args.scene.display(), e.reason)))?;
@@ -118,7 +112,7 @@ pub fn continue_orbit(args: ContinueArgs, registry: &Registry) -> Result<Code, F
             }
         },
     )
-    .map_err(flag)?;
+    .map_err(Failure::flag)?;
     let out = args.out.clone().unwrap_or_else(|| {
         let stem = args
             .scene
@@ -170,7 +164,7 @@ pub fn continue_orbit(args: ContinueArgs, registry: &Registry) -> Result<Code, F
             (scene.t_end() / 2.0, args.brute_force_events, scene.t_end()),
             (request.stop.as_ref(), request.deadline),
         )
-        .map_err(flag)?
+        .map_err(Failure::flag)?
     } else {
         Vec::new()
     };

@@ -2,6 +2,7 @@
 //! or a tool's stop gives.
 
 use crate::engine::Status;
+use crate::scene::SceneError;
 
 /// What the process tells its caller.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -54,6 +55,13 @@ impl Failure {
             code: Code::BadInput,
             message: message.to_string(),
         }
+    }
+
+    /// A request refused for one of its flags: `--{field}: {reason}`
+    /// (the field's underscores written as the flag's dashes).
+    pub fn flag(e: SceneError) -> Self {
+        let field = e.field.unwrap_or_default().replace('_', "-");
+        Failure::bad_input(format!("--{field}: {}", e.reason))
     }
 
     /// A failure for a run that cannot be trusted, or output that could not

@@ -101,10 +101,7 @@ pub fn lyapunov(args: LyapunovArgs, registry: &Registry) -> Result<Code, Failure
     };
     let request = asked
         .resolve(&scene, &*family, Some(stop.clone()))
-        .map_err(|e| {
-            let field = e.field.unwrap_or_default().replace('_', "-");
-            Failure::bad_input(format!("--{field}: {}", e.reason))
-        })?;
+        .map_err(Failure::flag)?;
     let out = args.out.clone().unwrap_or_else(|| {
         let stem = args
             .scene

@@ -6,8 +6,8 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use crate::log::summary::write_atomically;
-use crate::orbit::OrbitRequest;
 use crate::scene::Registry;
+use crate::session::SearchRequest;
 
 use crate::cli::exit::{Code, Failure};
 use crate::cli::progress::WithProgress;
@@ -53,14 +53,15 @@ pub struct OrbitArgs {
 /// A search that does not converge exits 3, saying why.
 pub fn orbit(args: OrbitArgs, registry: &Registry) -> Result<Code, Failure> {
     let scene = registry.load(&args.scene).map_err(Failure::bad_input)?;
-    let request = OrbitRequest {
-        guard: args.section.clone(),
+    let request = SearchRequest {
+        section: args.section.clone(),
         events: args.events,
         settle: args.settle,
         forcing_period: args.forcing_period,
-        stop: Some(crate::cli::setup::stop_flag()),
-        deadline: crate::cli::setup::deadline(args.wall)?,
-    };
+        wall: args.wall,
+    }
+    .resolve(Some(crate::cli::setup::stop_flag()))
+    .map_err(Failure::flag)?;
     let out = args.out.unwrap_or_else(|| {
         let stem = args
             .scene
@@ -90,13 +91,7 @@ pub fn orbit(args: OrbitArgs, registry: &Registry) -> Result<Code, Failure> {
     };
     let found = crate::orbit::search(&*family, &request, scene.t_end(), watch);
     bar.finish();
-    let orbit = found.map_err(|e| {
-        Failure::bad_input(format!(
-            "--{}: {}",
-            e.field.clone().unwrap_or_default().replace('_', "-"),
-            e.reason
-        ))
-    })?;
+    let orbit = found.map_err(Failure::flag)?;
     let wall = started.elapsed().as_secs_f64();
     crate::cli::setup::output_folder(&out)?;
     let path = out.join("orbit.json");
