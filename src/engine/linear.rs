@@ -96,8 +96,11 @@ impl Linear {
         }
     }
 
-    /// Nothing to forget: a step does not depend on the one before.
-    pub fn restart(&mut self) {}
+    /// Forget the last step's rounding residual: after an event the run
+    /// goes on from the event's state.
+    pub fn restart(&mut self) {
+        self.carry.fill(0.0);
+    }
 
     /// The length of the last step taken.
     pub fn h(&self) -> f64 {
