@@ -300,7 +300,9 @@ impl Piece<'_> {
         }
         let mut c = [0.0; MAX_SHIFTED];
         c[..len].copy_from_slice(self.c);
-        for k in 0..len {
+        // From the series' own origin (most searches) there is nothing to
+        // shift: the sums would only add zeros.
+        for k in (0..len).filter(|_| x0 != 0.0) {
             for j in (k..len - 1).rev() {
                 c[j] += x0 * c[j + 1];
             }
