@@ -10,8 +10,10 @@
 //! - the propagator over a whole step, `exp(M h)` in double-double, so that
 //!   a step rounds its result once, as the series it replaces does, and
 //!   applying it many times adds no bias of its own; it is built once the
-//!   mode has taken [`SERIES_STEPS`] whole steps by their series (it costs
-//!   about `n + 1` of them, which a run of a few steps would not win back);
+//!   mode has taken `n + 1` whole steps by their series (building it takes
+//!   `n + 1` series in double-double: microseconds for a few states, a
+//!   millisecond at 16), so a run of a handful of steps never pays for it
+//!   and any longer one wins it back;
 //! - for each guard that is affine in the state, `g(x) = c . x + d`, the
 //!   rows `[c, d] M^k / k!`: the guard's Taylor coefficients along any step
 //!   are their products with `y`, with no series of the state in between.
@@ -32,9 +34,6 @@ pub const ORDER: usize = 24;
 /// states, one guard per unit) could not afford; larger modes are stepped
 /// by their series.
 pub const SOLVED_DIMENSION: usize = 32;
-
-/// Whole steps a mode takes by its series before its propagator is built.
-pub const SERIES_STEPS: u32 = 16;
 
 /// A mode's augmented matrix, its step bound and, where it is small, its
 /// propagator and its affine guards' rows.
@@ -225,7 +224,7 @@ impl AffineMode {
 
     /// The propagator over a whole step (`h_bound`), for one more whole
     /// step: `None` while the mode is too large, its bound infinite, or it
-    /// has taken fewer than [`SERIES_STEPS`] by the series.
+    /// has taken no more than its augmented size (`n + 1`) by the series.
     pub fn whole_step(&mut self) -> Option<&[DoubleDouble]> {
         if self.propagator.is_none() {
             let m = self.augmented_len();
@@ -233,7 +232,7 @@ impl AffineMode {
                 return None;
             }
             self.series_steps += 1;
-            if self.series_steps <= SERIES_STEPS {
+            if self.series_steps <= m as u32 {
                 return None;
             }
             self.propagator = Some(self.propagator_over(self.h_bound, m));
