@@ -3,11 +3,14 @@
 //! A run of 10^7 impacts adds 10^7 flight times to a clock near 10^7: a plain
 //! `f64` sum loses about one ulp per addition, which grows to microseconds and
 //! spoils the state at the end. [`Time`] adds each flight time with an
-//! error-free transformation (Knuth's two-sum), so the clock stays exact to
+//! error-free transformation (Knuth's two-sum, from
+//! [`crate::numerics::double_double`]), so the clock stays exact to
 //! about 1e-32 relative and a flow can always be evaluated at a small elapsed
 //! time `tau` from its own origin.
 
 use std::cmp::Ordering;
+
+use crate::numerics::double_double::{quick_two_sum, two_sum};
 
 /// A point in simulated time, `hi + lo` with `|lo| <= ulp(hi) / 2`.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -63,18 +66,6 @@ impl PartialOrd for Time {
             unequal => Some(unequal),
         }
     }
-}
-
-fn two_sum(a: f64, b: f64) -> (f64, f64) {
-    let s = a + b;
-    let bb = s - a;
-    let e = (a - (s - bb)) + (b - bb);
-    (s, e)
-}
-
-fn quick_two_sum(a: f64, b: f64) -> (f64, f64) {
-    let s = a + b;
-    (s, b - (s - a))
 }
 
 #[cfg(test)]

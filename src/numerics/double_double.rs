@@ -22,10 +22,18 @@ pub struct DoubleDouble {
 
 /// `a + b` exactly, as the rounded sum and its error (Knuth).
 #[inline(always)]
-fn two_sum(a: f64, b: f64) -> (f64, f64) {
+pub fn two_sum(a: f64, b: f64) -> (f64, f64) {
     let s = a + b;
     let t = s - a;
     (s, (a - (s - t)) + (b - t))
+}
+
+/// `a + b` exactly for `|a| >= |b|` (or `a` zero), in three operations
+/// instead of [`two_sum`]'s six (Dekker).
+#[inline(always)]
+pub fn quick_two_sum(a: f64, b: f64) -> (f64, f64) {
+    let s = a + b;
+    (s, b - (s - a))
 }
 
 /// `a * b` exactly, as the rounded product and its error (one fused

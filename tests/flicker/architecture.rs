@@ -8,8 +8,10 @@ use std::path::{Path, PathBuf};
 
 /// The layers, lowest first: a module may import from any lower layer,
 /// none from its own or a higher one.
-const LAYERS: [&[&str]; 10] = [
-    &["numerics", "time"],
+const LAYERS: [&[&str]; 11] = [
+    &["numerics"],
+    // The run's clock, a double-double of numerics' error-free sums.
+    &["time"],
     // The generic engine and the model interface the tools ask (Family).
     &["engine"],
     // What a run returns and what controls it.
