@@ -18,7 +18,7 @@ use nalgebra::{DMatrix, DVector};
 use crate::engine::names::intern;
 use crate::engine::{Flow, Guard, HybridModel, Jump, Mode};
 use crate::models::automaton::definition::{Definition, Source};
-use crate::models::automaton::expr::derivative::{jacobian, jacobian_into};
+use crate::models::automaton::expr::derivative::{jacobian, jacobian_into, jacobian_tape};
 use crate::models::automaton::expr::recurrences::Series;
 use crate::models::automaton::expr::{Ast, Scope, Tape};
 use crate::models::automaton::filippov::{self, Target};
@@ -50,6 +50,8 @@ struct CompiledMode {
     name: &'static str,
     /// The rate of every state component.
     flow: Tape,
+    /// Its Jacobian's entries, row-major, where compiled (a smooth flow).
+    flow_jacobian: Option<Tape>,
     /// The text of each state's rate, for diagnoses.
     rates: Vec<Option<Source>>,
     guards: Vec<Guard>,
@@ -216,6 +218,14 @@ impl Automaton {
                 rates.push(&one);
             }
             let flow = compile(&rates)?;
+            // Within a few times the flow's own forward pass (a register
+            // and `n` gradient entries each).
+            let budget = 4 * (n + 1) * flow.ops.len();
+            let asts: Vec<&Ast> = rates.iter().map(|s| &s.ast).collect();
+            let flow_jacobian = flow
+                .smooth()
+                .then(|| jacobian_tape(&asts, &scope, budget))
+                .flatten();
             let mut guards = Vec::new();
             let mut guard_tapes = Vec::new();
             let mut resets = Vec::new();
@@ -281,6 +291,7 @@ impl Automaton {
                 rough,
                 name: intern(&mode.name),
                 flow,
+                flow_jacobian,
                 rates: mode.flow.clone(),
                 guards,
                 guard_tapes,
@@ -431,7 +442,11 @@ impl HybridModel for Automaton {
 
     /// Exact, by forward differentiation along the mode's tape.
     fn jacobian(&self, mode: Mode, x: &[f64], jac: &mut [f64]) -> bool {
-        jacobian_into(&self.modes[mode].flow, x, jac);
+        let m = &self.modes[mode];
+        match &m.flow_jacobian {
+            Some(tape) => tape.eval_scratch(x, jac),
+            None => jacobian_into(&m.flow, x, jac),
+        }
         true
     }
 

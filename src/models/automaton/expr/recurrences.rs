@@ -29,6 +29,82 @@ pub struct Series {
     main: Vec<f64>,
     /// First and second helper series of each register.
     aux: [Vec<f64>; 2],
+    /// The tape lowered for the orders' loop.
+    program: Vec<Step>,
+}
+
+/// One instruction as the orders' loop runs it: offsets into the
+/// coefficients resolved, constant operands told apart once per series
+/// instead of once per order, constants written before the loop.
+#[derive(Debug, Clone, Copy)]
+enum Step {
+    /// A constant, already in place.
+    Done,
+    /// Input `from` (an offset into the inputs' coefficients).
+    Input {
+        from: usize,
+        out: usize,
+    },
+    Add {
+        a: usize,
+        b: usize,
+        out: usize,
+    },
+    Sub {
+        a: usize,
+        b: usize,
+        out: usize,
+    },
+    Neg {
+        a: usize,
+        out: usize,
+    },
+    /// `a * b`, `a` constant.
+    ScaledRight {
+        a: usize,
+        b: usize,
+        out: usize,
+    },
+    /// `a * b`, `b` constant.
+    ScaledLeft {
+        a: usize,
+        b: usize,
+        out: usize,
+    },
+    Mul {
+        a: usize,
+        b: usize,
+        out: usize,
+    },
+    /// `a / b`, `b` constant.
+    DivConst {
+        a: usize,
+        b: usize,
+        out: usize,
+    },
+    Div {
+        a: usize,
+        b: usize,
+        out: usize,
+    },
+    /// `a^b`, and whether `b` is constant.
+    Pow {
+        a: usize,
+        b: usize,
+        constant: bool,
+        out: usize,
+    },
+    Call {
+        f: Fun,
+        a: usize,
+        out: usize,
+    },
+    Call2 {
+        f: Fun2,
+        a: usize,
+        b: usize,
+        out: usize,
+    },
 }
 
 impl Series {
@@ -36,9 +112,109 @@ impl Series {
         self.width = order + 1;
         let len = tape.ops.len() * self.width;
         let [aux0, aux1] = &mut self.aux;
+        // Every coefficient is written before it is read (a constant's
+        // here), so what a buffer held before needs no clearing.
         for buffer in [&mut self.main, aux0, aux1] {
-            buffer.clear();
             buffer.resize(len, 0.0);
+        }
+        let w = self.width;
+        let at = |reg: u32| reg as usize * w;
+        self.program.clear();
+        for (r, &op) in tape.ops.iter().enumerate() {
+            let out = r * w;
+            self.program.push(match op {
+                Op::Const(c) => {
+                    self.main[out..out + w].fill(0.0);
+                    self.main[out] = c;
+                    Step::Done
+                }
+                Op::Input(i) => Step::Input { from: at(i), out },
+                Op::Add(a, b) => Step::Add {
+                    a: at(a),
+                    b: at(b),
+                    out,
+                },
+                Op::Sub(a, b) => Step::Sub {
+                    a: at(a),
+                    b: at(b),
+                    out,
+                },
+                Op::Neg(a) => Step::Neg { a: at(a), out },
+                Op::Mul(a, b) if constant(tape, a) => Step::ScaledRight {
+                    a: at(a),
+                    b: at(b),
+                    out,
+                },
+                Op::Mul(a, b) if constant(tape, b) => Step::ScaledLeft {
+                    a: at(a),
+                    b: at(b),
+                    out,
+                },
+                Op::Mul(a, b) => Step::Mul {
+                    a: at(a),
+                    b: at(b),
+                    out,
+                },
+                Op::Div(a, b) if constant(tape, b) => Step::DivConst {
+                    a: at(a),
+                    b: at(b),
+                    out,
+                },
+                Op::Div(a, b) => Step::Div {
+                    a: at(a),
+                    b: at(b),
+                    out,
+                },
+                Op::Pow(a, b) => Step::Pow {
+                    a: at(a),
+                    b: at(b),
+                    constant: constant(tape, b),
+                    out,
+                },
+                Op::Call(f, a) => Step::Call { f, a: at(a), out },
+                Op::Call2(f, a, b) => Step::Call2 {
+                    f,
+                    a: at(a),
+                    b: at(b),
+                    out,
+                },
+            });
+        }
+    }
+
+    /// Coefficient `k` of every register, in order, their operands known to
+    /// order `k`.
+    #[inline]
+    fn order(&mut self, k: usize, inputs: &[f64]) {
+        for i in 0..self.program.len() {
+            let m = &mut self.main;
+            match self.program[i] {
+                Step::Done => {}
+                Step::Input { from, out } => m[out + k] = inputs[from + k],
+                Step::Add { a, b, out } => m[out + k] = m[a + k] + m[b + k],
+                Step::Sub { a, b, out } => m[out + k] = m[a + k] - m[b + k],
+                Step::Neg { a, out } => m[out + k] = -m[a + k],
+                Step::ScaledRight { a, b, out } => m[out + k] = m[a] * m[b + k],
+                Step::ScaledLeft { a, b, out } => m[out + k] = m[a + k] * m[b],
+                Step::Mul { a, b, out } => m[out + k] = conv(m, a, m, b, k, 0, |_| 1.0),
+                Step::DivConst { a, b, out } => m[out + k] = m[a + k] / m[b],
+                Step::Div { a, b, out } => {
+                    let sum = if k == 0 {
+                        0.0
+                    } else {
+                        conv(m, b, m, out, k, 1, |_| 1.0)
+                    };
+                    m[out + k] = (m[a + k] - sum) / m[b];
+                }
+                Step::Pow {
+                    a,
+                    b,
+                    constant,
+                    out,
+                } => self.main[out + k] = self.pow(a, b, constant, out, k),
+                Step::Call { f, a, out } => self.main[out + k] = self.call(f, a, out, k),
+                Step::Call2 { f, a, b, out } => self.main[out + k] = self.call2(f, a, b, out, k),
+            }
         }
     }
 
@@ -52,9 +228,7 @@ impl Series {
             out[i * w] = x;
         }
         for k in 0..=order {
-            for r in 0..tape.ops.len() {
-                self.coefficient(tape, r, k, out);
-            }
+            self.order(k, out);
             if k < order {
                 for (i, &o) in tape.outputs.iter().enumerate() {
                     out[i * w + k + 1] = self.main[o as usize * w + k] / (k + 1) as f64;
@@ -68,72 +242,35 @@ impl Series {
     pub fn compose(&mut self, tape: &Tape, inputs: &[f64], order: usize, out: &mut [f64]) {
         self.prepare(tape, order);
         for k in 0..=order {
-            for r in 0..tape.ops.len() {
-                self.coefficient(tape, r, k, inputs);
-            }
+            self.order(k, inputs);
         }
         let o = tape.outputs[0] as usize * self.width;
         out[..=order].copy_from_slice(&self.main[o..o + order + 1]);
     }
 
-    /// Coefficient `k` of register `r`, its operands known to order `k`.
-    #[inline]
-    fn coefficient(&mut self, tape: &Tape, r: usize, k: usize, inputs: &[f64]) {
-        let w = self.width;
-        let at = |reg: u32| reg as usize * w;
-        let out = r * w;
-        let kf = k as f64;
-        let one = |_: usize| 1.0;
-        let index = |j: usize| j as f64;
+    /// Coefficient `k` of `a^b`.
+    fn pow(&mut self, a: usize, b: usize, constant_exponent: bool, out: usize, k: usize) -> f64 {
         let m = &self.main;
-        let value = match tape.ops[r] {
-            Op::Const(c) => {
-                if k == 0 {
-                    c
-                } else {
-                    0.0
-                }
+        let kf = k as f64;
+        if constant_exponent {
+            if k == 0 {
+                return m[a].powf(m[b]);
             }
-            Op::Input(i) => inputs[i as usize * w + k],
-            Op::Add(a, b) => m[at(a) + k] + m[at(b) + k],
-            Op::Sub(a, b) => m[at(a) + k] - m[at(b) + k],
-            Op::Neg(a) => -m[at(a) + k],
-            // A constant factor or divisor scales; the general case convolves.
-            Op::Mul(a, b) if constant(tape, a) => m[at(a)] * m[at(b) + k],
-            Op::Mul(a, b) if constant(tape, b) => m[at(a) + k] * m[at(b)],
-            Op::Mul(a, b) => conv(m, at(a), m, at(b), k, 0, one),
-            Op::Div(a, b) if constant(tape, b) => m[at(a) + k] / m[at(b)],
-            Op::Div(a, b) => {
-                let sum = if k == 0 {
-                    0.0
-                } else {
-                    conv(m, at(b), m, out, k, 1, one)
-                };
-                (m[at(a) + k] - sum) / m[at(b)]
-            }
-            Op::Pow(a, b) if k == 0 && constant(tape, b) => m[at(a)].powf(m[at(b)]),
-            Op::Pow(a, b) if constant(tape, b) => {
-                // a p' = c a' p.
-                let c = m[at(b)];
-                let sum = conv(m, at(a), m, out, k, 1, |j| c * j as f64 - (k - j) as f64);
-                sum / (kf * m[at(a)])
-            }
-            Op::Pow(a, b) => {
-                // exp(b log a): aux 0 holds log a, aux 1 holds b log a.
-                let log = log_coefficient(m, at(a), &self.aux[0], out, k);
-                self.aux[0][out + k] = log;
-                let product = conv(m, at(b), &self.aux[0], out, k, 0, one);
-                self.aux[1][out + k] = product;
-                if k == 0 {
-                    m[at(a)].powf(m[at(b)])
-                } else {
-                    conv(&self.aux[1], out, m, out, k, 1, index) / kf
-                }
-            }
-            Op::Call(f, a) => self.call(f, at(a), out, k),
-            Op::Call2(f, a, b) => self.call2(f, at(a), at(b), out, k),
-        };
-        self.main[out + k] = value;
+            // a p' = c a' p.
+            let c = m[b];
+            let sum = conv(m, a, m, out, k, 1, |j| c * j as f64 - (k - j) as f64);
+            return sum / (kf * m[a]);
+        }
+        // exp(b log a): aux 0 holds log a, aux 1 holds b log a.
+        let log = log_coefficient(m, a, &self.aux[0], out, k);
+        self.aux[0][out + k] = log;
+        let product = conv(m, b, &self.aux[0], out, k, 0, |_| 1.0);
+        self.aux[1][out + k] = product;
+        if k == 0 {
+            m[a].powf(m[b])
+        } else {
+            conv(&self.aux[1], out, m, out, k, 1, |j| j as f64) / kf
+        }
     }
 
     /// Coefficient `k` of `f(a)`, keeping its helper series.
@@ -142,13 +279,7 @@ impl Series {
         let kf = k as f64;
         let a0 = m[a];
         // sum_{j=1}^{k} j a_j y_{k-j}: the coefficient k - 1 of a' y.
-        let slope_times = |y: &[f64]| -> f64 {
-            let mut sum = 0.0;
-            for j in 1..=k {
-                sum += j as f64 * m[a + j] * y[out + k - j];
-            }
-            sum
-        };
+        let slope_times = |y: &[f64]| slopes_times(&m[a..=a + k], &y[out..out + k], &[]).0;
         // sum_{j=1}^{k-1} j y_j z_{k-j}: the part of (z y')_(k-1) below y_k.
         let known = |y: &[f64], z: &[f64]| -> f64 {
             let mut sum = 0.0;
@@ -177,10 +308,9 @@ impl Series {
                     return value;
                 }
                 // s' = a' c, c' = -+ a' s (minus for the circular cos).
-                let partner_series = &aux[..];
-                let main_series = m;
-                let value_from_partner = slope_times(partner_series) / kf;
-                let partner_from_value = slope_times(main_series) / kf;
+                let (from_partner, from_value) =
+                    slopes_times(&m[a..=a + k], &aux[out..out + k], &m[out..out + k]);
+                let (value_from_partner, partner_from_value) = (from_partner / kf, from_value / kf);
                 let sign = if hyperbolic { 1.0 } else { -1.0 };
                 // For sin: value' = a' partner, partner' = -a' value.
                 // For cos: value' = -a' partner, partner' = a' value.
@@ -306,11 +436,33 @@ fn conv(
     lo: usize,
     weight: impl Fn(usize) -> f64,
 ) -> f64 {
+    // Sliced first, so that the loop needs no bounds checks.
+    let (x, y) = (&x[xs + lo..=xs + k], &y[ys..=ys + k - lo]);
     let mut sum = 0.0;
-    for j in lo..=k {
-        sum += weight(j) * x[xs + j] * y[ys + k - j];
+    for (j, (a, b)) in x.iter().zip(y.iter().rev()).enumerate() {
+        sum += weight(lo + j) * a * b;
     }
     sum
+}
+
+/// `sum_{j=1}^{k} j a_j y_{k-j}` and the same with `z` (if given: empty
+/// for none), `k + 1 = a.len()`, `y` and `z` holding orders `0..k`: the
+/// coefficient `k - 1` of `a' y` and `a' z`, in one pass.
+#[inline(always)]
+fn slopes_times(a: &[f64], y: &[f64], z: &[f64]) -> (f64, f64) {
+    let (mut with_y, mut with_z) = (0.0, 0.0);
+    let rates = a.iter().enumerate().skip(1).map(|(j, a)| j as f64 * a);
+    if z.is_empty() {
+        for (rate, y) in rates.zip(y.iter().rev()) {
+            with_y += rate * y;
+        }
+    } else {
+        for ((rate, y), z) in rates.zip(y.iter().rev()).zip(z.iter().rev()) {
+            with_y += rate * y;
+            with_z += rate * z;
+        }
+    }
+    (with_y, with_z)
 }
 
 /// Coefficient `k` of `log a` (`a` at `a_at` in `a_series`), its earlier
@@ -404,6 +556,30 @@ mod tests {
         for (k, &c) in out.iter().enumerate() {
             let want = (k + 1) as f64 * (-0.5f64).powi(k as i32);
             assert!((c - want).abs() < 1e-14 * want.abs(), "{k}: {c} vs {want}");
+        }
+    }
+
+    /// One scratch serves every tape of a thread: what an earlier series
+    /// left in it (longer tapes, constants where the next has a product,
+    /// higher orders) changes nothing.
+    #[test]
+    fn a_scratch_reused_across_tapes_expands_as_a_fresh_one() {
+        let tapes = [
+            tape(&["v * c + 2", "-sin(x) + c"], &["x", "v"]),
+            tape(&["x * v", "x / (1 + v^2) - exp(v) * cos(x)"], &["x", "v"]),
+            tape(&["v", "-x"], &["x", "v"]),
+        ];
+        let mut shared = Series::default();
+        for (order, t) in [
+            (24, &tapes[0]),
+            (12, &tapes[1]),
+            (20, &tapes[2]),
+            (24, &tapes[1]),
+        ] {
+            let (mut reused, mut fresh) = (vec![0.0; 2 * (order + 1)], vec![0.0; 2 * (order + 1)]);
+            shared.flow(t, &[0.4, -0.3], order, &mut reused);
+            Series::default().flow(t, &[0.4, -0.3], order, &mut fresh);
+            assert_eq!(reused, fresh, "order {order}");
         }
     }
 
