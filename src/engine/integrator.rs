@@ -217,6 +217,16 @@ impl Integrator {
         }
     }
 
+    /// The state at `tau` into the last step, to working precision: what
+    /// a linearisation of the step samples (Taylor's series summed without
+    /// compensation; the other methods' dense output as [`Integrator::eval`]).
+    pub fn sample(&self, tau: f64, x: &mut [f64]) {
+        match self {
+            Integrator::Taylor(m) => m.sample(tau, x),
+            _ => self.eval(tau, x),
+        }
+    }
+
     /// The state at the end of the last step.
     pub fn end(&self, x: &mut [f64]) {
         match self {

@@ -965,7 +965,7 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
                 let local = self.local_error() * (tau / h).min(1.0);
                 let step = &self.integrator;
                 self.bound
-                    .after_step(model, mode, tau, local, |s, x| step.eval(s, x));
+                    .after_step(model, mode, tau, local, |s, x| step.sample(s, x));
             }
             Motion::Exact => self.bound.after_exact(model, mode, &self.state, tau),
             _ => {}

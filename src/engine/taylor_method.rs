@@ -29,7 +29,7 @@ use crate::engine::adaptive::{StepFailure, Tolerances};
 use crate::engine::locate::{Start, StepScan};
 use crate::engine::model::{Direction, HybridModel, Mode};
 use crate::numerics::first_crossing::{eval2, first_fall};
-use crate::numerics::polynomial::eval_compensated;
+use crate::numerics::polynomial::{eval, eval_compensated};
 
 /// The tolerance `taylor` takes unless told: machine epsilon, as heyoka.
 pub const DEFAULT_TOLERANCE: f64 = f64::EPSILON;
@@ -48,8 +48,11 @@ pub struct Taylor {
     guard: Vec<f64>,
     h: f64,
     local_error: f64,
-    /// Scratch: the state at a step's end, and the flow there.
+    /// The state at a step's end (scratch for the step's check), and the
+    /// flow there.
     end: Vec<f64>,
+    /// Whether `end` holds the accepted step's end.
+    end_known: bool,
     rate: Vec<f64>,
     /// Series asked of the model (flows and guards).
     evaluations: u64,
@@ -68,6 +71,7 @@ impl Taylor {
             h: 0.0,
             local_error: 0.0,
             end: vec![0.0; dimension],
+            end_known: false,
             rate: vec![0.0; dimension],
             evaluations: 0,
         }
@@ -92,6 +96,7 @@ impl Taylor {
     ) -> Result<(), StepFailure> {
         let p = self.order;
         let w = p + 1;
+        self.end_known = false;
         model.flow_series(mode, y0, p, &mut self.series);
         self.evaluations += 1;
         if !self.series.iter().all(|c| c.is_finite()) {
@@ -200,6 +205,7 @@ impl Taylor {
             (slope - fi).abs() * h <= tolerance + 16.0 * f64::EPSILON * size * h
         });
         (self.end, self.rate) = (end, rate);
+        self.end_known = solves;
         solves
     }
 
@@ -218,9 +224,23 @@ impl Taylor {
         }
     }
 
-    /// The state at the end of the step.
+    /// The state at the end of the step (found by the step's own check of
+    /// its series, where the flow has a right-hand side).
     pub fn end(&self, x: &mut [f64]) {
-        self.eval(self.h, x);
+        if self.end_known {
+            x.copy_from_slice(&self.end);
+        } else {
+            self.eval(self.h, x);
+        }
+    }
+
+    /// The state at `tau` into the step to working precision (plain
+    /// Horner, fused): what a linearisation of the step samples, which
+    /// needs none of [`Taylor::eval`]'s compensation.
+    pub fn sample(&self, tau: f64, x: &mut [f64]) {
+        for (xi, c) in x.iter_mut().zip(self.series.chunks_exact(self.order + 1)) {
+            *xi = eval(c, tau);
+        }
     }
 
     /// The last term kept, at the step's length.

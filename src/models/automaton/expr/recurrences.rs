@@ -437,10 +437,11 @@ fn conv(
     weight: impl Fn(usize) -> f64,
 ) -> f64 {
     // Sliced first, so that the loop needs no bounds checks.
-    let (x, y) = (&x[xs + lo..=xs + k], &y[ys..=ys + k - lo]);
+    let n = k + 1 - lo;
+    let (x, y) = (&x[xs + lo..xs + lo + n], &y[ys..ys + n]);
     let mut sum = 0.0;
-    for (j, (a, b)) in x.iter().zip(y.iter().rev()).enumerate() {
-        sum += weight(lo + j) * a * b;
+    for j in 0..n {
+        sum += weight(lo + j) * x[j] * y[n - 1 - j];
     }
     sum
 }
@@ -451,15 +452,18 @@ fn conv(
 #[inline(always)]
 fn slopes_times(a: &[f64], y: &[f64], z: &[f64]) -> (f64, f64) {
     let (mut with_y, mut with_z) = (0.0, 0.0);
-    let rates = a.iter().enumerate().skip(1).map(|(j, a)| j as f64 * a);
+    let k = y.len();
+    let (a, y) = (&a[..k + 1], &y[..k]);
     if z.is_empty() {
-        for (rate, y) in rates.zip(y.iter().rev()) {
-            with_y += rate * y;
+        for j in 1..=k {
+            with_y += j as f64 * a[j] * y[k - j];
         }
     } else {
-        for ((rate, y), z) in rates.zip(y.iter().rev()).zip(z.iter().rev()) {
-            with_y += rate * y;
-            with_z += rate * z;
+        let z = &z[..k];
+        for j in 1..=k {
+            let rate = j as f64 * a[j];
+            with_y += rate * y[k - j];
+            with_z += rate * z[k - j];
         }
     }
     (with_y, with_z)
