@@ -29,22 +29,20 @@ pub struct Series {
     main: Vec<f64>,
     /// First and second helper series of each register.
     aux: [Vec<f64>; 2],
-    /// The tape lowered for the orders' loop.
+    /// The tape lowered for the orders' loop (its constants and inputs
+    /// aside).
     program: Vec<Step>,
+    /// Each input register: where its input's coefficients start among the
+    /// inputs', and where its own do.
+    loads: Vec<(usize, usize)>,
 }
 
 /// One instruction as the orders' loop runs it: offsets into the
 /// coefficients resolved, constant operands told apart once per series
-/// instead of once per order, constants written before the loop.
+/// instead of once per order. Constants are written before the loop and
+/// inputs copied in as they become known, outside it.
 #[derive(Debug, Clone, Copy)]
 enum Step {
-    /// A constant, already in place.
-    Done,
-    /// Input `from` (an offset into the inputs' coefficients).
-    Input {
-        from: usize,
-        out: usize,
-    },
     Add {
         a: usize,
         b: usize,
@@ -120,15 +118,19 @@ impl Series {
         let w = self.width;
         let at = |reg: u32| reg as usize * w;
         self.program.clear();
+        self.loads.clear();
         for (r, &op) in tape.ops.iter().enumerate() {
             let out = r * w;
             self.program.push(match op {
                 Op::Const(c) => {
                     self.main[out..out + w].fill(0.0);
                     self.main[out] = c;
-                    Step::Done
+                    continue;
                 }
-                Op::Input(i) => Step::Input { from: at(i), out },
+                Op::Input(i) => {
+                    self.loads.push((at(i), out));
+                    continue;
+                }
                 Op::Add(a, b) => Step::Add {
                     a: at(a),
                     b: at(b),
@@ -185,12 +187,10 @@ impl Series {
     /// Coefficient `k` of every register, in order, their operands known to
     /// order `k`.
     #[inline]
-    fn order(&mut self, k: usize, inputs: &[f64]) {
+    fn order(&mut self, k: usize) {
         for i in 0..self.program.len() {
             let m = &mut self.main;
             match self.program[i] {
-                Step::Done => {}
-                Step::Input { from, out } => m[out + k] = inputs[from + k],
                 Step::Add { a, b, out } => m[out + k] = m[a + k] + m[b + k],
                 Step::Sub { a, b, out } => m[out + k] = m[a + k] - m[b + k],
                 Step::Neg { a, out } => m[out + k] = -m[a + k],
@@ -228,7 +228,10 @@ impl Series {
             out[i * w] = x;
         }
         for k in 0..=order {
-            self.order(k, out);
+            for &(from, to) in &self.loads {
+                self.main[to + k] = out[from + k];
+            }
+            self.order(k);
             if k < order {
                 for (i, &o) in tape.outputs.iter().enumerate() {
                     out[i * w + k + 1] = self.main[o as usize * w + k] / (k + 1) as f64;
@@ -241,8 +244,12 @@ impl Series {
     /// (laid out as [`Series::flow`] writes them), into `out` (`order + 1`).
     pub fn compose(&mut self, tape: &Tape, inputs: &[f64], order: usize, out: &mut [f64]) {
         self.prepare(tape, order);
+        let w = self.width;
+        for &(from, to) in &self.loads {
+            self.main[to..to + w].copy_from_slice(&inputs[from..from + w]);
+        }
         for k in 0..=order {
-            self.order(k, inputs);
+            self.order(k);
         }
         let o = tape.outputs[0] as usize * self.width;
         out[..=order].copy_from_slice(&self.main[o..o + order + 1]);
