@@ -143,6 +143,7 @@ impl Tangents {
                     *o = tau * a;
                 }
             }
+            without_clock(n, model.clock(), &mut x);
             exp(n, &x, out, &mut first, &mut second);
             match &mut self.linear_tangent {
                 Some((known, tangent)) => {
@@ -174,6 +175,7 @@ impl Tangents {
                 for (o, j) in x.iter_mut().zip(first.iter()) {
                     *o = tau * j;
                 }
+                without_clock(n, model.clock(), &mut x);
                 exp(n, &x, out, &mut first, &mut second);
             } else {
                 let mut piece = std::mem::take(&mut self.d);
@@ -185,6 +187,7 @@ impl Tangents {
                     for (o, j) in x.iter_mut().zip(first.iter()) {
                         *o = h * j;
                     }
+                    without_clock(n, model.clock(), &mut x);
                     exp(n, &x, &mut piece, &mut first, &mut second);
                     if k == 0 {
                         out.copy_from_slice(&piece);
@@ -311,6 +314,20 @@ impl Tangents {
         self.up = rate_before;
         self.down = rate_after;
         (closing, largest_jump)
+    }
+}
+
+/// Clear the clock's column of the row-major `n x n` generator `a`. The
+/// clock carries no error (its row of every map is cleared, see
+/// `ErrorSet`), so what its column would feed into the state multiplies
+/// nothing; without it a forced flow's clock decouples, and [`exp`] takes
+/// the exponential of the state's block alone (a forced oscillator's is
+/// then the 2 x 2 closed form).
+fn without_clock(n: usize, clock: Option<usize>, a: &mut [f64]) {
+    if let Some(c) = clock.filter(|&c| c < n) {
+        for row in a[..n * n].chunks_exact_mut(n) {
+            row[c] = 0.0;
+        }
     }
 }
 
