@@ -46,7 +46,18 @@ impl Parallelepiped {
     /// Carry the set through `m` (row-major), clearing component `exact`,
     /// and add a local error box of half-width `local` in the others.
     pub(super) fn map(&mut self, m: &[f64], local: f64, exact: Option<usize>) {
-        let n = self.n;
+        // The usual sizes get their own copy of the body, its loops of known
+        // length unrolled: the map runs at every step.
+        match self.n {
+            2 => self.map_sized(2, m, local, exact),
+            3 => self.map_sized(3, m, local, exact),
+            4 => self.map_sized(4, m, local, exact),
+            n => self.map_sized(n, m, local, exact),
+        }
+    }
+
+    #[inline(always)]
+    fn map_sized(&mut self, n: usize, m: &[f64], local: f64, exact: Option<usize>) {
         let mut product = [0.0; TRACKED * TRACKED];
         // product = m * basis, column-major.
         for j in 0..n {
