@@ -143,6 +143,7 @@ fn direction(v: &[f64]) -> Option<(f64, f64)> {
 /// in `order`, completed by unit vectors where `m` is rank-deficient (a
 /// reset that collapses a direction). Gram-Schmidt twice over, which keeps
 /// `q` orthogonal to round-off for the small `n` tracked.
+#[inline(always)]
 fn orthonormalize(n: usize, m: &[f64], order: &[usize], q: &mut [f64]) {
     let mut filled = 0;
     let mut candidate = [0.0; TRACKED];
