@@ -428,19 +428,25 @@ fn falls(
 /// B s^2` with `B = sum_{k >= 2} max(0, -c_k) h^(k - 2)` (`s^k <= s^2 h^(k -
 /// 2)`), which is smallest at an end of the step and keeps a rising start.
 fn stays_above(c: &[f64], h: f64, level: f64) -> bool {
-    let pulls = |from: usize| {
-        c.iter()
-            .skip(from)
-            .rev()
-            .fold(0.0, |acc, x| (acc + x.min(0.0)) * h)
+    // from_two = sum_{k >= 2} min(0, c_k) h^(k - 1), by Horner from the top;
+    // one step more gives the sum from k = 1, the same fold it ends.
+    let from_two = c
+        .iter()
+        .skip(2)
+        .rev()
+        .fold(0.0, |acc, x| (acc + x.min(0.0)) * h);
+    let (c0, c1) = (c[0], c.get(1).copied().unwrap_or(0.0));
+    let from_one = if c.len() > 1 {
+        (from_two + c1.min(0.0)) * h
+    } else {
+        0.0
     };
     let margin = 1.0 + 1e-12;
-    if c[0] + pulls(1) * margin > level {
+    if c0 + from_one * margin > level {
         return true;
     }
-    let (c0, c1) = (c[0], c.get(1).copied().unwrap_or(0.0));
-    // pulls(2) is sum_{k >= 2} min(0, c_k) h^(k - 1), so B h^2 is h times it.
-    let end = c0 + c1 * h + pulls(2) * h * margin;
+    // B h^2 is h times from_two.
+    let end = c0 + c1 * h + from_two * h * margin;
     c0 > level && end > level
 }
 
