@@ -111,9 +111,12 @@ impl Series {
         let len = tape.ops.len() * self.width;
         let [aux0, aux1] = &mut self.aux;
         // Every coefficient is written before it is read (a constant's
-        // here), so what a buffer held before needs no clearing.
+        // here), so what a buffer held before needs no clearing; nor does
+        // a buffer shrink (a flow's series and a guard's alternate).
         for buffer in [&mut self.main, aux0, aux1] {
-            buffer.resize(len, 0.0);
+            if buffer.len() < len {
+                buffer.resize(len, 0.0);
+            }
         }
         let w = self.width;
         let at = |reg: u32| reg as usize * w;
