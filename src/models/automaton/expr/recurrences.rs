@@ -18,7 +18,7 @@
 //! method that trusts a whole step to one series must not take them (see
 //! [`Tape::smooth`]).
 
-use crate::models::automaton::expr::tape::{Fun, Fun2, Op, Tape};
+use crate::models::automaton::expr::tape::{Fun, Fun2, Op, Reg, Tape};
 
 /// Scratch for the series of one tape.
 #[derive(Debug, Clone, Default)]
@@ -43,66 +43,31 @@ pub struct Series {
 /// inputs copied in as they become known, outside it.
 #[derive(Debug, Clone, Copy)]
 enum Step {
-    Add {
-        a: usize,
-        b: usize,
-        out: usize,
-    },
-    Sub {
-        a: usize,
-        b: usize,
-        out: usize,
-    },
-    Neg {
-        a: usize,
-        out: usize,
-    },
+    Add(At),
+    Sub(At),
+    Neg(At),
     /// `a * b`, `a` constant.
-    ScaledRight {
-        a: usize,
-        b: usize,
-        out: usize,
-    },
+    ScaledRight(At),
     /// `a * b`, `b` constant.
-    ScaledLeft {
-        a: usize,
-        b: usize,
-        out: usize,
-    },
-    Mul {
-        a: usize,
-        b: usize,
-        out: usize,
-    },
+    ScaledLeft(At),
+    Mul(At),
     /// `a / b`, `b` constant.
-    DivConst {
-        a: usize,
-        b: usize,
-        out: usize,
-    },
-    Div {
-        a: usize,
-        b: usize,
-        out: usize,
-    },
-    /// `a^b`, and whether `b` is constant.
-    Pow {
-        a: usize,
-        b: usize,
-        constant: bool,
-        out: usize,
-    },
-    Call {
-        f: Fun,
-        a: usize,
-        out: usize,
-    },
-    Call2 {
-        f: Fun2,
-        a: usize,
-        b: usize,
-        out: usize,
-    },
+    DivConst(At),
+    Div(At),
+    /// `a^b`, `b` constant.
+    PowConst(At),
+    Pow(At),
+    Call(Fun, At),
+    Call2(Fun2, At),
+}
+
+/// Where a [`Step`] reads and writes: the offsets of its operands'
+/// coefficients and of its own (`b` is `a` for one operand).
+#[derive(Debug, Clone, Copy)]
+struct At {
+    a: usize,
+    b: usize,
+    out: usize,
 }
 
 impl Series {
@@ -119,11 +84,15 @@ impl Series {
             }
         }
         let w = self.width;
-        let at = |reg: u32| reg as usize * w;
         self.program.clear();
         self.loads.clear();
         for (r, &op) in tape.ops.iter().enumerate() {
             let out = r * w;
+            let at = |a: Reg, b: Reg| At {
+                a: a as usize * w,
+                b: b as usize * w,
+                out,
+            };
             self.program.push(match op {
                 Op::Const(c) => {
                     self.main[out..out + w].fill(0.0);
@@ -131,58 +100,21 @@ impl Series {
                     continue;
                 }
                 Op::Input(i) => {
-                    self.loads.push((at(i), out));
+                    self.loads.push((i as usize * w, out));
                     continue;
                 }
-                Op::Add(a, b) => Step::Add {
-                    a: at(a),
-                    b: at(b),
-                    out,
-                },
-                Op::Sub(a, b) => Step::Sub {
-                    a: at(a),
-                    b: at(b),
-                    out,
-                },
-                Op::Neg(a) => Step::Neg { a: at(a), out },
-                Op::Mul(a, b) if constant(tape, a) => Step::ScaledRight {
-                    a: at(a),
-                    b: at(b),
-                    out,
-                },
-                Op::Mul(a, b) if constant(tape, b) => Step::ScaledLeft {
-                    a: at(a),
-                    b: at(b),
-                    out,
-                },
-                Op::Mul(a, b) => Step::Mul {
-                    a: at(a),
-                    b: at(b),
-                    out,
-                },
-                Op::Div(a, b) if constant(tape, b) => Step::DivConst {
-                    a: at(a),
-                    b: at(b),
-                    out,
-                },
-                Op::Div(a, b) => Step::Div {
-                    a: at(a),
-                    b: at(b),
-                    out,
-                },
-                Op::Pow(a, b) => Step::Pow {
-                    a: at(a),
-                    b: at(b),
-                    constant: constant(tape, b),
-                    out,
-                },
-                Op::Call(f, a) => Step::Call { f, a: at(a), out },
-                Op::Call2(f, a, b) => Step::Call2 {
-                    f,
-                    a: at(a),
-                    b: at(b),
-                    out,
-                },
+                Op::Add(a, b) => Step::Add(at(a, b)),
+                Op::Sub(a, b) => Step::Sub(at(a, b)),
+                Op::Neg(a) => Step::Neg(at(a, a)),
+                Op::Mul(a, b) if constant(tape, a) => Step::ScaledRight(at(a, b)),
+                Op::Mul(a, b) if constant(tape, b) => Step::ScaledLeft(at(a, b)),
+                Op::Mul(a, b) => Step::Mul(at(a, b)),
+                Op::Div(a, b) if constant(tape, b) => Step::DivConst(at(a, b)),
+                Op::Div(a, b) => Step::Div(at(a, b)),
+                Op::Pow(a, b) if constant(tape, b) => Step::PowConst(at(a, b)),
+                Op::Pow(a, b) => Step::Pow(at(a, b)),
+                Op::Call(f, a) => Step::Call(f, at(a, a)),
+                Op::Call2(f, a, b) => Step::Call2(f, at(a, b)),
             });
         }
     }
@@ -194,14 +126,14 @@ impl Series {
         for i in 0..self.program.len() {
             let m = &mut self.main;
             match self.program[i] {
-                Step::Add { a, b, out } => m[out + k] = m[a + k] + m[b + k],
-                Step::Sub { a, b, out } => m[out + k] = m[a + k] - m[b + k],
-                Step::Neg { a, out } => m[out + k] = -m[a + k],
-                Step::ScaledRight { a, b, out } => m[out + k] = m[a] * m[b + k],
-                Step::ScaledLeft { a, b, out } => m[out + k] = m[a + k] * m[b],
-                Step::Mul { a, b, out } => m[out + k] = conv(m, a, m, b, k, 0, |_| 1.0),
-                Step::DivConst { a, b, out } => m[out + k] = m[a + k] / m[b],
-                Step::Div { a, b, out } => {
+                Step::Add(At { a, b, out }) => m[out + k] = m[a + k] + m[b + k],
+                Step::Sub(At { a, b, out }) => m[out + k] = m[a + k] - m[b + k],
+                Step::Neg(At { a, out, .. }) => m[out + k] = -m[a + k],
+                Step::ScaledRight(At { a, b, out }) => m[out + k] = m[a] * m[b + k],
+                Step::ScaledLeft(At { a, b, out }) => m[out + k] = m[a + k] * m[b],
+                Step::Mul(At { a, b, out }) => m[out + k] = conv(m, a, m, b, k, 0, |_| 1.0),
+                Step::DivConst(At { a, b, out }) => m[out + k] = m[a + k] / m[b],
+                Step::Div(At { a, b, out }) => {
                     let sum = if k == 0 {
                         0.0
                     } else {
@@ -209,14 +141,14 @@ impl Series {
                     };
                     m[out + k] = (m[a + k] - sum) / m[b];
                 }
-                Step::Pow {
-                    a,
-                    b,
-                    constant,
-                    out,
-                } => self.main[out + k] = self.pow(a, b, constant, out, k),
-                Step::Call { f, a, out } => self.main[out + k] = self.call(f, a, out, k),
-                Step::Call2 { f, a, b, out } => self.main[out + k] = self.call2(f, a, b, out, k),
+                Step::PowConst(At { a, b, out }) => {
+                    self.main[out + k] = self.pow(a, b, true, out, k)
+                }
+                Step::Pow(At { a, b, out }) => self.main[out + k] = self.pow(a, b, false, out, k),
+                Step::Call(f, At { a, out, .. }) => self.main[out + k] = self.call(f, a, out, k),
+                Step::Call2(f, At { a, b, out }) => {
+                    self.main[out + k] = self.call2(f, a, b, out, k)
+                }
             }
         }
     }
