@@ -253,7 +253,8 @@ impl Tangents {
         }
     }
 
-    /// The gradient of `guard` in `mode` at `x`.
+    /// The gradient of `guard` in `mode` at `x`: the model's, where it
+    /// knows it exactly, else central differences.
     pub fn gradient<M: HybridModel + ?Sized>(
         &mut self,
         model: &M,
@@ -262,6 +263,9 @@ impl Tangents {
         x: &[f64],
         out: &mut [f64],
     ) {
+        if model.guard_gradient(mode, guard, x, out) {
+            return;
+        }
         self.x.copy_from_slice(x);
         for j in 0..self.n {
             let h = step_for(x[j]);

@@ -94,12 +94,16 @@ impl Parallelepiped {
         let mut radii = [0.0; TRACKED];
         for (a, r) in radii[..n].iter_mut().enumerate() {
             let qa = &q[a * n..(a + 1) * n];
-            let carried: f64 = (0..n)
-                .map(|j| {
-                    let dot: f64 = (0..n).map(|i| qa[i] * product[j * n + i]).sum();
-                    dot.abs() * self.radii[j]
-                })
-                .sum();
+            // Loops, not iterator sums, so that they unroll with the rest
+            // (the same sums: f64's start from -0.0).
+            let mut carried = -0.0;
+            for j in 0..n {
+                let mut dot = -0.0;
+                for i in 0..n {
+                    dot += qa[i] * product[j * n + i];
+                }
+                carried += dot.abs() * self.radii[j];
+            }
             let mut spread: f64 = qa.iter().map(|x| x.abs()).sum();
             if let Some(c) = exact {
                 spread -= qa[c].abs();
