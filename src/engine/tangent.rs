@@ -279,8 +279,9 @@ impl Tangents {
     }
 
     /// The saltation matrix of `guard`'s event at `before` in `mode`, into
-    /// `out` ([`saltation::matrix`]), the reset's Jacobian by central
-    /// differences: the closing speed and the largest jump of the rate.
+    /// `out` ([`saltation::matrix`]), the reset's Jacobian the model's or
+    /// central differences: the closing speed and the largest jump of the
+    /// rate.
     #[allow(clippy::too_many_arguments)]
     pub fn saltation<M: HybridModel + ?Sized>(
         &mut self,
@@ -295,8 +296,9 @@ impl Tangents {
     ) -> (f64, f64) {
         let n = self.n;
         let mut reset = std::mem::take(&mut self.a);
-        // The reset's Jacobian, by central differences.
-        for j in 0..n {
+        // The reset's Jacobian: the model's, else central differences.
+        let exact = model.reset_jacobian(mode, guard, before, &mut reset[..n * n]);
+        for j in (0..n).filter(|_| !exact) {
             let h = step_for(before[j]);
             self.up.copy_from_slice(before);
             self.up[j] += h;

@@ -468,8 +468,18 @@ impl HybridModel for Automaton {
         if reset.targets.is_empty() {
             return true;
         }
-        let mut rows = vec![0.0; reset.targets.len() * n];
-        jacobian_into(&reset.tape, x, &mut rows);
+        // The rows of the states it sets, on the stack where they fit (an
+        // event's saltation asks at every event).
+        let size = reset.targets.len() * n;
+        let mut small = [0.0; 64];
+        let mut large = Vec::new();
+        let rows = if size <= small.len() {
+            &mut small[..size]
+        } else {
+            large.resize(size, 0.0);
+            &mut large[..]
+        };
+        jacobian_into(&reset.tape, x, rows);
         for (k, &i) in reset.targets.iter().enumerate() {
             out[i * n..(i + 1) * n].copy_from_slice(&rows[k * n..(k + 1) * n]);
         }
