@@ -394,7 +394,7 @@ fn exp_dense(n: usize, a: &[f64], out: &mut [f64], scratch: &mut [f64]) {
 }
 
 /// Scratch matrices [`exp`] needs.
-pub const EXP_SCRATCH: usize = 4;
+const EXP_SCRATCH: usize = 4;
 
 #[inline(always)]
 fn exp_sized(n: usize, a: &[f64], out: &mut [f64], scratch: &mut [f64]) {
