@@ -28,7 +28,8 @@ use crate::engine::periodic::Returns;
 use crate::engine::queue::EventQueue;
 use crate::engine::run::{Options, Outcome, Status};
 use crate::engine::run_loop::{End, Segments, drive, end_window};
-use crate::numerics::central_difference::{CBRT_EPSILON, step_for};
+use crate::engine::tangent::guard_gradient;
+use crate::numerics::central_difference::CBRT_EPSILON;
 use crate::time::Time;
 
 /// The state at one of the sample times a run was asked for.
@@ -754,8 +755,8 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
         let model = self.model;
         let (mut a, mut b) = std::mem::take(&mut self.rates);
         let mut probe = std::mem::take(&mut self.probe);
-        normal(model, from, slot, &self.before, &mut a, &mut probe);
-        normal(model, self.mode, g, &self.state, &mut b, &mut probe);
+        guard_gradient(model, from, slot, &self.before, &mut a, &mut probe);
+        guard_gradient(model, self.mode, g, &self.state, &mut b, &mut probe);
         let dot: f64 = a.iter().zip(&b).map(|(x, y)| x * y).sum();
         let norms = a.iter().map(|x| x * x).sum::<f64>() * b.iter().map(|y| y * y).sum::<f64>();
         (self.rates, self.probe) = ((a, b), probe);
@@ -791,7 +792,7 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
             0.0
         };
         let mut gradient = std::mem::take(&mut self.gradient);
-        normal(model, mode, g, x, &mut gradient, &mut probe);
+        guard_gradient(model, mode, g, x, &mut gradient, &mut probe);
         self.probe = probe;
         let scale: f64 = gradient.iter().zip(x).map(|(d, v)| (d * v).abs()).sum();
         self.gradient = gradient;
@@ -1267,31 +1268,6 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
 /// Rounding a step makes, in ulps of the state's size: a few roundings of
 /// each stage's or term's sum.
 pub const STEP_ROUNDING_ULPS: f64 = 4.0;
-
-/// The gradient of guard `g` of `mode` at `x` into `out`: the model's, or
-/// central differences (`probe` is scratch of the state's length).
-fn normal<M: HybridModel + ?Sized>(
-    model: &M,
-    mode: Mode,
-    g: usize,
-    x: &[f64],
-    out: &mut [f64],
-    probe: &mut [f64],
-) {
-    if model.guard_gradient(mode, g, x, out) {
-        return;
-    }
-    probe.copy_from_slice(x);
-    for j in 0..x.len() {
-        let h = step_for(x[j]);
-        probe[j] = x[j] + h;
-        let up = model.guard(mode, g, probe);
-        probe[j] = x[j] - h;
-        let down = model.guard(mode, g, probe);
-        probe[j] = x[j];
-        out[j] = (up - down) / (2.0 * h);
-    }
-}
 
 /// The largest component of `x` but the clock, and at least one: the
 /// scale differences and rounding are measured against.

@@ -10,7 +10,7 @@
 //!
 //! [`ErrorSet`]: crate::engine::error_set::ErrorSet
 
-use crate::engine::error_set::TRACKED;
+use crate::engine::error_set::{TRACKED, unrolled};
 use crate::engine::model::{Flow, HybridModel, Mode};
 use crate::engine::saltation;
 use crate::numerics::central_difference::step_for;
@@ -253,8 +253,7 @@ impl Tangents {
         }
     }
 
-    /// The gradient of `guard` in `mode` at `x`: the model's, where it
-    /// knows it exactly, else central differences.
+    /// The gradient of `guard` in `mode` at `x` (see [`guard_gradient`]).
     pub fn gradient<M: HybridModel + ?Sized>(
         &mut self,
         model: &M,
@@ -263,19 +262,7 @@ impl Tangents {
         x: &[f64],
         out: &mut [f64],
     ) {
-        if model.guard_gradient(mode, guard, x, out) {
-            return;
-        }
-        self.x.copy_from_slice(x);
-        for j in 0..self.n {
-            let h = step_for(x[j]);
-            self.x[j] = x[j] + h;
-            let up = model.guard(mode, guard, &self.x);
-            self.x[j] = x[j] - h;
-            let down = model.guard(mode, guard, &self.x);
-            self.x[j] = x[j];
-            out[j] = (up - down) / (2.0 * h);
-        }
+        guard_gradient(model, mode, guard, x, out, &mut self.x);
     }
 
     /// The saltation matrix of `guard`'s event at `before` in `mode`, into
@@ -320,6 +307,32 @@ impl Tangents {
         self.up = rate_before;
         self.down = rate_after;
         (closing, largest_jump)
+    }
+}
+
+/// The gradient of `guard` in `mode` at `x` into `out`: the model's, where
+/// it knows it exactly, else central differences (`probe` is scratch of the
+/// state's length).
+pub fn guard_gradient<M: HybridModel + ?Sized>(
+    model: &M,
+    mode: Mode,
+    guard: usize,
+    x: &[f64],
+    out: &mut [f64],
+    probe: &mut [f64],
+) {
+    if model.guard_gradient(mode, guard, x, out) {
+        return;
+    }
+    probe.copy_from_slice(x);
+    for j in 0..x.len() {
+        let h = step_for(x[j]);
+        probe[j] = x[j] + h;
+        let up = model.guard(mode, guard, probe);
+        probe[j] = x[j] - h;
+        let down = model.guard(mode, guard, probe);
+        probe[j] = x[j];
+        out[j] = (up - down) / (2.0 * h);
     }
 }
 
@@ -381,15 +394,16 @@ fn exp(n: usize, a: &[f64], out: &mut [f64], scratch: &mut [f64]) {
 
 /// [`exp`] without looking for decoupled components.
 fn exp_dense(n: usize, a: &[f64], out: &mut [f64], scratch: &mut [f64]) {
-    // The usual sizes get their own copy of the body, its loops of known
-    // length unrolled: a Taylor step takes several of these.
     match n {
         0 => {}
         1 => out[0] = a[0].exp(),
         2 => exp2(a, out),
-        3 => exp_sized(3, a, out, scratch),
-        4 => exp_sized(4, a, out, scratch),
-        n => exp_sized(n, a, out, scratch),
+        // A Taylor step takes several of these.
+        n => unrolled(
+            n,
+            #[inline(always)]
+            |n| exp_sized(n, a, out, scratch),
+        ),
     }
 }
 

@@ -10,7 +10,7 @@
 //! of an orbit whose period depends on its energy), that sum swells the
 //! thin axes, which the parallelepiped beside it does not.
 
-use super::TRACKED;
+use super::{TRACKED, unrolled};
 
 /// The ellipsoid, for dimensions up to [`TRACKED`].
 #[derive(Debug, Clone)]
@@ -32,14 +32,12 @@ impl Ellipsoid {
     /// Carry the set through `m` (row-major), clearing component `exact`,
     /// and add a local error box of half-width `local` in the others.
     pub(super) fn map(&mut self, m: &[f64], local: f64, exact: Option<usize>) {
-        // The usual sizes get their own copy of the body, its loops of known
-        // length unrolled: the map runs at every step.
-        match self.n {
-            2 => self.map_sized(2, m, local, exact),
-            3 => self.map_sized(3, m, local, exact),
-            4 => self.map_sized(4, m, local, exact),
-            n => self.map_sized(n, m, local, exact),
-        }
+        // It runs at every step.
+        unrolled(
+            self.n,
+            #[inline(always)]
+            |n| self.map_sized(n, m, local, exact),
+        );
     }
 
     #[inline(always)]

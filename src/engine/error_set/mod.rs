@@ -38,6 +38,19 @@ mod parallelepiped;
 use ellipsoid::Ellipsoid;
 use parallelepiped::Parallelepiped;
 
+/// `body(n)`, with `n` a constant for the usual sizes (2, 3 and 4): each
+/// gets its own copy of an inlined body, its loops of known length
+/// unrolled. For the linear algebra a run does at every step.
+#[inline(always)]
+pub(crate) fn unrolled<R>(n: usize, body: impl FnOnce(usize) -> R) -> R {
+    match n {
+        2 => body(2),
+        3 => body(3),
+        4 => body(4),
+        n => body(n),
+    }
+}
+
 /// Largest state dimension whose errors are carried through flows and
 /// events.
 pub const TRACKED: usize = 8;

@@ -13,7 +13,7 @@
 //! each time: the wrapping effect, which the ellipsoid beside it does not
 //! have.
 
-use super::TRACKED;
+use super::{TRACKED, unrolled};
 
 /// The parallelepiped, for dimensions up to [`TRACKED`].
 #[derive(Debug, Clone)]
@@ -46,14 +46,12 @@ impl Parallelepiped {
     /// Carry the set through `m` (row-major), clearing component `exact`,
     /// and add a local error box of half-width `local` in the others.
     pub(super) fn map(&mut self, m: &[f64], local: f64, exact: Option<usize>) {
-        // The usual sizes get their own copy of the body, its loops of known
-        // length unrolled: the map runs at every step.
-        match self.n {
-            2 => self.map_sized(2, m, local, exact),
-            3 => self.map_sized(3, m, local, exact),
-            4 => self.map_sized(4, m, local, exact),
-            n => self.map_sized(n, m, local, exact),
-        }
+        // It runs at every step.
+        unrolled(
+            self.n,
+            #[inline(always)]
+            |n| self.map_sized(n, m, local, exact),
+        );
     }
 
     #[inline(always)]
