@@ -3,14 +3,17 @@
 //! same from either: a run with derivatives along some directions or
 //! samples of the state at some times ([`RunRequest`]), a periodic-orbit
 //! search or branch ([`SearchRequest`]), and a Lyapunov spectrum whose
-//! unset settings follow the scene ([`SpectrumRequest`]).
+//! unset settings follow the scene ([`SpectrumRequest`]). A tool's request
+//! resolved against its scene is a [`Prepared`] tool, which both run.
 
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
 use crate::engine::{Family, Observer};
-use crate::lyapunov;
-use crate::orbit::OrbitRequest;
+use crate::lyapunov::{self, Spectrum};
+use crate::orbit::continuation::Point;
+use crate::orbit::diagram::Column;
+use crate::orbit::{ContinuedBranch, Orbit, OrbitRequest, Watch};
 use crate::runner::{Control, Report, Trajectory};
 use crate::scene::{Scene, SceneError};
 
@@ -112,6 +115,23 @@ impl SpectrumRequest {
         lyapunov::check(family, &request).map_err(|(field, why)| SceneError::field(field, why))?;
         Ok(request)
     }
+
+    /// The spectrum asked of `scene`, ready to run: its model's family
+    /// (refused in one line, field `model`, for a scene without a finite
+    /// state) and the settings resolved against it.
+    pub fn on(
+        &self,
+        scene: &Scene,
+        stop: Option<Arc<AtomicBool>>,
+    ) -> Result<Prepared<lyapunov::Request>, SceneError> {
+        let family = scene.family()?;
+        let request = self.resolve(scene, &*family, stop)?;
+        Ok(Prepared {
+            family,
+            request,
+            t_max: scene.t_end(),
+        })
+    }
 }
 
 /// A periodic-orbit search, or a branch of them, as asked (the flags of
@@ -145,5 +165,87 @@ impl SearchRequest {
             deadline: crate::runner::deadline_in(self.wall)
                 .map_err(|why| SceneError::field("wall", why))?,
         })
+    }
+
+    /// The search asked of `scene`, ready to run: its model's family
+    /// (refused in one line, field `model`, for a scene without a finite
+    /// state) and the search's settings.
+    pub fn on(
+        &self,
+        scene: &Scene,
+        stop: Option<Arc<AtomicBool>>,
+    ) -> Result<Prepared<OrbitRequest>, SceneError> {
+        Ok(Prepared {
+            family: scene.family()?,
+            request: self.resolve(stop)?,
+            t_max: scene.t_end(),
+        })
+    }
+}
+
+/// A tool's request resolved against its scene: the scene's model as the
+/// tools see it and the settings they run with. The command line and
+/// Python both run it; they only convert what goes in and what comes out.
+pub struct Prepared<R> {
+    /// The scene's model as the tools see it.
+    pub family: Box<dyn Family>,
+    /// The tool's settings.
+    pub request: R,
+    /// The scene's `t_end`: the latest any return may come.
+    t_max: f64,
+}
+
+impl Prepared<OrbitRequest> {
+    /// The periodic orbit through the section (see [`crate::orbit::search`]).
+    pub fn orbit(&self, watch: Watch<'_>) -> Result<Orbit, SceneError> {
+        crate::orbit::search(&*self.family, &self.request, self.t_max, watch)
+    }
+
+    /// The branch of orbits followed in `parameter` to `to`, at most
+    /// `points` orbits, no step longer than `max_step` of the way (see
+    /// [`crate::orbit::follow`]); `on_point` hears of each orbit found.
+    pub fn branch(
+        &self,
+        parameter: &str,
+        to: f64,
+        steps: (usize, f64),
+        on_point: &mut dyn FnMut(&Point),
+    ) -> Result<ContinuedBranch, SceneError> {
+        crate::orbit::follow(
+            &*self.family,
+            &self.request,
+            parameter,
+            to,
+            steps,
+            self.t_max,
+            on_point,
+        )
+    }
+
+    /// The brute-force diagram at each of `values` of `parameter`: the
+    /// section's states over `events` returns after half the scene's span
+    /// (see [`crate::orbit::diagram::brute_force`]).
+    pub fn brute_force(
+        &self,
+        parameter: &str,
+        values: &[f64],
+        events: usize,
+    ) -> Result<Vec<Column>, SceneError> {
+        crate::orbit::diagram::brute_force(
+            &*self.family,
+            parameter,
+            values,
+            &self.request.guard,
+            (self.t_max / 2.0, events, self.t_max),
+            (self.request.stop.as_ref(), self.request.deadline),
+        )
+    }
+}
+
+impl Prepared<lyapunov::Request> {
+    /// The spectrum (see [`crate::lyapunov::spectrum`]); `progress` hears
+    /// of the time reached and the events so far.
+    pub fn spectrum(&self, progress: &mut dyn FnMut(f64, u64)) -> Spectrum {
+        lyapunov::spectrum(&*self.family, &self.request, progress)
     }
 }

@@ -9,7 +9,6 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use serde_json::Value;
 
-use flicker::orbit::OrbitRequest;
 use flicker::runner::Control;
 use flicker::scene::Registry;
 use flicker::session::{SearchRequest, SpectrumRequest};
@@ -202,21 +201,19 @@ fn rayon_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, String> {
         .map_err(|e| e.to_string())
 }
 
-/// The search as asked (see [`SearchRequest`]), stopped by the caller.
-fn request(
-    py: Python<'_>,
+/// The search as asked (see [`SearchRequest`]).
+fn asked(
     section: String,
     (events, settle, forcing_period): (usize, f64, Option<f64>),
     wall: f64,
-) -> PyResult<OrbitRequest> {
-    let asked = SearchRequest {
+) -> SearchRequest {
+    SearchRequest {
         section,
         events,
         settle,
         forcing_period,
         wall,
-    };
-    asked.resolve(None).map_err(|e| scene_error(py, &e))
+    }
 }
 
 /// `flicker orbit`: the JSON text of `orbit.json` for the orbit found (or
@@ -235,20 +232,14 @@ pub fn orbit(
     wall: f64,
 ) -> PyResult<String> {
     let (scene, label) = load(py, text, path)?;
-    let request = request(py, section.clone(), (events, settle, forcing_period), wall)?;
+    let asked = asked(section.clone(), (events, settle, forcing_period), wall);
     let started = std::time::Instant::now();
-    let family = scene
-        .family()
-        .map_err(|e| override_error(py, "model", e.reason))?;
     let found = interruptible(py, |stop| {
-        let request = OrbitRequest {
-            stop: Some(stop.clone()),
-            ..request.clone()
-        };
-        flicker::orbit::search(&*family, &request, scene.t_end(), Default::default())
-    })?;
-    let found =
-        found.map_err(|e| override_error(py, e.field.as_deref().unwrap_or("section"), e.reason))?;
+        asked
+            .on(&scene, Some(stop.clone()))
+            .and_then(|search| search.orbit(Default::default()))
+    })?
+    .map_err(|e| scene_error(py, &e))?;
     let json = found.to_json(Path::new(&label), &section, started.elapsed().as_secs_f64());
     Ok(json.to_string())
 }
@@ -274,27 +265,13 @@ pub fn continuation<'py>(
     wall: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (scene, _) = load(py, text, path)?;
-    let request = request(py, section, (events, settle, forcing_period), wall)?;
-    let family = scene
-        .family()
-        .map_err(|e| override_error(py, "model", e.reason))?;
-    let followed = interruptible(py, |stop| {
-        let request = OrbitRequest {
-            stop: Some(stop.clone()),
-            ..request.clone()
-        };
-        flicker::orbit::follow(
-            &*family,
-            &request,
-            &param,
-            to,
-            (points, max_step),
-            scene.t_end(),
-            &mut |_| {},
-        )
-    })?;
-    let (branch, names, p) = followed
-        .map_err(|e| override_error(py, e.field.as_deref().unwrap_or("param"), e.reason))?;
+    let asked = asked(section, (events, settle, forcing_period), wall);
+    let (branch, names, p) = interruptible(py, |stop| {
+        asked
+            .on(&scene, Some(stop.clone()))
+            .and_then(|search| search.branch(&param, to, (points, max_step), &mut |_| {}))
+    })?
+    .map_err(|e| scene_error(py, &e))?;
     let out = PyDict::new(py);
     let column = |f: &dyn Fn(&flicker::orbit::continuation::Point) -> f64| -> Vec<f64> {
         branch.points.iter().map(f).collect()
@@ -343,9 +320,6 @@ pub fn lyapunov(
     wall: f64,
 ) -> PyResult<String> {
     let (scene, label) = load(py, text, path)?;
-    let family = scene
-        .family()
-        .map_err(|e| override_error(py, "model", e.reason))?;
     let asked = SpectrumRequest {
         exponents,
         transient,
@@ -353,15 +327,11 @@ pub fn lyapunov(
         interval,
         wall,
     };
-    let request = asked
-        .resolve(&scene, &*family, None)
-        .map_err(|e| scene_error(py, &e))?;
     let found = interruptible(py, |stop| {
-        let request = flicker::lyapunov::Request {
-            stop: Some(stop.clone()),
-            ..request.clone()
-        };
-        flicker::lyapunov::spectrum(&*family, &request, &mut |_, _| {})
+        asked
+            .on(&scene, Some(stop.clone()))
+            .map(|spectrum| (spectrum.spectrum(&mut |_, _| {}), spectrum.request))
     })?;
+    let (found, request) = found.map_err(|e| scene_error(py, &e))?;
     Ok(found.to_json(&request, Path::new(&label)).to_string())
 }

@@ -76,43 +76,38 @@ pub struct ContinueArgs {
 /// Run `flicker continue`.
 pub fn continue_orbit(args: ContinueArgs, registry: &Registry) -> Result<Code, Failure> {
     let scene = registry.load(&args.scene).map_err(Failure::bad_input)?;
-    let request = SearchRequest {
+    let search = SearchRequest {
         section: args.section.clone(),
         events: args.events,
         settle: args.settle,
         forcing_period: args.forcing_period,
         wall: args.wall,
     }
-    .resolve(Some(crate::cli::setup::stop_flag()))
-    .map_err(Failure::flag)?;
-    let family = scene
-        .family()
-        .map_err(|e| Failure::bad_input(format!("{}: {}", args.scene.display(), e.reason)))?;
-    let (branch, names, p) = crate::orbit::follow(
-        &*family,
-        &request,
-        &args.param,
-        args.to,
-        (args.points, args.max_step),
-        scene.t_end(),
-        &mut |q| {
-            // One line per orbit on a terminal: a branch never goes quiet.
-            if !args.quiet && std::io::stderr().is_terminal() {
-                eprintln!(
-                    "  orbit at {} = {:.10e}: period {:.10e}{}",
-                    args.param,
-                    q.parameter,
-                    q.period,
-                    if q.label.is_empty() {
-                        String::new()
-                    } else {
-                        format!(" ({})", q.label)
-                    }
-                );
-            }
-        },
-    )
-    .map_err(Failure::flag)?;
+    .on(&scene, Some(crate::cli::setup::stop_flag()))
+    .map_err(|e| Failure::refused(&args.scene, e))?;
+    let (branch, names, p) = search
+        .branch(
+            &args.param,
+            args.to,
+            (args.points, args.max_step),
+            &mut |q| {
+                // One line per orbit on a terminal: a branch never goes quiet.
+                if !args.quiet && std::io::stderr().is_terminal() {
+                    eprintln!(
+                        "  orbit at {} = {:.10e}: period {:.10e}{}",
+                        args.param,
+                        q.parameter,
+                        q.period,
+                        if q.label.is_empty() {
+                            String::new()
+                        } else {
+                            format!(" ({})", q.label)
+                        }
+                    );
+                }
+            },
+        )
+        .map_err(Failure::flag)?;
     let out = args.out.clone().unwrap_or_else(|| {
         let stem = args
             .scene
@@ -156,15 +151,9 @@ pub fn continue_orbit(args: ContinueArgs, registry: &Registry) -> Result<Code, F
         let values: Vec<f64> = (0..args.brute_force)
             .map(|i| lo + (hi - lo) * i as f64 / (args.brute_force.max(2) - 1) as f64)
             .collect();
-        crate::orbit::diagram::brute_force(
-            &*family,
-            &args.param,
-            &values,
-            &args.section,
-            (scene.t_end() / 2.0, args.brute_force_events, scene.t_end()),
-            (request.stop.as_ref(), request.deadline),
-        )
-        .map_err(Failure::flag)?
+        search
+            .brute_force(&args.param, &values, args.brute_force_events)
+            .map_err(Failure::flag)?
     } else {
         Vec::new()
     };

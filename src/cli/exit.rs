@@ -64,6 +64,15 @@ impl Failure {
         Failure::bad_input(format!("--{field}: {}", e.reason))
     }
 
+    /// A tool's request refused: its scene's model, which the tool cannot
+    /// apply to (`SCENE: reason`), or a flag's value (`--field: reason`).
+    pub fn refused(scene: &std::path::Path, e: SceneError) -> Self {
+        match e.field.as_deref() {
+            Some("model") => Failure::bad_input(format!("{}: {}", scene.display(), e.reason)),
+            _ => Failure::flag(e),
+        }
+    }
+
     /// A failure for a run that cannot be trusted, or output that could not
     /// be written ([`Code::Untrusted`]).
     pub fn untrusted(message: impl ToString) -> Self {

@@ -9,7 +9,7 @@ use crate::cli::exit::{Code, Failure};
 use crate::cli::progress::WithProgress;
 use crate::engine::Observer;
 use crate::log::summary::write_atomically;
-use crate::lyapunov::{Spectrum, spectrum};
+use crate::lyapunov::Spectrum;
 use crate::plot::draw::{Curve, Figure, Style};
 use crate::scene::Registry;
 use crate::session::SpectrumRequest;
@@ -88,9 +88,6 @@ fn draw(found: &Spectrum, scene: &Path, out: &Path) -> Result<Vec<PathBuf>, Stri
 /// spectrum that stopped short exits 3 (130 if interrupted), saying why.
 pub fn lyapunov(args: LyapunovArgs, registry: &Registry) -> Result<Code, Failure> {
     let scene = registry.load(&args.scene).map_err(Failure::bad_input)?;
-    let family = scene
-        .family()
-        .map_err(|e| Failure::bad_input(format!("{}: {}", args.scene.display(), e.reason)))?;
     let stop = crate::cli::setup::stop_flag();
     let asked = SpectrumRequest {
         exponents: args.exponents,
@@ -99,9 +96,10 @@ pub fn lyapunov(args: LyapunovArgs, registry: &Registry) -> Result<Code, Failure
         interval: args.interval,
         wall: args.wall,
     };
-    let request = asked
-        .resolve(&scene, &*family, Some(stop.clone()))
-        .map_err(Failure::flag)?;
+    let prepared = asked
+        .on(&scene, Some(stop.clone()))
+        .map_err(|e| Failure::refused(&args.scene, e))?;
+    let request = &prepared.request;
     let out = args.out.clone().unwrap_or_else(|| {
         let stem = args
             .scene
@@ -111,12 +109,10 @@ pub fn lyapunov(args: LyapunovArgs, registry: &Registry) -> Result<Code, Failure
     });
     crate::cli::setup::output_folder(&out)?;
     let mut bar = WithProgress::new((), request.span, args.quiet);
-    let found = spectrum(&*family, &request, &mut |t, events| {
-        bar.on_progress(t, events)
-    });
+    let found = prepared.spectrum(&mut |t, events| bar.on_progress(t, events));
     bar.finish();
     let path = out.join("lyapunov.json");
-    write_atomically(&path, &found.to_json(&request, &args.scene))
+    write_atomically(&path, &found.to_json(request, &args.scene))
         .map_err(|e| Failure::untrusted(format!("{}: cannot be written: {e}", path.display())))?;
     let drawn = if found.history.is_empty() {
         Vec::new()

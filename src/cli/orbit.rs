@@ -53,15 +53,15 @@ pub struct OrbitArgs {
 /// A search that does not converge exits 3, saying why.
 pub fn orbit(args: OrbitArgs, registry: &Registry) -> Result<Code, Failure> {
     let scene = registry.load(&args.scene).map_err(Failure::bad_input)?;
-    let request = SearchRequest {
+    let search = SearchRequest {
         section: args.section.clone(),
         events: args.events,
         settle: args.settle,
         forcing_period: args.forcing_period,
         wall: args.wall,
     }
-    .resolve(Some(crate::cli::setup::stop_flag()))
-    .map_err(Failure::flag)?;
+    .on(&scene, Some(crate::cli::setup::stop_flag()))
+    .map_err(|e| Failure::refused(&args.scene, e))?;
     let out = args.out.unwrap_or_else(|| {
         let stem = args
             .scene
@@ -70,9 +70,6 @@ pub fn orbit(args: OrbitArgs, registry: &Registry) -> Result<Code, Failure> {
         Path::new("out").join(format!("{stem}-orbit"))
     });
     let started = Instant::now();
-    let family = scene
-        .family()
-        .map_err(|e| Failure::bad_input(format!("{}: {}", args.scene.display(), e.reason)))?;
     // On a terminal: a bar over the transient, a line per Newton iteration.
     let shown = !args.quiet && std::io::stderr().is_terminal();
     let mut bar = WithProgress::new((), args.settle, args.quiet);
@@ -89,7 +86,7 @@ pub fn orbit(args: OrbitArgs, registry: &Registry) -> Result<Code, Failure> {
         transient: Some(&mut bar),
         newton: Some(&mut newton),
     };
-    let found = crate::orbit::search(&*family, &request, scene.t_end(), watch);
+    let found = search.orbit(watch);
     bar.finish();
     let orbit = found.map_err(Failure::flag)?;
     let wall = started.elapsed().as_secs_f64();

@@ -179,6 +179,17 @@ fn the_continuum_refuses_the_tools_in_one_line() {
     let scene = models("continuum_release_paper.json");
     for args in [
         vec!["orbit", scene.as_str(), "--section", "impact"],
+        vec![
+            "continue",
+            scene.as_str(),
+            "--section",
+            "impact",
+            "--param",
+            "load",
+            "--to",
+            "1",
+        ],
+        vec!["lyapunov", scene.as_str()],
         vec!["run", scene.as_str(), "--sensitivities", "load"],
     ] {
         let done = flicker(&args);
@@ -187,6 +198,45 @@ fn the_continuum_refuses_the_tools_in_one_line() {
         assert!(err.contains("no finite state"), "{err}");
         assert_eq!(err.trim().lines().count(), 1, "{err}");
     }
+}
+
+/// The search the command line runs is the session's (`SearchRequest::on`
+/// then `Prepared::orbit`), which Python runs too: the same orbit to the
+/// bit, and the continuum refused naming the field `model`.
+#[test]
+fn the_session_s_search_is_the_one_the_command_line_runs() {
+    use flicker::session::SearchRequest;
+    let asked = SearchRequest {
+        section: "impact".into(),
+        events: 1,
+        settle: 0.0,
+        forcing_period: None,
+        wall: 60.0,
+    };
+    let load = |name: &str| {
+        Registry::builtin()
+            .load(std::path::Path::new(&models(name)))
+            .expect("the bundled scene loads")
+    };
+    let found = asked
+        .on(&load("mechanism_impacting.json"), None)
+        .expect("the mechanism has a family")
+        .orbit(Default::default())
+        .expect("a valid search");
+    assert!(found.converged, "{}", found.status);
+    let cli = orbit("mechanism_impacting.json");
+    assert_eq!(found.period, cli["period"].as_f64().unwrap());
+    assert!((found.period - t_imp()).abs() < 1e-12 * t_imp());
+    let refused = asked
+        .on(&load("continuum_release_paper.json"), None)
+        .err()
+        .expect("the continuum has no family");
+    assert_eq!(
+        refused.field.as_deref(),
+        Some("model"),
+        "{}",
+        refused.reason
+    );
 }
 
 /// A model that names no states (the chain) names none of their
