@@ -10,14 +10,16 @@
 //!
 //! Run: `cargo run --release --example bouncing_ball [-- RESTITUTION]`
 
+use flicker::engine::Name;
 use flicker::engine::{
     Direction, Flow, Guard, HybridModel, Jump, Mode, Options, Recorder, simulate,
 };
+use flicker::names;
 
 /// The ball in the air.
 pub const FLYING: Mode = 0;
 const RESTING: Mode = 1;
-const BOUNCE: [Guard; 1] = [Guard::affine("bounce", Direction::Falling)];
+const BOUNCE: &[Guard] = &[Guard::affine("bounce", Direction::Falling)];
 
 /// State `[height, velocity]`.
 pub struct BouncingBall {
@@ -32,16 +34,16 @@ impl HybridModel for BouncingBall {
         2
     }
 
-    fn state_names(&self, _: Mode) -> &[&'static str] {
-        &["height", "velocity"]
+    fn state_names(&self, _: Mode) -> &[Name] {
+        names!["height", "velocity"]
     }
 
-    fn mode_name(&self, mode: Mode) -> &'static str {
+    fn mode_name(&self, mode: Mode) -> &str {
         if mode == RESTING { "resting" } else { "flying" }
     }
 
     fn guards(&self, mode: Mode) -> &[Guard] {
-        if mode == RESTING { &[] } else { &BOUNCE }
+        if mode == RESTING { &[] } else { BOUNCE }
     }
 
     fn guard(&self, _: Mode, _: usize, x: &[f64]) -> f64 {

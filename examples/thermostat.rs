@@ -3,16 +3,18 @@
 //! and on at 18. The flow is an ODE the engine integrates; the guards only
 //! mark passages (`as_crossing`), and each switch changes the mode.
 //! Run: `cargo run --release --example thermostat`
+use flicker::engine::Name;
 use flicker::engine::{
     Direction, Flow, Guard, HybridModel, Jump, Mode, Options, Recorder, simulate,
 };
+use flicker::names;
 
 const HEATING: Mode = 0;
 const RATE: f64 = 0.5;
 const TARGET: [f64; 2] = [30.0, 10.0];
 const SWITCH_AT: [f64; 2] = [22.0, 18.0];
-const OFF: [Guard; 1] = [Guard::affine("heater_off", Direction::Rising).as_crossing()];
-const ON: [Guard; 1] = [Guard::affine("heater_on", Direction::Falling).as_crossing()];
+const OFF: &[Guard] = &[Guard::affine("heater_off", Direction::Rising).as_crossing()];
+const ON: &[Guard] = &[Guard::affine("heater_on", Direction::Falling).as_crossing()];
 
 pub struct Thermostat;
 
@@ -20,9 +22,9 @@ pub struct Thermostat;
 #[rustfmt::skip]
 impl HybridModel for Thermostat {
     fn dimension(&self) -> usize { 1 }
-    fn state_names(&self, _: Mode) -> &[&'static str] { &["temperature"] }
-    fn mode_name(&self, mode: Mode) -> &'static str { ["heating", "cooling"][mode] }
-    fn guards(&self, mode: Mode) -> &[Guard] { if mode == HEATING { &OFF } else { &ON } }
+    fn state_names(&self, _: Mode) -> &[Name] { names!["temperature"] }
+    fn mode_name(&self, mode: Mode) -> &str { ["heating", "cooling"][mode] }
+    fn guards(&self, mode: Mode) -> &[Guard] { if mode == HEATING { OFF } else { ON } }
     fn guard(&self, mode: Mode, _: usize, x: &[f64]) -> f64 { x[0] - SWITCH_AT[mode] }
     fn flow(&self, _: Mode) -> Flow { Flow::Ode }
     fn rhs(&self, mode: Mode, x: &[f64], dx: &mut [f64]) { dx[0] = RATE * (TARGET[mode] - x[0]) }

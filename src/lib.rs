@@ -21,13 +21,13 @@
 //! use flicker::prelude::*;
 //!
 //! struct Sawtooth;
-//! const WRAP: [Guard; 1] = [Guard::affine("wrap", Direction::Rising)];
+//! const WRAP: &[Guard] = &[Guard::affine("wrap", Direction::Rising)];
 //!
 //! impl HybridModel for Sawtooth {
 //!     fn dimension(&self) -> usize { 1 }
-//!     fn state_names(&self, _: Mode) -> &[&'static str] { &["x"] }
-//!     fn mode_name(&self, _: Mode) -> &'static str { "ramp" }
-//!     fn guards(&self, _: Mode) -> &[Guard] { &WRAP }
+//!     fn state_names(&self, _: Mode) -> &[Name] { names!["x"] }
+//!     fn mode_name(&self, _: Mode) -> &str { "ramp" }
+//!     fn guards(&self, _: Mode) -> &[Guard] { WRAP }
 //!     fn guard(&self, _: Mode, _: usize, x: &[f64]) -> f64 { x[0] - 1.0 }
 //!     fn flow(&self, _: Mode) -> Flow { Flow::Exact }
 //!     fn advance(&self, _: Mode, x0: &[f64], tau: f64, x: &mut [f64]) { x[0] = x0[0] + tau }

@@ -21,7 +21,7 @@ use serde_json::{Map, Value, json};
 use crate::engine::method::tightest;
 use crate::engine::variational::Variational;
 use crate::engine::{
-    Family, HybridModel, Method, Mode, Observer, Sample, Tolerances, simulate_sampled,
+    Family, HybridModel, Method, Mode, Name, Observer, Sample, Tolerances, simulate_sampled,
 };
 use crate::runner::{Control, Report};
 use crate::scene::{Scene, SceneError};
@@ -293,7 +293,7 @@ pub fn run(
         .zip(&outcome.final_state[..n])
         .enumerate()
         .filter(|(k, _)| keep(*k))
-        .map(|(_, (name, x))| (crate::engine::names::intern(name), *x))
+        .map(|(_, (name, x))| (Name::from(name.as_str()), *x))
         .collect();
     let mut sensitivities = Map::new();
     for (j, label) in setup.labels.iter().enumerate() {
@@ -336,11 +336,7 @@ pub fn sampled(
     observer: &mut dyn Observer,
 ) -> Result<crate::runner::Trajectory, SceneError> {
     let family = scene.family()?;
-    let own = family
-        .state_names()
-        .iter()
-        .map(|s| crate::engine::names::intern(s))
-        .collect();
+    let own = family.state_names().into_iter().map(Name::from).collect();
     crate::runner::Trajectory::record(own, |on_sample| {
         run(scene, names, control, times, on_sample, observer)
     })

@@ -15,7 +15,7 @@
 //! cargo run --release --example registered_ball -- schema
 //! ```
 
-use flicker::engine::{Method, Observer, Options, Tolerances, simulate};
+use flicker::engine::{Method, Name, Observer, Options, Tolerances, simulate};
 use flicker::runner::{Control, Report};
 use flicker::scene::fields::Fields;
 use flicker::scene::solver::SolverSpec;
@@ -112,8 +112,8 @@ impl SceneModel for BallScene {
             control.options(self.t_end, 1_000_000, Method::Auto, Tolerances::default());
         let outcome = simulate(&ball, FLYING, &[self.height, 0.0], &options, observer);
         let final_state = vec![
-            ("height", outcome.final_state[0]),
-            ("velocity", outcome.final_state[1]),
+            (Name::new("height"), outcome.final_state[0]),
+            (Name::new("velocity"), outcome.final_state[1]),
         ];
         Ok(Report {
             outcome,

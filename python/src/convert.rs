@@ -27,14 +27,20 @@ pub fn events<'py>(py: Python<'py>, columns: &mut EventColumns) -> PyResult<Boun
     ] {
         out.set_item(key, values.into_pyarray(py))?;
     }
-    out.set_item("names", PyList::new(py, &columns.names)?)?;
+    out.set_item(
+        "names",
+        PyList::new(py, columns.names.iter().map(|n| n.as_str()))?,
+    )?;
     for (key, values) in [
         ("energy_before", std::mem::take(&mut columns.energy_before)),
         ("energy_after", std::mem::take(&mut columns.energy_after)),
     ] {
         out.set_item(key, values.into_pyarray(py))?;
     }
-    out.set_item("state_names", PyList::new(py, &table.names)?)?;
+    out.set_item(
+        "state_names",
+        PyList::new(py, table.names.iter().map(|n| n.as_str()))?,
+    )?;
     for (key, values) in [("before", table.before), ("after", table.after)] {
         out.set_item(key, values.into_pyarray(py).reshape([n, width])?)?;
     }
@@ -56,7 +62,7 @@ pub fn samples<'py>(py: Python<'py>, trajectory: Trajectory) -> PyResult<Bound<'
     out.set_item("t", times.into_pyarray(py))?;
     for (k, name) in trajectory.names.iter().enumerate() {
         if *name != "t" {
-            out.set_item(*name, column(k).into_pyarray(py))?;
+            out.set_item(name.as_str(), column(k).into_pyarray(py))?;
         }
     }
     out.set_item("bound", trajectory.bounds.into_pyarray(py))?;

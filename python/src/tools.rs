@@ -279,7 +279,7 @@ pub fn continuation<'py>(
     out.set_item("parameter", column(&|q| q.parameter).into_pyarray(py))?;
     out.set_item("period", column(&|q| q.period).into_pyarray(py))?;
     for (i, name) in names.iter().enumerate().filter(|(i, _)| *i != p) {
-        out.set_item(*name, column(&|q| q.state[i]).into_pyarray(py))?;
+        out.set_item(name.as_str(), column(&|q| q.state[i]).into_pyarray(py))?;
     }
     out.set_item(
         "largest_multiplier",

@@ -6,6 +6,7 @@
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
+use crate::engine::Name;
 use crate::orbit::continuation::{Branch, Point};
 use crate::orbit::diagram::Column;
 use crate::plot::draw::{Curve, Figure, Style};
@@ -129,7 +130,7 @@ pub fn continue_orbit(args: ContinueArgs, registry: &Registry) -> Result<Code, F
     let plotted = match &args.plot {
         Some(name) => names
             .iter()
-            .position(|n| n == name)
+            .position(|n| n == name.as_str())
             .filter(|&i| i != p)
             .ok_or_else(|| {
                 Failure::bad_input(format!(
@@ -169,7 +170,7 @@ pub fn continue_orbit(args: ContinueArgs, registry: &Registry) -> Result<Code, F
     let label = if names[plotted] == "t" && args.forcing_period.is_some() {
         "t mod T (the forcing's phase)"
     } else {
-        names[plotted]
+        names[plotted].as_str()
     };
     let figure = chart(&branch, &columns, &args.param, label, plotted);
     let mut written = vec![csv];
@@ -261,7 +262,7 @@ fn most_varied(branch: &Branch, n: usize, p: usize) -> usize {
 
 /// `continuation.csv`: parameter, period, each state at the section (the
 /// parameter's own left out), the largest multiplier modulus, stable, label.
-fn write_csv(branch: &Branch, names: &[&str], p: usize, path: &Path) -> csv::Result<()> {
+fn write_csv(branch: &Branch, names: &[Name], p: usize, path: &Path) -> csv::Result<()> {
     let mut w = csv::Writer::from_path(path)?;
     let mut header = vec!["parameter".to_string(), "period".to_string()];
     header.extend(
@@ -296,7 +297,7 @@ fn write_csv(branch: &Branch, names: &[&str], p: usize, path: &Path) -> csv::Res
 /// `brute_force.csv`: parameter, then each state just after a section
 /// event (the parameter's own left out; a forced system's clock as the
 /// forcing's phase), a row per event recorded.
-fn write_brute_force(columns: &[Column], names: &[&str], p: usize, path: &Path) -> csv::Result<()> {
+fn write_brute_force(columns: &[Column], names: &[Name], p: usize, path: &Path) -> csv::Result<()> {
     let mut w = csv::Writer::from_path(path)?;
     let mut header = vec!["parameter"];
     header.extend(
@@ -304,7 +305,7 @@ fn write_brute_force(columns: &[Column], names: &[&str], p: usize, path: &Path) 
             .iter()
             .enumerate()
             .filter(|(i, _)| *i != p)
-            .map(|(_, n)| *n),
+            .map(|(_, n)| n.as_str()),
     );
     w.write_record(&header)?;
     for c in columns {

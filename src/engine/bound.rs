@@ -279,7 +279,7 @@ impl Bound {
         if self.errors.is_empty() || !self.errors.tracked() {
             return Ok(());
         }
-        let guard = model.guards(mode)[slot];
+        let guard = &model.guards(mode)[slot];
         self.tangents
             .gradient(model, mode, slot, before, &mut self.gradient);
         let along = self.errors.along(&self.gradient);

@@ -9,6 +9,7 @@ use std::sync::atomic::Ordering;
 use std::time::Instant;
 
 use crate::engine::model::Mode;
+use crate::engine::names::Name;
 use crate::engine::observer::{EventRecord, Observer, SETTLE};
 use crate::engine::run::{FastForward, Options, Outcome, Status};
 use crate::engine::run_loop::{BUDGET_CHECK, CLOCK_EVERY, End, PROGRESS_SECONDS};
@@ -19,8 +20,8 @@ use crate::time::Time;
 pub(crate) struct Final<'a> {
     pub t_reached: Time,
     pub mode: Mode,
-    pub mode_name: &'static str,
-    pub state_names: &'a [&'static str],
+    pub mode_name: &'a str,
+    pub state_names: &'a [Name],
     pub state: Vec<f64>,
     pub energy: Option<f64>,
     pub flow_evaluations: u64,
@@ -41,7 +42,7 @@ pub(crate) struct Ledger<'o> {
     /// Event counts per mode and guard.
     counts: Vec<Vec<u64>>,
     /// Counts of the events a reset named (see `Jump::event`).
-    named: BTreeMap<&'static str, u64>,
+    named: BTreeMap<Name, u64>,
     zeno: ZenoWatch,
     settles: u64,
     /// Set once the run has settled a Zeno accumulation and gone on.
@@ -194,8 +195,17 @@ impl<'o> Ledger<'o> {
     }
 
     /// Count an event the model named otherwise than its guard.
-    pub fn count_named(&mut self, name: &'static str) {
-        *self.named.entry(name).or_insert(0) += 1;
+    pub fn count_named(&mut self, name: &Name) {
+        self.count_named_many(name, 1);
+    }
+
+    fn count_named_many(&mut self, name: &Name, n: u64) {
+        match self.named.get_mut(name) {
+            Some(count) => *count += n,
+            None => {
+                self.named.insert(name.clone(), n);
+            }
+        }
     }
 
     /// Events a jump over whole periods of `tau` from `now` may count,
@@ -220,7 +230,7 @@ impl<'o> Ledger<'o> {
     /// gives, `named`): count them as fired.
     pub fn jumped(
         &mut self,
-        (mode, slot, named): (Mode, usize, Option<&'static str>),
+        (mode, slot, named): (Mode, usize, Option<&Name>),
         periods: u64,
         tau: f64,
         (from, to): (Time, Time),
@@ -232,7 +242,7 @@ impl<'o> Ledger<'o> {
             self.budget_check = (self.events + BUDGET_CHECK, self.events, to);
         }
         match named {
-            Some(name) => *self.named.entry(name).or_insert(0) += periods,
+            Some(name) => self.count_named_many(name, periods),
             None => self.count_many(mode, slot, periods),
         }
         let jump = self.fast_forward.get_or_insert(FastForward {
@@ -375,7 +385,7 @@ impl<'o> Ledger<'o> {
         mut self,
         end: End,
         last: Final,
-        guard_name: impl Fn(Mode, usize) -> &'static str,
+        guard_name: impl Fn(Mode, usize) -> Name,
     ) -> Outcome {
         self.audit(last.energy);
         let mut events_by_guard = BTreeMap::new();
@@ -386,11 +396,11 @@ impl<'o> Ledger<'o> {
                 }
             }
         }
-        for (name, n) in &self.named {
-            *events_by_guard.entry(*name).or_insert(0) += n;
+        for (name, n) in std::mem::take(&mut self.named) {
+            *events_by_guard.entry(name).or_insert(0) += n;
         }
         if self.settles > 0 {
-            events_by_guard.insert(SETTLE, self.settles);
+            events_by_guard.insert(Name::new(SETTLE), self.settles);
         }
         Outcome {
             zeno: end.status == Status::Zeno || self.zeno_reason.is_some(),
@@ -406,7 +416,7 @@ impl<'o> Ledger<'o> {
                 .max_energy_error
                 .map(|error| error / self.relative_to()),
             final_mode: last.mode,
-            final_mode_name: last.mode_name,
+            final_mode_name: Name::from(last.mode_name),
             final_state_names: last.state_names.to_vec(),
             final_state: last.state,
             flow_evaluations: last.flow_evaluations,

@@ -125,7 +125,7 @@ pub fn simulate_local<M: LocalModel + ?Sized, O: Observer + ?Sized>(
         event_time_bound: None,
     };
     let guards = model.guards();
-    ledger.outcome(end, last, |_, slot| guards[slot].name)
+    ledger.outcome(end, last, |_, slot| guards[slot].name.clone())
 }
 
 struct LocalRun<'m, M: LocalModel + ?Sized> {
@@ -162,7 +162,8 @@ impl<M: LocalModel + ?Sized> Segments for LocalRun<'_, M> {
         observer: &mut O,
     ) -> Result<(), End> {
         self.queue.pop();
-        let guard = self.model.guards()[slot];
+        // A local model's guards are literals: a copy, not a count.
+        let guard = self.model.guards()[slot].clone();
         let logged = !guard.internal && observer.wants_details();
         let energy_before = if logged { self.model.energy(t) } else { None };
         let fired = self.model.fire(slot, t).map_err(|why| {
@@ -187,9 +188,9 @@ impl<M: LocalModel + ?Sized> Segments for LocalRun<'_, M> {
         }
         ledger.count(0, slot);
         let energy_after = if logged { self.model.energy(t) } else { None };
-        let event = self.event(guard.name, t, energy_before, energy_after, &fired.labels);
+        let event = self.event(&guard.name, t, energy_before, energy_after, &fired.labels);
         ledger.log(event, observer)?;
-        let Some(what) = ledger.zeno(0, slot, guard.name, t) else {
+        let Some(what) = ledger.zeno(0, slot, &guard.name, t) else {
             return self.repredict(slot, fired.affects);
         };
         let Some(settled) = self.model.settle(slot, t) else {
@@ -224,7 +225,7 @@ impl<M: LocalModel + ?Sized> LocalRun<'_, M> {
     /// An event of the model's (its state is its own, not the log's).
     fn event<'a>(
         &self,
-        name: &'static str,
+        name: &'a str,
         t: Time,
         energy_before: Option<f64>,
         energy_after: Option<f64>,

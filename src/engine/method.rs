@@ -208,6 +208,8 @@ pub fn tightest<M: HybridModel + ?Sized>(model: &M, modes: usize, tolerance: f64
 mod tests {
     use super::*;
     use crate::engine::model::{Guard, Jump, Mode};
+    use crate::engine::names::Name;
+    use crate::names;
 
     /// A model whose modes are of the kinds given: `e` exact, `l` linear,
     /// `s` an ODE with Taylor series, `o` an ODE without.
@@ -217,10 +219,10 @@ mod tests {
         fn dimension(&self) -> usize {
             1
         }
-        fn state_names(&self, _: Mode) -> &[&'static str] {
-            &["x"]
+        fn state_names(&self, _: Mode) -> &[Name] {
+            names!["x"]
         }
-        fn mode_name(&self, _: Mode) -> &'static str {
+        fn mode_name(&self, _: Mode) -> &str {
             "m"
         }
         fn guards(&self, _: Mode) -> &[Guard] {

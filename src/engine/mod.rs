@@ -40,6 +40,7 @@ pub use labels::{Label, Labels};
 pub use local::{Fired, LocalModel, simulate_local};
 pub use method::Method;
 pub use model::{Affects, Direction, Flow, Guard, HybridModel, Jump, Mode};
+pub use names::Name;
 pub use observer::{EachEvent, EventRecord, EventTimes, Observer, RecordedEvent, Recorder, SETTLE};
 pub use problem::{Limits, Problem};
 pub use run::{FastForward, Options, Outcome, Status};

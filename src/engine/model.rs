@@ -11,6 +11,7 @@
 use nalgebra::{DMatrix, DVector};
 
 use crate::engine::labels::Labels;
+use crate::engine::names::Name;
 
 /// Index of a discrete mode. Models name their modes with [`HybridModel::mode_name`].
 pub type Mode = usize;
@@ -39,10 +40,15 @@ impl Direction {
 }
 
 /// A guard: a function of the state whose zero crossing fires an event.
-#[derive(Debug, Clone, Copy, PartialEq)]
+///
+/// A model's guards built from literals are a constant slice or a static
+/// (`const WALL: &[Guard] = &[Guard::affine("wall", Direction::Falling)];`):
+/// a guard owns its [`Name`], so a constant array of them cannot be
+/// borrowed for longer than the function it is used in.
+#[derive(Debug, Clone, PartialEq)]
 pub struct Guard {
     /// Name used in the event log and the summary (`impact`, `bounce`...).
-    pub name: &'static str,
+    pub name: Name,
     /// Which way the guard must cross zero to fire.
     pub direction: Direction,
     /// The guard is an affine function of the state. Along a polynomial
@@ -65,7 +71,7 @@ impl Guard {
     /// An affine barrier guard: the common case (an impact).
     pub const fn affine(name: &'static str, direction: Direction) -> Self {
         Guard {
-            name,
+            name: Name::new(name),
             direction,
             affine: true,
             internal: false,
@@ -75,19 +81,15 @@ impl Guard {
 
     /// Mark this guard as a passage marker rather than a barrier (see
     /// [`Guard::barrier`]).
-    pub const fn as_crossing(self) -> Self {
-        Guard {
-            barrier: false,
-            ..self
-        }
+    pub const fn as_crossing(mut self) -> Self {
+        self.barrier = false;
+        self
     }
 
     /// Mark this guard as an internal switch (see [`Guard::internal`]).
-    pub const fn as_internal(self) -> Self {
-        Guard {
-            internal: true,
-            ..self
-        }
+    pub const fn as_internal(mut self) -> Self {
+        self.internal = true;
+        self
     }
 }
 
@@ -119,7 +121,7 @@ pub enum Affects {
 }
 
 /// What a reset did: the mode after it, and which predictions it spoiled.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Jump {
     /// The mode after the reset.
     pub mode: Mode,
@@ -128,7 +130,7 @@ pub struct Jump {
     /// What the event is called in the log and the counts, where the
     /// reset names it otherwise than its guard (a switching surface
     /// reached: crossed, or slid on); `None` keeps the guard's name.
-    pub event: Option<&'static str>,
+    pub event: Option<Name>,
     /// The guard of the new mode whose surface the state starts on, leaving
     /// it along the flow (a sliding that ends where the flow turns
     /// tangent): it neither fires there nor can be said to move its way,
@@ -148,7 +150,7 @@ impl Jump {
     }
 
     /// The same, the event called `name` in the log.
-    pub fn named(self, name: &'static str) -> Self {
+    pub fn named(self, name: Name) -> Self {
         Jump {
             event: Some(name),
             ..self
@@ -178,11 +180,12 @@ pub trait HybridModel {
     /// Length of the continuous state.
     fn dimension(&self) -> usize;
 
-    /// Names of the state components in `mode`, for logs and summaries.
-    fn state_names(&self, mode: Mode) -> &[&'static str];
+    /// Names of the state components in `mode`, for logs and summaries
+    /// (from literals: `names!["x", "v"]`).
+    fn state_names(&self, mode: Mode) -> &[Name];
 
     /// Name of a mode, for logs and summaries.
-    fn mode_name(&self, mode: Mode) -> &'static str;
+    fn mode_name(&self, mode: Mode) -> &str;
 
     /// The guards active in `mode`; guard indices are positions in this slice.
     fn guards(&self, mode: Mode) -> &[Guard];

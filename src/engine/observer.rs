@@ -8,6 +8,7 @@
 
 use crate::engine::labels::Labels;
 use crate::engine::model::Mode;
+use crate::engine::names::Name;
 
 /// One event, borrowed from the engine for the duration of the call.
 #[derive(Debug, Clone, Copy)]
@@ -17,11 +18,11 @@ pub struct EventRecord<'a> {
     /// Time of the event.
     pub t: f64,
     /// Name of the guard that fired ([`SETTLE`] for a Zeno settling).
-    pub guard: &'static str,
+    pub guard: &'a str,
     /// Name of the mode before the reset.
-    pub mode_before: &'static str,
+    pub mode_before: &'a str,
     /// Name of the mode after the reset.
-    pub mode_after: &'static str,
+    pub mode_after: &'a str,
     /// The mode before the reset, by index (the model's `Mode`; its name is
     /// `mode_before`).
     pub from: Mode,
@@ -32,11 +33,11 @@ pub struct EventRecord<'a> {
     /// The model's energy just after the reset, if it has one.
     pub energy_after: Option<f64>,
     /// Names of the components of `before`.
-    pub names_before: &'a [&'static str],
+    pub names_before: &'a [Name],
     /// The state just before the reset (empty for an event-local model).
     pub before: &'a [f64],
     /// Names of the components of `after`.
-    pub names_after: &'a [&'static str],
+    pub names_after: &'a [Name],
     /// The state just after the reset (empty for an event-local model).
     pub after: &'a [f64],
     /// What the model labels the event with (a chain's unit and closing
@@ -117,7 +118,7 @@ pub struct RecordedEvent {
     /// Time of the event.
     pub t: f64,
     /// Name of the guard that fired.
-    pub guard: &'static str,
+    pub guard: Name,
     /// The mode before the reset, by index.
     pub from: Mode,
     /// The mode after the reset, by index.
@@ -145,7 +146,7 @@ impl Observer for Recorder {
     fn on_event(&mut self, e: &EventRecord) -> std::io::Result<()> {
         self.events.push(RecordedEvent {
             t: e.t,
-            guard: e.guard,
+            guard: Name::from(e.guard),
             from: e.from,
             to: e.to,
             energy_before: e.energy_before,

@@ -98,25 +98,27 @@ impl<'m, M: HybridModel + ?Sized> Problem<'m, M> {
 mod tests {
     use super::*;
     use crate::engine::model::{Direction, Flow, Guard, Jump};
+    use crate::engine::names::Name;
+    use crate::names;
 
     /// `x' = -x`, its closed form, and a marker where `x` falls through
     /// `1/2`.
     struct Decay;
 
-    const HALF: [Guard; 1] = [Guard::affine("half", Direction::Falling).as_crossing()];
+    const HALF: &[Guard] = &[Guard::affine("half", Direction::Falling).as_crossing()];
 
     impl HybridModel for Decay {
         fn dimension(&self) -> usize {
             1
         }
-        fn state_names(&self, _: Mode) -> &[&'static str] {
-            &["x"]
+        fn state_names(&self, _: Mode) -> &[Name] {
+            names!["x"]
         }
-        fn mode_name(&self, _: Mode) -> &'static str {
+        fn mode_name(&self, _: Mode) -> &str {
             "decay"
         }
         fn guards(&self, _: Mode) -> &[Guard] {
-            &HALF
+            HALF
         }
         fn guard(&self, _: Mode, _: usize, x: &[f64]) -> f64 {
             x[0] - 0.5

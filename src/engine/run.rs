@@ -9,6 +9,7 @@ use std::sync::atomic::AtomicBool;
 use crate::engine::adaptive::Tolerances;
 use crate::engine::method::Method;
 use crate::engine::model::Mode;
+use crate::engine::names::Name;
 
 /// How to run a model.
 #[derive(Debug, Clone)]
@@ -87,7 +88,7 @@ pub struct Outcome {
     pub events: u64,
     /// Events per guard name; Zeno settlings under
     /// [`SETTLE`](crate::engine::observer::SETTLE).
-    pub events_by_guard: BTreeMap<&'static str, u64>,
+    pub events_by_guard: BTreeMap<Name, u64>,
     /// Whether a Zeno accumulation was recognised, whether the run then
     /// settled and went on or stopped there.
     pub zeno: bool,
@@ -102,9 +103,9 @@ pub struct Outcome {
     /// The mode the run ended in.
     pub final_mode: Mode,
     /// That mode's name.
-    pub final_mode_name: &'static str,
+    pub final_mode_name: Name,
     /// Names of the components of `final_state`.
-    pub final_state_names: Vec<&'static str>,
+    pub final_state_names: Vec<Name>,
     /// The state at `t_reached`.
     pub final_state: Vec<f64>,
     /// Evaluations of the flow: right-hand sides and propagators of

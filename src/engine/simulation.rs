@@ -23,6 +23,7 @@ use crate::engine::ledger::{Final, Ledger};
 use crate::engine::locate::{Start, scan_step};
 use crate::engine::method::Method;
 use crate::engine::model::{Affects, Direction, HybridModel, Mode};
+use crate::engine::names::Name;
 use crate::engine::observer::{EventRecord, Observer, SETTLE};
 use crate::engine::periodic::Returns;
 use crate::engine::queue::EventQueue;
@@ -156,7 +157,7 @@ struct Run<'m, 's, M: HybridModel + ?Sized> {
     /// The state after the last event, to prove the orbit periodic, and
     /// that event's mode, guard and name (what a period's event counts as).
     returns: Returns,
-    repeated: (Mode, usize, Option<&'static str>),
+    repeated: (Mode, usize, Option<Name>),
 }
 
 impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
@@ -199,7 +200,7 @@ impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
             self.queue.cancel(slot);
         }
         let (model, mode) = (self.model, self.mode);
-        let guard = model.guards(mode)[slot];
+        let guard = &model.guards(mode)[slot];
         let mut before = std::mem::take(&mut self.before);
         self.state_at(t.since(self.origin), &mut before);
         let t = self.sharpen(slot, t, &mut before);
@@ -227,14 +228,14 @@ impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
         } else if guard.internal {
             Ok(())
         } else {
-            match jump.event {
+            match &jump.event {
                 Some(name) => ledger.count_named(name),
                 None => ledger.count(mode, slot),
             }
             let labels = model.labels(mode, slot, &before);
             ledger.log(
                 self.event(
-                    jump.event.unwrap_or(guard.name),
+                    jump.event.as_deref().unwrap_or(&guard.name),
                     t,
                     jump.mode,
                     &before,
@@ -273,7 +274,7 @@ impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
         }
         // Internal switches are watched too: a chart that flickers at one
         // instant must not spin either.
-        if let Some(what) = ledger.zeno(mode, slot, guard.name, t) {
+        if let Some(what) = ledger.zeno(mode, slot, &guard.name, t) {
             return self.settle(what, t, ledger, observer);
         }
         let predicted = match (self.motion, jump.affects) {
@@ -365,7 +366,13 @@ impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
         self.origin = from.after_multiple(periods, tau);
         self.queue.postpone(periods, tau);
         self.bound.postpone(periods, tau);
-        ledger.jumped(self.repeated, periods, tau, (from, self.origin));
+        let (mode, slot, named) = &self.repeated;
+        ledger.jumped(
+            (*mode, *slot, named.as_ref()),
+            periods,
+            tau,
+            (from, self.origin),
+        );
     }
 
     fn renew(&mut self, t: Time) -> Result<(), End> {
@@ -566,7 +573,7 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
     /// to `self.after` in `mode_after`, with the model's energies.
     fn event<'a>(
         &'a self,
-        name: &'static str,
+        name: &'a str,
         t: Time,
         mode_after: Mode,
         before: &'a [f64],
@@ -1261,7 +1268,9 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
             event_time_bound: self.bound.event_time_bound(self.origin),
             state: self.state,
         };
-        ledger.outcome(end, last, |mode, slot| model.guards(mode)[slot].name)
+        ledger.outcome(end, last, |mode, slot| {
+            model.guards(mode)[slot].name.clone()
+        })
     }
 }
 

@@ -30,7 +30,7 @@ use nalgebra::{DMatrix, DVector};
 
 use crate::engine::labels::Labels;
 use crate::engine::model::{Flow, Guard, HybridModel, Jump, Mode};
-use crate::engine::names::intern;
+use crate::engine::names::Name;
 use crate::engine::saltation;
 use crate::numerics::central_difference::step_for;
 
@@ -42,7 +42,7 @@ pub struct Variational<'m, M: HybridModel + ?Sized> {
     m: usize,
     /// Each mode's state names: the model's, then `d{x}/d{p}` for each
     /// direction `p`, then `dt/d{p}`.
-    names: Vec<Vec<&'static str>>,
+    names: Vec<Vec<Name>>,
 }
 
 impl<'m, M: HybridModel + ?Sized> Variational<'m, M> {
@@ -59,11 +59,11 @@ impl<'m, M: HybridModel + ?Sized> Variational<'m, M> {
                 if base.is_empty() {
                     return Vec::new();
                 }
-                let mut names: Vec<&'static str> = base.to_vec();
+                let mut names: Vec<Name> = base.to_vec();
                 for p in directions {
-                    names.extend(base.iter().map(|x| intern(&format!("d{x}/d{p}"))));
+                    names.extend(base.iter().map(|x| Name::from(format!("d{x}/d{p}"))));
                 }
-                names.extend(directions.iter().map(|p| intern(&format!("dt/d{p}"))));
+                names.extend(directions.iter().map(|p| Name::from(format!("dt/d{p}"))));
                 names
             })
             .collect();
@@ -134,11 +134,11 @@ impl<M: HybridModel + ?Sized> HybridModel for Variational<'_, M> {
         self.n * (1 + self.m) + self.m
     }
 
-    fn state_names(&self, mode: Mode) -> &[&'static str] {
+    fn state_names(&self, mode: Mode) -> &[Name] {
         &self.names[mode]
     }
 
-    fn mode_name(&self, mode: Mode) -> &'static str {
+    fn mode_name(&self, mode: Mode) -> &str {
         self.model.mode_name(mode)
     }
 

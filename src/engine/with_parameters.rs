@@ -12,7 +12,7 @@
 
 use crate::engine::labels::Labels;
 use crate::engine::model::{Flow, Guard, HybridModel, Jump, Mode};
-use crate::engine::names::intern;
+use crate::engine::names::Name;
 use crate::numerics::central_difference::step_for;
 
 /// `base`'s structure, with its numbers from `build(p)`.
@@ -23,7 +23,7 @@ pub struct WithParameters<M, F> {
     /// How many parameters.
     p: usize,
     /// Each mode's state names, then the parameters'.
-    names: Vec<Vec<&'static str>>,
+    names: Vec<Vec<Name>>,
 }
 
 impl<M: HybridModel, F: Fn(&[f64]) -> M> WithParameters<M, F> {
@@ -36,7 +36,7 @@ impl<M: HybridModel, F: Fn(&[f64]) -> M> WithParameters<M, F> {
                 // no parameters either.
                 let mut names = base.state_names(mode).to_vec();
                 if !names.is_empty() {
-                    names.extend(parameters.iter().map(|p| intern(p)));
+                    names.extend(parameters.iter().map(|p| Name::from(p.as_str())));
                 }
                 names
             })
@@ -87,11 +87,11 @@ impl<M: HybridModel, F: Fn(&[f64]) -> M> HybridModel for WithParameters<M, F> {
         self.n + self.p
     }
 
-    fn state_names(&self, mode: Mode) -> &[&'static str] {
+    fn state_names(&self, mode: Mode) -> &[Name] {
         &self.names[mode]
     }
 
-    fn mode_name(&self, mode: Mode) -> &'static str {
+    fn mode_name(&self, mode: Mode) -> &str {
         self.base.mode_name(mode)
     }
 
@@ -229,23 +229,24 @@ impl<M: HybridModel, F: Fn(&[f64]) -> M> HybridModel for WithParameters<M, F> {
 mod tests {
     use super::*;
     use crate::engine::{Direction, Options, simulate};
+    use crate::names;
 
     /// `x' = -k x` from 1, a marker at `x = 1/2`: with `k` a state.
     struct Decay(f64);
-    const HALF: [Guard; 1] = [Guard::affine("half", Direction::Falling).as_crossing()];
+    const HALF: &[Guard] = &[Guard::affine("half", Direction::Falling).as_crossing()];
 
     impl HybridModel for Decay {
         fn dimension(&self) -> usize {
             1
         }
-        fn state_names(&self, _: Mode) -> &[&'static str] {
-            &["x"]
+        fn state_names(&self, _: Mode) -> &[Name] {
+            names!["x"]
         }
-        fn mode_name(&self, _: Mode) -> &'static str {
+        fn mode_name(&self, _: Mode) -> &str {
             "decay"
         }
         fn guards(&self, _: Mode) -> &[Guard] {
-            &HALF
+            HALF
         }
         fn guard(&self, _: Mode, _: usize, x: &[f64]) -> f64 {
             x[0] - 0.5

@@ -12,6 +12,7 @@
 //! event has none.
 
 use crate::engine::labels::Label;
+use crate::engine::names::Name;
 use crate::engine::observer::{EventRecord, Observer};
 
 /// Every event of a run, field by field.
@@ -28,7 +29,7 @@ pub struct EventColumns {
     /// The mode after the reset, likewise.
     pub mode_after: Vec<u32>,
     /// The guard and mode names the indices refer to, each once.
-    pub names: Vec<&'static str>,
+    pub names: Vec<Name>,
     /// The energy before each reset (NaN for a model without one).
     pub energy_before: Vec<f64>,
     /// The energy after each reset.
@@ -37,7 +38,7 @@ pub struct EventColumns {
     /// values are whole numbers (a unit's index).
     pub labels: Vec<LabelColumn>,
     /// The distinct lists of state names, as events name their states.
-    layouts: Vec<Vec<&'static str>>,
+    layouts: Vec<Vec<Name>>,
     /// Each event's layout before and after the reset.
     layout_before: Vec<u32>,
     layout_after: Vec<u32>,
@@ -61,7 +62,7 @@ pub struct LabelColumn {
 #[derive(Debug, Clone, PartialEq)]
 pub struct StateTable {
     /// The columns: every state name seen, in the order first seen.
-    pub names: Vec<&'static str>,
+    pub names: Vec<Name>,
     /// The state before each reset, row by row (`events x names`), NaN
     /// where the event's mode has no such state.
     pub before: Vec<f64>,
@@ -81,18 +82,18 @@ impl EventColumns {
     }
 
     /// The index of `name` among [`names`](Self::names), added if new.
-    fn name(&mut self, name: &'static str) -> u32 {
+    fn name(&mut self, name: &str) -> u32 {
         match self.names.iter().position(|n| *n == name) {
             Some(i) => i as u32,
             None => {
-                self.names.push(name);
+                self.names.push(Name::from(name));
                 (self.names.len() - 1) as u32
             }
         }
     }
 
     /// The index of the layout `names`, added if new (a model has a few).
-    fn layout(&mut self, names: &[&'static str]) -> u32 {
+    fn layout(&mut self, names: &[Name]) -> u32 {
         match self.layouts.iter().position(|l| l.as_slice() == names) {
             Some(i) => i as u32,
             None => {
@@ -105,11 +106,11 @@ impl EventColumns {
     /// The states before and after each event, laid out as one table
     /// (see the module doc); the values move out of the columns.
     pub fn states(&mut self) -> StateTable {
-        let mut names: Vec<&'static str> = Vec::new();
+        let mut names: Vec<Name> = Vec::new();
         for layout in &self.layouts {
             for name in layout {
                 if !names.contains(name) {
-                    names.push(name);
+                    names.push(name.clone());
                 }
             }
         }
@@ -204,11 +205,12 @@ impl Observer for EventColumns {
 mod tests {
     use super::*;
     use crate::engine::labels::Labels;
+    use crate::names;
 
     fn event<'a>(
         t: f64,
         guard: &'static str,
-        names: &'a [&'static str],
+        names: &'a [Name],
         before: &'a [f64],
         after: &'a [f64],
         labels: &'a Labels,
@@ -240,7 +242,7 @@ mod tests {
             .on_event(&event(
                 1.0,
                 "a",
-                &["x", "v"],
+                names!["x", "v"],
                 &[1.0, 2.0],
                 &[1.0, -2.0],
                 &none,
@@ -250,7 +252,7 @@ mod tests {
             .on_event(&event(
                 2.0,
                 "b",
-                &["q", "v"],
+                names!["q", "v"],
                 &[3.0, 4.0],
                 &[3.0, -4.0],
                 &unit,
@@ -281,7 +283,14 @@ mod tests {
         for k in 0..3 {
             let x = k as f64;
             columns
-                .on_event(&event(x, "a", &["x", "v"], &[x, 1.0], &[x, -1.0], &none))
+                .on_event(&event(
+                    x,
+                    "a",
+                    names!["x", "v"],
+                    &[x, 1.0],
+                    &[x, -1.0],
+                    &none,
+                ))
                 .unwrap();
         }
         let table = columns.states();

@@ -13,6 +13,8 @@
 use std::io::{self, Write};
 use std::path::Path;
 
+use crate::engine::Name;
+
 /// The most samples a run takes (`--samples`, or times in `--at`).
 pub const MAX_SAMPLES: usize = 10_000_000;
 
@@ -57,7 +59,7 @@ pub fn times(count: Option<usize>, at: Option<&[f64]>, t_end: f64) -> Result<Vec
 /// `samples` are `(t, state)`, `bounds` each sample's error bound.
 pub fn write_csv(
     path: &Path,
-    names: &[&str],
+    names: &[Name],
     samples: &[(f64, Vec<f64>)],
     bounds: &[f64],
 ) -> io::Result<()> {
@@ -67,7 +69,7 @@ pub fn write_csv(
     // A model's clock (the state named `t`, a name no other state may
     // take) is the first column already.
     let kept: Vec<usize> = (0..names.len()).filter(|&i| names[i] != "t").collect();
-    let header: Vec<&str> = kept.iter().map(|&i| names[i]).collect();
+    let header: Vec<&str> = kept.iter().map(|&i| names[i].as_str()).collect();
     writeln!(out, "t,{},bound", header.join(","))?;
     for ((t, state), bound) in samples.iter().zip(bounds) {
         out.write_all(number(&mut floats, *t).as_bytes())?;
@@ -124,7 +126,7 @@ mod tests {
         let path = dir.path().join("samples.csv");
         let awkward = [0.1 + 0.2, 1.0 / 3.0, -2.5e-300, 6.02214076e23];
         let samples = vec![(0.0, awkward[..2].to_vec()), (0.7, awkward[2..].to_vec())];
-        write_csv(&path, &["a", "b"], &samples, &[1e-16, f64::NAN]).unwrap();
+        write_csv(&path, crate::names!["a", "b"], &samples, &[1e-16, f64::NAN]).unwrap();
         let text = std::fs::read_to_string(&path).unwrap();
         let mut lines = text.lines();
         assert_eq!(lines.next(), Some("t,a,b,bound"));
@@ -137,7 +139,13 @@ mod tests {
         assert_eq!(row[..3], [0.7, awkward[2], awkward[3]]);
         assert!(row[3].is_nan());
         assert!(!path.with_extension("csv.tmp").exists());
-        write_csv(&path, &["x", "t"], &[(2.0, vec![1.5, 2.0])], &[0.0]).unwrap();
+        write_csv(
+            &path,
+            crate::names!["x", "t"],
+            &[(2.0, vec![1.5, 2.0])],
+            &[0.0],
+        )
+        .unwrap();
         let text = std::fs::read_to_string(&path).unwrap();
         assert_eq!(text, "t,x,bound\n2.0,1.5,0.0\n");
     }

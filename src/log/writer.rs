@@ -6,7 +6,7 @@
 
 use std::io::{self, Write};
 
-use crate::engine::{EventRecord, Label, Observer};
+use crate::engine::{EventRecord, Label, Name, Observer};
 
 /// Bytes collected before they are written out.
 const CHUNK: usize = 1 << 16;
@@ -55,7 +55,7 @@ impl<W: Write> JsonlWriter<W> {
         }
     }
 
-    fn state(&mut self, names: &[&str], values: &[f64]) {
+    fn state(&mut self, names: &[Name], values: &[f64]) {
         self.buffer.push(b'{');
         for (i, (name, value)) in names.iter().zip(values).enumerate() {
             if i > 0 {
@@ -243,9 +243,9 @@ mod tests {
             to: 0,
             energy_before: Some(0.025),
             energy_after: None,
-            names_before: &["strain", "strain_rate"],
+            names_before: crate::names!["strain", "strain_rate"],
             before: &[0.0, -1e-300],
-            names_after: &["strain", "strain_rate"],
+            names_after: crate::names!["strain", "strain_rate"],
             after: &[0.0, f64::NAN],
             labels: &Labels::NONE
                 .with("unit", Label::Count(7))

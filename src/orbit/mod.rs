@@ -17,7 +17,7 @@ mod json;
 pub mod section;
 pub mod shooting;
 
-use crate::engine::{Family, HybridModel, Mode, Observer, Options, Status, simulate};
+use crate::engine::{Family, HybridModel, Mode, Name, Observer, Options, Status, simulate};
 use crate::scene::SceneError;
 pub use section::Section;
 pub use shooting::{Orbit, OrbitRequest, Unknowns};
@@ -33,8 +33,8 @@ pub fn check(
     let mut known: Vec<&str> = Vec::new();
     for m in 0..modes {
         for g in model.guards(m) {
-            if !known.contains(&g.name) {
-                known.push(g.name);
+            if !known.contains(&&*g.name) {
+                known.push(&g.name);
             }
         }
     }
@@ -165,7 +165,7 @@ pub fn search(
                 status: format!("no start on the section: {why}"),
                 period: f64::NAN,
                 events_per_period: request.events,
-                mode: model.mode_name(mode0),
+                mode: model.mode_name(mode0).into(),
                 section_state: Vec::new(),
                 multipliers: Vec::new(),
                 stable: false,
@@ -185,7 +185,7 @@ pub fn search(
 
 /// A followed branch, the names of the state's components, and the
 /// parameter's component among them.
-pub type ContinuedBranch = (continuation::Branch, Vec<&'static str>, usize);
+pub type ContinuedBranch = (continuation::Branch, Vec<Name>, usize);
 
 /// A branch of orbits of `family`'s model followed in its parameter
 /// `parameter` to `to` (at most `points` orbits, the longest step

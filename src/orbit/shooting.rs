@@ -12,7 +12,7 @@
 use nalgebra::{DMatrix, DVector};
 
 use crate::engine::Mode;
-use crate::engine::names::intern;
+use crate::engine::names::Name;
 use crate::orbit::section::{Return, Section};
 
 /// Newton iterations at most.
@@ -63,9 +63,9 @@ pub struct Orbit {
     /// Section events per period.
     pub events_per_period: usize,
     /// The mode just after the section event.
-    pub mode: &'static str,
+    pub mode: Name,
     /// The state just after the section event, by name.
-    pub section_state: Vec<(&'static str, f64)>,
+    pub section_state: Vec<(Name, f64)>,
     /// The monodromy matrix's eigenvalues, `(re, im)`, saltation matrices
     /// included: first the trivial 1 of the flow's direction (or of the
     /// clock), then the others by decreasing modulus.
@@ -213,8 +213,8 @@ pub fn shoot(
         status,
         period: f64::NAN,
         events_per_period: section.events,
-        mode: section.model.mode_name(mode),
-        section_state: names.iter().copied().zip(x.iter().copied()).collect(),
+        mode: section.model.mode_name(mode).into(),
+        section_state: names.iter().cloned().zip(x.iter().copied()).collect(),
         multipliers: Vec::new(),
         stable: false,
         residual: f64::NAN,
@@ -302,7 +302,7 @@ pub(crate) fn names(
     mode: Mode,
     n: usize,
     parameter: Option<(usize, &str)>,
-) -> Vec<&'static str> {
+) -> Vec<Name> {
     let own = section.model.state_names(mode);
     if own.len() == n {
         return own.to_vec();
@@ -312,9 +312,9 @@ pub(crate) fn names(
         listed.insert(p, name.to_string());
     }
     if listed.len() == n {
-        return listed.iter().map(|name| intern(name)).collect();
+        return listed.into_iter().map(Name::from).collect();
     }
-    (0..n).map(|i| intern(&format!("x{i}"))).collect()
+    (0..n).map(|i| Name::from(format!("x{i}"))).collect()
 }
 
 /// The orbit at `x`, which Newton accepted: its period and multipliers
@@ -353,8 +353,8 @@ fn verified(
         status,
         period: back.elapsed,
         events_per_period: section.events,
-        mode: section.model.mode_name(mode),
-        section_state: names.iter().copied().zip(x.iter().copied()).collect(),
+        mode: section.model.mode_name(mode).into(),
+        section_state: names.iter().cloned().zip(x.iter().copied()).collect(),
         multipliers,
         stable,
         residual,

@@ -60,7 +60,7 @@ pub fn state_plane(
     let mut curves = Vec::new();
     let title;
     if events.events.len() <= MAX_JUMPS {
-        let slides = events.events.iter().any(|e| sliding_after(e.guard));
+        let slides = events.events.iter().any(|e| sliding_after(&e.guard));
         title = if slides {
             format!("{y} against {x} (dashed: resets; red: sliding)")
         } else {
@@ -91,7 +91,7 @@ pub fn state_plane(
                     style: Style::Jump,
                 });
             }
-            *sliding = sliding_after(e.guard);
+            *sliding = sliding_after(&e.guard);
             flight.push(point(&e.after));
         };
         for (t, state) in &trajectory.samples {

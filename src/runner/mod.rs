@@ -7,7 +7,7 @@ mod fields;
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
-use crate::engine::{Method, Options, Outcome, Tolerances};
+use crate::engine::{Method, Name, Options, Outcome, Tolerances};
 
 pub use fields::{CLASSICAL_MAX_UNITS, Classical, FieldOutputs, Profile, TraceRow};
 
@@ -21,7 +21,7 @@ pub struct Report {
     /// A sentence saying which description of the model was used and why.
     pub description: String,
     /// The final state in the scene's physical variables.
-    pub final_state: Vec<(&'static str, f64)>,
+    pub final_state: Vec<(Name, f64)>,
     /// What a model with extent adds: momentum, profiles, the trace.
     pub fields: Option<FieldOutputs>,
     /// The derivatives of the final state and of the last event's time
@@ -37,7 +37,7 @@ pub struct Report {
 #[derive(Debug, Clone)]
 pub struct Trajectory {
     /// The names of the state's components.
-    pub names: Vec<&'static str>,
+    pub names: Vec<Name>,
     /// `(t, state)` at each sample time the run reached (the state before
     /// an event at the same time).
     pub samples: Vec<(f64, Vec<f64>)>,
@@ -53,7 +53,7 @@ impl Trajectory {
     /// The trajectory of a run `run` makes, handing each sample it takes
     /// to the callback it is given; `names` head the state's components.
     pub fn record<E>(
-        names: Vec<&'static str>,
+        names: Vec<Name>,
         run: impl FnOnce(&mut dyn FnMut(&crate::engine::Sample)) -> Result<Report, E>,
     ) -> Result<Trajectory, E> {
         let (mut samples, mut bounds) = (Vec::new(), Vec::new());

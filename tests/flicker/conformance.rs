@@ -29,11 +29,13 @@
 //! crossing, and a completed run is within its stated bounds. A wrong count
 //! or a time outside its bound fails the test, naming the case.
 
+use flicker::engine::Name;
 use flicker::engine::{
     Affects, Direction, Flow, Guard, HybridModel, Jump, Method, Mode, Options, Outcome, Status,
     Tolerances, simulate,
 };
 use flicker::models::automaton::{AutomatonBuilder, TransitionBuilder};
+use flicker::names;
 
 use crate::support::{EventLog, Seen};
 
@@ -317,7 +319,7 @@ struct ExactOscillator {
 impl ExactOscillator {
     fn new(case: &Case) -> Self {
         let guard = |name| Guard {
-            name,
+            name: Name::new(name),
             direction: case.direction,
             affine: true,
             internal: false,
@@ -341,10 +343,10 @@ impl HybridModel for ExactOscillator {
     fn dimension(&self) -> usize {
         4
     }
-    fn state_names(&self, _: Mode) -> &[&'static str] {
-        &["x", "k", "v", "w"]
+    fn state_names(&self, _: Mode) -> &[Name] {
+        names!["x", "k", "v", "w"]
     }
-    fn mode_name(&self, mode: Mode) -> &'static str {
+    fn mode_name(&self, mode: Mode) -> &str {
         ["a", "b"][mode]
     }
     fn guards(&self, _: Mode) -> &[Guard] {
@@ -451,12 +453,19 @@ fn check(case: &Case) -> Result<bool, String> {
             "{} events where the closed form has {}: {:?} against {:?}",
             seen.len(),
             want.len(),
-            seen.iter().map(|e| (e.t, e.guard)).collect::<Vec<_>>(),
+            seen.iter()
+                .map(|e| (e.t, e.guard.as_str()))
+                .collect::<Vec<_>>(),
             want.iter().map(|e| (e.0, e.1)).collect::<Vec<_>>()
         ));
     }
     for (k, (e, w)) in seen.iter().zip(&want).enumerate() {
-        if (e.guard, e.mode_before, e.mode_after) != (w.1, w.2, w.3) {
+        if (
+            e.guard.as_str(),
+            e.mode_before.as_str(),
+            e.mode_after.as_str(),
+        ) != (w.1, w.2, w.3)
+        {
             return Err(format!("event {k}: {e:?} where the closed form has {w:?}"));
         }
         if (e.t - w.0).abs() > time_bound + ulps(w.0) {
@@ -661,7 +670,7 @@ fn an_exact_marker_re_predicted_by_range_fires_once_per_crossing() {
             "{direction:?}: {:?}",
             outcome.reason
         );
-        let seen: Vec<(f64, &str)> = log.0.iter().map(|e| (e.t, e.guard)).collect();
+        let seen: Vec<(f64, &str)> = log.0.iter().map(|e| (e.t, e.guard.as_str())).collect();
         assert_eq!(seen.len(), want.len(), "{direction:?}: {seen:?}");
         for (e, w) in seen.iter().zip(&want) {
             assert_eq!(e.1, w.1, "{direction:?}: {seen:?}");
@@ -676,19 +685,19 @@ fn an_exact_marker_re_predicted_by_range_fires_once_per_crossing() {
 #[test]
 fn a_marker_predicted_at_once_forever_stops_the_run() {
     struct Stuck;
-    const STUCK: [Guard; 1] = [Guard::affine("mark", Direction::Rising).as_crossing()];
+    const STUCK: &[Guard] = &[Guard::affine("mark", Direction::Rising).as_crossing()];
     impl HybridModel for Stuck {
         fn dimension(&self) -> usize {
             1
         }
-        fn state_names(&self, _: Mode) -> &[&'static str] {
-            &["x"]
+        fn state_names(&self, _: Mode) -> &[Name] {
+            names!["x"]
         }
-        fn mode_name(&self, _: Mode) -> &'static str {
+        fn mode_name(&self, _: Mode) -> &str {
             "m"
         }
         fn guards(&self, _: Mode) -> &[Guard] {
-            &STUCK
+            STUCK
         }
         fn guard(&self, _: Mode, _: usize, x: &[f64]) -> f64 {
             x[0]
@@ -750,7 +759,11 @@ fn a_corner_fires_both_surfaces_at_once_by_every_method() {
             "{way:?}: {:?}",
             outcome.reason
         );
-        let seen: Vec<(&str, &str)> = log.0.iter().map(|e| (e.guard, e.mode_after)).collect();
+        let seen: Vec<(&str, &str)> = log
+            .0
+            .iter()
+            .map(|e| (e.guard.as_str(), e.mode_after.as_str()))
+            .collect();
         assert_eq!(seen, [("first", "b"), ("second", "c")], "{way:?}");
         assert!(log.0.iter().all(|e| (e.t - 1.0).abs() < 1e-12), "{way:?}");
     }

@@ -186,7 +186,7 @@ fn the_paper_release_is_a_front_at_the_wave_speed_then_one_impact_at_the_wall() 
     );
     assert_eq!(outcome.status, Status::Completed, "{:?}", outcome.reason);
     assert!(worst < 1e-15, "{worst:e}");
-    let guards: Vec<&str> = log.events.iter().map(|e| e.guard).collect();
+    let guards: Vec<&str> = log.events.iter().map(|e| e.guard.as_str()).collect();
     assert_eq!(guards, ["wall", "impact"]);
     let impact = &log.events[1];
     assert_eq!((impact.t, impact.labels.number("x")), (2.0, Some(-1.0)));

@@ -5,10 +5,12 @@
 
 use std::cell::Cell;
 
+use flicker::engine::Name;
 use flicker::engine::{
     Affects, Direction, Fired, Flow, Guard, HybridModel, Jump, Labels, LocalModel, Mode, Options,
     Recorder, Status, simulate, simulate_local,
 };
+use flicker::names;
 use flicker::time::Time;
 
 /// Two independent ramps `x' = 1`, `y' = 4`, each wrapped to zero at one.
@@ -17,7 +19,7 @@ struct TwoRamps {
 }
 
 const RATES: [f64; 2] = [1.0, 4.0];
-const WRAPS: [Guard; 2] = [
+const WRAPS: &[Guard] = &[
     Guard::affine("wrap_x", Direction::Rising),
     Guard::affine("wrap_y", Direction::Rising),
 ];
@@ -26,14 +28,14 @@ impl HybridModel for TwoRamps {
     fn dimension(&self) -> usize {
         2
     }
-    fn state_names(&self, _: Mode) -> &[&'static str] {
-        &["x", "y"]
+    fn state_names(&self, _: Mode) -> &[Name] {
+        names!["x", "y"]
     }
-    fn mode_name(&self, _: Mode) -> &'static str {
+    fn mode_name(&self, _: Mode) -> &str {
         "ramps"
     }
     fn guards(&self, _: Mode) -> &[Guard] {
-        &WRAPS
+        WRAPS
     }
     fn guard(&self, _: Mode, g: usize, x: &[f64]) -> f64 {
         x[g] - 1.0
@@ -93,7 +95,7 @@ fn simultaneous_events_come_out_in_guard_order() {
         .events
         .iter()
         .filter(|e| e.t == 1.0)
-        .map(|e| e.guard)
+        .map(|e| e.guard.as_str())
         .collect();
     assert_eq!(at_one, vec!["wrap_x", "wrap_y"]);
     let times: Vec<f64> = log.events.iter().map(|e| e.t).collect();
@@ -111,7 +113,7 @@ struct SilencedAlarm {
     alarm_predictions: Cell<u64>,
 }
 
-const CLOCK: [Guard; 2] = [
+const CLOCK: &[Guard] = &[
     Guard::affine("tick", Direction::Rising),
     Guard::affine("alarm", Direction::Rising),
 ];
@@ -121,7 +123,7 @@ impl LocalModel for SilencedAlarm {
         "clock"
     }
     fn guards(&self) -> &[Guard] {
-        &CLOCK
+        CLOCK
     }
     fn predict(&self, guard: usize, now: Time) -> Result<Option<Time>, String> {
         if guard == 0 {

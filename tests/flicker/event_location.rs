@@ -1,10 +1,12 @@
 //! Event location on numerical flows must not miss a crossing, even one that
 //! enters and leaves inside a single step.
 
+use flicker::engine::Name;
 use flicker::engine::{
     Direction, Flow, Guard, HybridModel, Jump, Method, Mode, Options, Outcome, Recorder, Status,
     Tolerances, simulate,
 };
+use flicker::names;
 
 /// A harmonic oscillator `x'' = -x` whose guard `x = level` is reached only
 /// briefly near each crest: with a loose tolerance the integrator takes a
@@ -14,20 +16,20 @@ struct Crest {
     level: f64,
 }
 
-const CREST_GUARDS: [Guard; 1] = [Guard::affine("crest", Direction::Rising).as_crossing()];
+const CREST_GUARDS: &[Guard] = &[Guard::affine("crest", Direction::Rising).as_crossing()];
 
 impl HybridModel for Crest {
     fn dimension(&self) -> usize {
         2
     }
-    fn state_names(&self, _: Mode) -> &[&'static str] {
-        &["x", "v"]
+    fn state_names(&self, _: Mode) -> &[Name] {
+        names!["x", "v"]
     }
-    fn mode_name(&self, _: Mode) -> &'static str {
+    fn mode_name(&self, _: Mode) -> &str {
         "free"
     }
     fn guards(&self, _: Mode) -> &[Guard] {
-        &CREST_GUARDS
+        CREST_GUARDS
     }
     fn guard(&self, _: Mode, _: usize, x: &[f64]) -> f64 {
         x[0] - self.level

@@ -2,33 +2,35 @@
 //! well as by name, and an observer that has seen what it came for ends
 //! the run at that event.
 
+use flicker::engine::Name;
 use flicker::engine::{
     Direction, EventRecord, Flow, Guard, HybridModel, Jump, Mode, Observer, Options, Status,
     simulate,
 };
+use flicker::names;
 
 /// `x` climbs to 1 at rate 1 in mode `up`, falls to 0 at rate 2 in mode
 /// `down`, and turns there: a triangle wave of period 1.5.
 struct Triangle;
 
 const RATE: [f64; 2] = [1.0, -2.0];
-const TURNS: [[Guard; 1]; 2] = [
-    [Guard::affine("top", Direction::Rising)],
-    [Guard::affine("bottom", Direction::Falling)],
+const TURNS: &[&[Guard]] = &[
+    &[Guard::affine("top", Direction::Rising)],
+    &[Guard::affine("bottom", Direction::Falling)],
 ];
 
 impl HybridModel for Triangle {
     fn dimension(&self) -> usize {
         1
     }
-    fn state_names(&self, _: Mode) -> &[&'static str] {
-        &["x"]
+    fn state_names(&self, _: Mode) -> &[Name] {
+        names!["x"]
     }
-    fn mode_name(&self, mode: Mode) -> &'static str {
+    fn mode_name(&self, mode: Mode) -> &str {
         ["up", "down"][mode]
     }
     fn guards(&self, mode: Mode) -> &[Guard] {
-        &TURNS[mode]
+        TURNS[mode]
     }
     fn guard(&self, mode: Mode, _: usize, x: &[f64]) -> f64 {
         if mode == 0 { x[0] - 1.0 } else { x[0] }
@@ -51,14 +53,14 @@ impl HybridModel for Triangle {
 
 /// Keeps each event's modes, and asks the run to end after `stop_after`.
 struct Modes {
-    seen: Vec<(Mode, Mode, &'static str, &'static str, f64)>,
+    seen: Vec<(Mode, Mode, String, String, f64)>,
     stop_after: usize,
 }
 
 impl Observer for Modes {
     fn on_event(&mut self, e: &EventRecord) -> std::io::Result<()> {
         self.seen
-            .push((e.from, e.to, e.mode_before, e.mode_after, e.t));
+            .push((e.from, e.to, e.mode_before.into(), e.mode_after.into(), e.t));
         Ok(())
     }
 
@@ -78,11 +80,11 @@ fn events_carry_their_modes_by_index_and_by_name() {
     // Turns at 1, 1.5, 2.5, 3; the next top is at 4.
     let times: Vec<f64> = modes.seen.iter().map(|s| s.4).collect();
     assert_eq!(times, vec![1.0, 1.5, 2.5, 3.0]);
-    for (i, &(from, to, before, after, _)) in modes.seen.iter().enumerate() {
-        assert_eq!(from, i % 2);
-        assert_eq!(to, 1 - i % 2);
-        assert_eq!(before, Triangle.mode_name(from));
-        assert_eq!(after, Triangle.mode_name(to));
+    for (i, (from, to, before, after, _)) in modes.seen.iter().enumerate() {
+        assert_eq!(*from, i % 2);
+        assert_eq!(*to, 1 - i % 2);
+        assert_eq!(before, Triangle.mode_name(*from));
+        assert_eq!(after, Triangle.mode_name(*to));
     }
 }
 

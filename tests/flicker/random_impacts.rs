@@ -294,7 +294,7 @@ fn keeps_its_word(
     }
     for (k, (e, (t, name))) in seen.iter().zip(events).enumerate() {
         let off = (d(e.t) - *t).abs();
-        if e.guard != name || f(off) > time_bound + 8.0 * f64::EPSILON * e.t.abs().max(1.0) {
+        if e.guard != *name || f(off) > time_bound + 8.0 * f64::EPSILON * e.t.abs().max(1.0) {
             return Err(format!(
                 "event {k}: `{}` at {} where the reference has `{name}` at {} ({:.2e} off, bound {time_bound:.2e})",
                 e.guard,

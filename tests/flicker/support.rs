@@ -11,9 +11,9 @@ use serde_json::Value;
 #[derive(Debug, Clone, PartialEq)]
 pub struct Seen {
     pub t: f64,
-    pub guard: &'static str,
-    pub mode_before: &'static str,
-    pub mode_after: &'static str,
+    pub guard: String,
+    pub mode_before: String,
+    pub mode_after: String,
     pub before: Vec<f64>,
     pub after: Vec<f64>,
 }
@@ -26,9 +26,9 @@ impl Observer for EventLog {
     fn on_event(&mut self, e: &EventRecord) -> std::io::Result<()> {
         self.0.push(Seen {
             t: e.t,
-            guard: e.guard,
-            mode_before: e.mode_before,
-            mode_after: e.mode_after,
+            guard: e.guard.into(),
+            mode_before: e.mode_before.into(),
+            mode_after: e.mode_after.into(),
             before: e.before.to_vec(),
             after: e.after.to_vec(),
         });

@@ -13,7 +13,7 @@ use rand::RngExt;
 use rayon::prelude::*;
 use serde_json::{Value, json};
 
-use crate::engine::{HybridModel, Status, simulate_sampled};
+use crate::engine::{HybridModel, Name, Status, simulate_sampled};
 use crate::models::automaton::scene::AutomatonScene;
 use crate::runner::Control;
 use crate::runner::ensemble::{EnsembleReport, EnsembleRequest, spread};
@@ -138,7 +138,7 @@ fn run_copy(
 /// of `ensemble.csv` per sample time (each state's spread), what to print.
 fn report(
     request: &EnsembleRequest,
-    names: &[&'static str],
+    names: &[Name],
     times: &[f64],
     spreads: &[Vec<f64>],
     scale: &[f64],
@@ -152,7 +152,7 @@ fn report(
             let mut row = serde_json::Map::new();
             row.insert("t".into(), json!(t));
             for (name, d) in names.iter().zip(d) {
-                row.insert((*name).into(), json!(d));
+                row.insert(name.to_string(), json!(d));
             }
             Value::Object(row)
         })

@@ -15,8 +15,7 @@ use std::cell::RefCell;
 
 use nalgebra::{DMatrix, DVector};
 
-use crate::engine::names::intern;
-use crate::engine::{Flow, Guard, HybridModel, Jump, Mode};
+use crate::engine::{Flow, Guard, HybridModel, Jump, Mode, Name};
 use crate::models::automaton::definition::{Definition, Source};
 use crate::models::automaton::expr::derivative::{jacobian, jacobian_into, jacobian_tape};
 use crate::models::automaton::expr::recurrences::Series;
@@ -27,7 +26,7 @@ use crate::scene::SceneError;
 /// A compiled automaton.
 #[derive(Debug, Clone)]
 pub struct Automaton {
-    states: Vec<&'static str>,
+    states: Vec<Name>,
     /// Whether the last state component is the clock.
     clock: bool,
     modes: Vec<CompiledMode>,
@@ -47,7 +46,7 @@ pub struct Automaton {
 
 #[derive(Debug, Clone)]
 struct CompiledMode {
-    name: &'static str,
+    name: String,
     /// The rate of every state component.
     flow: Tape,
     /// Its Jacobian's entries, row-major, where compiled (a smooth flow).
@@ -115,7 +114,7 @@ struct Surfaces {
     repelling: Vec<Mode>,
     double: Mode,
     /// What a slide onto each surface is called in the log.
-    slide_names: Vec<&'static str>,
+    slide_names: Vec<Name>,
     /// The state each surface is, up to a constant, where it is one.
     held: Vec<Option<usize>>,
 }
@@ -127,7 +126,7 @@ impl Surfaces {
     /// signs; on one surface, the side both flows carry it to, sliding
     /// where both point into it, the refusal where both point away; on two
     /// at once, the refusal.
-    fn pick(&self, x: &[f64], on: Option<usize>) -> (Mode, Option<&'static str>) {
+    fn pick(&self, x: &[f64], on: Option<usize>) -> (Mode, Option<&Name>) {
         let mut bits = 0;
         let mut zero = None;
         for (j, h) in self.surfaces.iter().enumerate() {
@@ -150,7 +149,7 @@ impl Surfaces {
         let plus_in = self.rates[plus][j].eval1(x) <= 0.0;
         let minus_in = self.rates[minus][j].eval1(x) >= 0.0;
         match (plus_in, minus_in) {
-            (true, true) => (self.sliding[j][bits], Some(self.slide_names[j])),
+            (true, true) => (self.sliding[j][bits], Some(&self.slide_names[j])),
             (true, false) => (self.regions[minus], None),
             (false, true) => (self.regions[plus], None),
             (false, false) => (self.repelling[j], None),
@@ -240,7 +239,7 @@ impl Automaton {
             for (t, &pick) in mode.transitions.iter().zip(&expanded.targets[index]) {
                 let tape = compile(&[&t.guard])?;
                 guards.push(Guard {
-                    name: intern(&t.name),
+                    name: Name::from(t.name.as_str()),
                     direction: t.direction,
                     affine: tape.affine(),
                     internal: false,
@@ -289,7 +288,7 @@ impl Automaton {
             };
             modes.push(CompiledMode {
                 rough,
-                name: intern(&mode.name),
+                name: mode.name.clone(),
                 flow,
                 flow_jacobian,
                 rates: mode.flow.clone(),
@@ -335,7 +334,7 @@ impl Automaton {
                     slide_names: f
                         .surfaces
                         .iter()
-                        .map(|h| intern(&filippov::event_name("slide", h)))
+                        .map(|h| Name::from(filippov::event_name("slide", h)))
                         .collect(),
                     held: f.held.clone(),
                 })
@@ -348,7 +347,7 @@ impl Automaton {
             _ => definition.initial_mode,
         };
         Ok(Automaton {
-            states: inputs.iter().map(|s| intern(s)).collect(),
+            states: inputs.into_iter().map(Name::from).collect(),
             clock,
             modes,
             energy,
@@ -410,12 +409,12 @@ impl HybridModel for Automaton {
         self.states.len()
     }
 
-    fn state_names(&self, _: Mode) -> &[&'static str] {
+    fn state_names(&self, _: Mode) -> &[Name] {
         &self.states
     }
 
-    fn mode_name(&self, mode: Mode) -> &'static str {
-        self.modes[mode].name
+    fn mode_name(&self, mode: Mode) -> &str {
+        &self.modes[mode].name
     }
 
     fn guards(&self, mode: Mode) -> &[Guard] {
@@ -538,7 +537,7 @@ impl HybridModel for Automaton {
             }
         };
         match named {
-            Some(name) => Jump::to(to).named(name),
+            Some(name) => Jump::to(to).named(name.clone()),
             None => Jump::to(to),
         }
     }

@@ -174,7 +174,7 @@ impl AutomatonScene {
         let final_state = outcome
             .final_state_names
             .iter()
-            .copied()
+            .cloned()
             .zip(outcome.final_state.iter().copied())
             .collect();
         Ok(Report {

@@ -8,19 +8,19 @@ use nalgebra::{DMatrix, DVector};
 
 use super::collide::{cascade, cascade_with};
 use super::{Chain, impact_labels};
-use crate::engine::{Flow, Guard, HybridModel, Jump, Labels, Mode};
+use crate::engine::{Flow, Guard, HybridModel, Jump, Labels, Mode, Name};
 
 impl HybridModel for Chain {
     fn dimension(&self) -> usize {
         2 * self.units
     }
 
-    fn state_names(&self, _: Mode) -> &[&'static str] {
+    fn state_names(&self, _: Mode) -> &[Name] {
         // Nodes are many; the log names the two halves of the state.
         &[]
     }
 
-    fn mode_name(&self, _: Mode) -> &'static str {
+    fn mode_name(&self, _: Mode) -> &str {
         "chain"
     }
 

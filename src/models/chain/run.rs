@@ -3,8 +3,8 @@
 //! profiles at the snapshot times and the trace at the sample times.
 
 use crate::engine::{
-    HybridModel, LocalModel, Method, Observer, Options, Outcome, Sample, Status, simulate_local,
-    simulate_sampled,
+    HybridModel, LocalModel, Method, Name, Observer, Options, Outcome, Sample, Status,
+    simulate_local, simulate_sampled,
 };
 use crate::models::chain::scene::ChainScene;
 use crate::models::chain::{Chain, TaylorChain};
@@ -260,8 +260,8 @@ fn report(outcome: Outcome, method: Method, description: String, fields: FieldOu
         method,
         description,
         final_state: vec![
-            ("momentum", fields.momentum),
-            ("right_end", fields.right_end),
+            (Name::new("momentum"), fields.momentum),
+            (Name::new("right_end"), fields.right_end),
         ],
         fields: Some(fields),
         sensitivities: None,

@@ -46,7 +46,7 @@ use crate::time::Time;
 /// Courant number of a step against the fastest cell.
 pub const CFL: f64 = 0.4;
 
-const STEP: [Guard; 1] = [Guard::affine("step", Direction::Rising).as_internal()];
+const STEP: &[Guard] = &[Guard::affine("step", Direction::Rising).as_internal()];
 
 /// One cell's conserved densities: mean strain, momentum, energy.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -382,7 +382,7 @@ impl LocalModel for Homogenized {
     }
 
     fn guards(&self) -> &[Guard] {
-        &STEP
+        STEP
     }
 
     fn predict(&self, _: usize, now: Time) -> Result<Option<Time>, String> {

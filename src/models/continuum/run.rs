@@ -3,7 +3,7 @@
 //! snapshot times, the trace at the sample times, and the classical string
 //! (constraint off) beside it.
 
-use crate::engine::{Method, Observer, Outcome, Status, simulate_local};
+use crate::engine::{Method, Name, Observer, Outcome, Status, simulate_local};
 use crate::models::continuum::scene::ContinuumScene;
 use crate::models::continuum::{FrontTracking, Homogenized, StringModel, Variant};
 use crate::runner::{Classical, Control, FieldOutputs, Profile, Report, TraceRow};
@@ -44,8 +44,8 @@ pub(crate) fn run(
         },
         description: describe(scene),
         final_state: vec![
-            ("momentum", fields.momentum),
-            ("right_end", fields.right_end),
+            (Name::new("momentum"), fields.momentum),
+            (Name::new("right_end"), fields.right_end),
         ],
         fields: Some(fields),
         sensitivities: None,

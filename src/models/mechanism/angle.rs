@@ -16,7 +16,7 @@
 //! Below the critical load, chattering at `theta = 0` settles into the
 //! `resting` mode, as in the strain formulation.
 
-use crate::engine::{Direction, Flow, Guard, HybridModel, Jump, Mode};
+use crate::engine::{Direction, Flow, Guard, HybridModel, Jump, Mode, Name};
 use crate::models::mechanism::closed_form::Mechanism;
 
 /// The angle chart, `theta > 0`: state `[theta, theta']`.
@@ -40,11 +40,11 @@ pub const SWITCH_IN: f64 = 0.01;
 /// Strain above which the strain chart hands back to the angle chart.
 pub const SWITCH_OUT: f64 = 0.02;
 
-const ANGLE_STATE: [&str; 2] = ["angle", "angle_rate"];
-const STRAIN_STATE: [&str; 2] = ["strain", "strain_rate"];
-const ANGLE_GUARDS: [Guard; 1] =
-    [Guard::affine("enter_strain_chart", Direction::Falling).as_internal()];
-const STRAIN_GUARDS: [Guard; 2] = [
+const ANGLE_STATE: &[Name] = &[Name::new("angle"), Name::new("angle_rate")];
+const STRAIN_STATE: &[Name] = &[Name::new("strain"), Name::new("strain_rate")];
+const ANGLE_GUARDS: &[Guard] =
+    &[Guard::affine("enter_strain_chart", Direction::Falling).as_internal()];
+const STRAIN_GUARDS: &[Guard] = &[
     Guard::affine("impact", Direction::Falling),
     Guard::affine("leave_strain_chart", Direction::Rising).as_internal(),
 ];
@@ -163,15 +163,15 @@ impl HybridModel for AngleMechanism {
         2
     }
 
-    fn state_names(&self, mode: Mode) -> &[&'static str] {
+    fn state_names(&self, mode: Mode) -> &[Name] {
         if is_strain_chart(mode) {
-            &STRAIN_STATE
+            STRAIN_STATE
         } else {
-            &ANGLE_STATE
+            ANGLE_STATE
         }
     }
 
-    fn mode_name(&self, mode: Mode) -> &'static str {
+    fn mode_name(&self, mode: Mode) -> &str {
         match mode {
             ANGLE_POSITIVE => "angle_chart_positive",
             ANGLE_NEGATIVE => "angle_chart_negative",
@@ -184,8 +184,8 @@ impl HybridModel for AngleMechanism {
 
     fn guards(&self, mode: Mode) -> &[Guard] {
         match mode {
-            ANGLE_POSITIVE | ANGLE_NEGATIVE => &ANGLE_GUARDS,
-            STRAIN_POSITIVE | STRAIN_NEGATIVE => &STRAIN_GUARDS,
+            ANGLE_POSITIVE | ANGLE_NEGATIVE => ANGLE_GUARDS,
+            STRAIN_POSITIVE | STRAIN_NEGATIVE => STRAIN_GUARDS,
             _ => &[],
         }
     }

@@ -1,6 +1,6 @@
 //! Running a mechanism scene in the formulation and method it asks for.
 
-use crate::engine::{Method, Observer, Sample, simulate_sampled};
+use crate::engine::{Method, Name, Observer, Sample, simulate_sampled};
 use crate::models::mechanism::scene::{Formulation, Initial, MechanismScene};
 use crate::models::mechanism::strain::FLIGHT;
 use crate::models::mechanism::{AngleMechanism, Charts, StrainMechanism};
@@ -32,7 +32,7 @@ pub(crate) fn run_sampled(
         scene.tolerances,
     );
     let (eps, rate) = scene.initial_strain;
-    let strain_names = ["strain", "strain_rate"];
+    let strain_names = [Name::new("strain"), Name::new("strain_rate")];
     match scene.formulation {
         Formulation::Strain => {
             let model = StrainMechanism {
@@ -104,7 +104,7 @@ pub(crate) fn run_sampled(
                 outcome,
                 method,
                 description,
-                final_state: vec![("strain", e), ("strain_rate", r)],
+                final_state: vec![(Name::new("strain"), e), (Name::new("strain_rate"), r)],
                 fields: None,
                 sensitivities: None,
             })

@@ -31,7 +31,7 @@ use crate::engine::Observer;
 use crate::engine::integrator::{methods_for, runs};
 use crate::engine::zeno;
 use crate::engine::{HybridModel, Mode};
-use crate::engine::{Method, Tolerances};
+use crate::engine::{Method, Name, Tolerances};
 use crate::models::mechanism::strain::{self, FLIGHT};
 use crate::models::mechanism::{AngleMechanism, ExactOrbit, StrainMechanism, angle};
 use crate::models::mechanism::{Charts, Mechanism, Phase};
@@ -362,7 +362,7 @@ impl SceneModel for MechanismScene {
         observer: &mut dyn Observer,
     ) -> Option<Result<Trajectory, SceneError>> {
         Some(Trajectory::record(
-            vec!["strain", "strain_rate"],
+            vec![Name::new("strain"), Name::new("strain_rate")],
             |on_sample| super::run::run_sampled(self, control, times, on_sample, observer),
         ))
     }

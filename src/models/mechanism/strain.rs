@@ -12,7 +12,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use crate::engine::{Direction, Flow, Guard, HybridModel, Jump, Mode};
+use crate::engine::{Direction, Flow, Guard, HybridModel, Jump, Mode, Name};
 use crate::models::mechanism::closed_form::Mechanism;
 
 /// Free flight: the linear oscillator, closing on the impact guard `eps = 0`.
@@ -20,8 +20,8 @@ pub const FLIGHT: Mode = 0;
 /// Resting contact at `eps = 0` below the critical load, after chattering.
 pub const RESTING: Mode = 1;
 
-const STATE: [&str; 2] = ["strain", "strain_rate"];
-const FLIGHT_GUARDS: [Guard; 1] = [Guard::affine("impact", Direction::Falling)];
+const STATE: &[Name] = &[Name::new("strain"), Name::new("strain_rate")];
+const FLIGHT_GUARDS: &[Guard] = &[Guard::affine("impact", Direction::Falling)];
 
 /// State `[eps, eps']`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -35,16 +35,16 @@ impl HybridModel for StrainMechanism {
         2
     }
 
-    fn state_names(&self, _: Mode) -> &[&'static str] {
-        &STATE
+    fn state_names(&self, _: Mode) -> &[Name] {
+        STATE
     }
 
-    fn mode_name(&self, mode: Mode) -> &'static str {
+    fn mode_name(&self, mode: Mode) -> &str {
         if mode == RESTING { "resting" } else { "flight" }
     }
 
     fn guards(&self, mode: Mode) -> &[Guard] {
-        if mode == RESTING { &[] } else { &FLIGHT_GUARDS }
+        if mode == RESTING { &[] } else { FLIGHT_GUARDS }
     }
 
     fn guard(&self, _: Mode, _: usize, x: &[f64]) -> f64 {
