@@ -155,7 +155,7 @@ pub fn search_fall(c: &[f64], a: f64, b: f64) -> Result<Option<f64>, String> {
         budget: std::cell::Cell::new(MAX_PIECES),
         gave_up: std::cell::Cell::new(false),
     };
-    let root = bound.search(from, b, at, 0);
+    let root = bound.search((from, b), (at, eval(c, b)), &mut None, 0);
     if bound.gave_up.get() {
         return Err(format!(
             "the first root on [{a:e}, {b:e}] could not be isolated within {MAX_PIECES} pieces \
@@ -225,11 +225,24 @@ enum Verdict {
     Unknown,
 }
 
+/// A piece's polynomial re-expanded at its left end, once computed: the
+/// left half of a piece has the same left end, and the same expansion.
+type Shifted = Option<[f64; MAX_SHIFTED]>;
+
 impl Piece<'_> {
-    fn search(&self, x0: f64, x1: f64, at0: (f64, f64, f64), depth: u32) -> Option<f64> {
-        let end = eval(self.c, x1);
+    /// The first falling crossing on `[x0, x1]`, given `(p, p', p'')` at
+    /// `x0` and `p` at `x1`, and the expansion at `x0` where known. Each
+    /// value is computed once: a half takes its ends' values from its
+    /// parent (`p` at the middle from the same Horner sum as alone).
+    fn search(
+        &self,
+        (x0, x1): (f64, f64),
+        (at0, end): ((f64, f64, f64), f64),
+        shifted: &mut Shifted,
+        depth: u32,
+    ) -> Option<f64> {
         let verdict = match self.classify(x1 - x0, at0, end) {
-            Verdict::Unknown => self.classify_shifted(x0, x1 - x0, end),
+            Verdict::Unknown => self.classify_shifted(x0, x1 - x0, end, shifted),
             known => known,
         };
         match verdict {
@@ -249,8 +262,8 @@ impl Piece<'_> {
                     return (at0.0 > 0.0 && end <= 0.0).then_some(x1);
                 }
                 let at_mid = eval2(self.c, mid);
-                self.search(x0, mid, at0, depth + 1)
-                    .or_else(|| self.search(mid, x1, at_mid, depth + 1))
+                self.search((x0, mid), (at0, at_mid.0), shifted, depth + 1)
+                    .or_else(|| self.search((mid, x1), (at_mid, end), &mut None, depth + 1))
             }
         }
     }
@@ -293,20 +306,23 @@ impl Piece<'_> {
     /// on the third derivative over the whole interval, these follow a
     /// polynomial that is flat to many orders at `x0` (a unit shut and at
     /// rest, its neighbours just starting to move).
-    fn classify_shifted(&self, x0: f64, w: f64, end: f64) -> Verdict {
+    fn classify_shifted(&self, x0: f64, w: f64, end: f64, shifted: &mut Shifted) -> Verdict {
         let len = self.c.len();
         if len > MAX_SHIFTED {
             return Verdict::Unknown;
         }
-        let mut c = [0.0; MAX_SHIFTED];
-        c[..len].copy_from_slice(self.c);
-        // From the series' own origin (most searches) there is nothing to
-        // shift: the sums would only add zeros.
-        for k in (0..len).filter(|_| x0 != 0.0) {
-            for j in (k..len - 1).rev() {
-                c[j] += x0 * c[j + 1];
+        let c = shifted.get_or_insert_with(|| {
+            let mut c = [0.0; MAX_SHIFTED];
+            c[..len].copy_from_slice(self.c);
+            // From the series' own origin (most searches) there is nothing
+            // to shift: the sums would only add zeros.
+            for k in (0..len).filter(|_| x0 != 0.0) {
+                for j in (k..len - 1).rev() {
+                    c[j] += x0 * c[j + 1];
+                }
             }
-        }
+            c
+        });
         let c = &c[..len];
         let mut low = c[0];
         let (mut slope_low, mut slope_high) = (
