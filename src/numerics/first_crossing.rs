@@ -290,9 +290,13 @@ impl Piece<'_> {
         }
         let lowest_at_end = p + d1 * w - 0.5 * curvature * w * w;
         let above = p > 0.0 && lowest_at_end > 0.0;
+        // Below zero throughout (p is at most the larger of its start and
+        // p + d1 w + curvature w^2 / 2): never positive, nothing to fall
+        // from. A turning point's search meets this at every crossing.
+        let below = p < 0.0 && p + d1 * w + 0.5 * curvature * w * w < 0.0;
         // From exactly zero, rising faster than the curvature can turn it.
         let lifting = p == 0.0 && d1 - 0.5 * curvature * w > 0.0;
-        if above || lifting {
+        if above || below || lifting {
             Verdict::Clear
         } else {
             Verdict::Unknown
@@ -324,7 +328,7 @@ impl Piece<'_> {
             c
         });
         let c = &c[..len];
-        let mut low = c[0];
+        let (mut low, mut high) = (c[0], c[0]);
         let (mut slope_low, mut slope_high) = (
             c.get(1).copied().unwrap_or(0.0),
             c.get(1).copied().unwrap_or(0.0),
@@ -333,6 +337,7 @@ impl Piece<'_> {
         for (k, &ck) in c.iter().enumerate().skip(1) {
             // power = w^(k-1) here.
             low += ck.min(0.0) * power * w;
+            high += ck.max(0.0) * power * w;
             if k >= 2 {
                 let term = k as f64 * ck * power;
                 slope_low += term.min(0.0);
@@ -352,6 +357,10 @@ impl Piece<'_> {
             };
         }
         if c[0] > 0.0 && low > pad * c[0] {
+            return Verdict::Clear;
+        }
+        if c[0] < 0.0 && high < pad * c[0] {
+            // Never positive: nothing to fall from.
             return Verdict::Clear;
         }
         Verdict::Unknown
@@ -562,6 +571,31 @@ mod tests {
         // And p is zero there to the rounding of its evaluation.
         let size: f64 = c.iter().rev().fold(0.0, |acc, x| acc * root + x.abs());
         assert!(p(root).abs() <= 4.0 * f64::EPSILON * size, "{root}");
+    }
+
+    /// A guard's slope at the guard's own crossing (a section's `-px` where
+    /// `x` crosses: below zero, flat, curving up) never rises above zero:
+    /// nothing falls, settled on the whole interval at once rather than by
+    /// halving toward the flat start; and a polynomial that does climb
+    /// above zero and fall back is still caught.
+    #[test]
+    fn staying_below_zero_is_settled_at_once() {
+        let flat_minimum = [-0.2765, 0.0, 0.0504, 0.001];
+        let piece = Piece {
+            c: &flat_minimum,
+            third: third_derivative_bound(&flat_minimum, 0.19),
+            budget: std::cell::Cell::new(MAX_PIECES),
+            gave_up: std::cell::Cell::new(false),
+        };
+        let at0 = eval2(&flat_minimum, 0.0);
+        let end = eval(&flat_minimum, 0.19);
+        assert_eq!(piece.search((0.0, 0.19), (at0, end), &mut None, 0), None);
+        assert_eq!(piece.budget.get(), MAX_PIECES, "no piece was halved");
+        assert_eq!(search_fall(&flat_minimum, 0.0, 0.19).unwrap(), None);
+        // -0.1 + s^2 - s^3 / 0.9: up through zero near 0.35, back down near 0.8.
+        let climbs = [-0.1, 0.0, 1.0, -1.0 / 0.9];
+        let s = search_fall(&climbs, 0.0, 1.0).unwrap().expect("falls back");
+        assert!(eval(&climbs, s).abs() < 1e-15 && s > 0.5, "{s}");
     }
 
     #[test]
