@@ -165,6 +165,9 @@ impl Tangents {
             // bound grows with every period).
             at(0.5 * tau, &mut x[..n]);
             self.jacobian(model, mode, &x[..n], &mut first);
+            // The clock's column moves no error (the clock carries none):
+            // it neither enters the tangent nor cuts the step into pieces.
+            without_clock(n, model.clock(), &mut first);
             let spread = tau * row_norm(n, &first);
             let pieces = if spread.is_finite() {
                 ((spread / PIECE_SPREAD).ceil() as usize).clamp(1, MAX_PIECES)
