@@ -315,18 +315,23 @@ impl Piece<'_> {
         if len > MAX_SHIFTED {
             return Verdict::Unknown;
         }
-        let c = shifted.get_or_insert_with(|| {
-            let mut c = [0.0; MAX_SHIFTED];
-            c[..len].copy_from_slice(self.c);
-            // From the series' own origin (most searches) there is nothing
-            // to shift: the sums would only add zeros.
-            for k in (0..len).filter(|_| x0 != 0.0) {
-                for j in (k..len - 1).rev() {
-                    c[j] += x0 * c[j + 1];
+        let c: &[f64] = match shifted {
+            Some(c) => c,
+            None => {
+                // Written where it is kept: a copy would cost a search
+                // that one piece settles as much as the shift.
+                let c = shifted.insert([0.0; MAX_SHIFTED]);
+                c[..len].copy_from_slice(self.c);
+                // From the series' own origin (most searches) there is
+                // nothing to shift: the sums would only add zeros.
+                for k in (0..len).filter(|_| x0 != 0.0) {
+                    for j in (k..len - 1).rev() {
+                        c[j] += x0 * c[j + 1];
+                    }
                 }
+                c
             }
-            c
-        });
+        };
         let c = &c[..len];
         let (mut low, mut high) = (c[0], c[0]);
         let (mut slope_low, mut slope_high) = (
