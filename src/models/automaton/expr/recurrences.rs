@@ -396,14 +396,19 @@ fn slopes_times(a: &[f64], y: &[f64], z: &[f64]) -> (f64, f64) {
     let (mut with_y, mut with_z) = (0.0, 0.0);
     let k = y.len();
     let (a, y) = (&a[..k + 1], &y[..k]);
+    // `j` as a float counted alongside (exact: the same numbers as `j as
+    // f64`, without a conversion per term).
+    let mut jf = 0.0;
     if z.is_empty() {
         for j in 1..=k {
-            with_y += j as f64 * a[j] * y[k - j];
+            jf += 1.0;
+            with_y += jf * a[j] * y[k - j];
         }
     } else {
         let z = &z[..k];
         for j in 1..=k {
-            let rate = j as f64 * a[j];
+            jf += 1.0;
+            let rate = jf * a[j];
             with_y += rate * y[k - j];
             with_z += rate * z[k - j];
         }
