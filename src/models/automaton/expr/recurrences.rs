@@ -178,6 +178,14 @@ impl Series {
     /// The series of `tape`'s first output when its inputs follow `inputs`
     /// (laid out as [`Series::flow`] writes them), into `out` (`order + 1`).
     pub fn compose(&mut self, tape: &Tape, inputs: &[f64], order: usize, out: &mut [f64]) {
+        // A guard that is one of the inputs (a section's `x`, an impact's
+        // `theta`): its series is that input's, as the loop below would
+        // copy it through.
+        if let ([Op::Input(i)], [0]) = (&tape.ops[..], &tape.outputs[..]) {
+            let from = *i as usize * (order + 1);
+            out[..=order].copy_from_slice(&inputs[from..=from + order]);
+            return;
+        }
         self.prepare(tape, order);
         let w = self.width;
         for &(from, to) in &self.loads {
