@@ -140,13 +140,23 @@ pub struct RecordedEvent {
 pub struct Recorder {
     /// The events, in the order they happened.
     pub events: Vec<RecordedEvent>,
+    /// Each guard name met, kept once: its events share it.
+    guards: Vec<Name>,
 }
 
 impl Observer for Recorder {
     fn on_event(&mut self, e: &EventRecord) -> std::io::Result<()> {
+        let guard = match self.guards.iter().find(|g| *g == e.guard) {
+            Some(known) => known.clone(),
+            None => {
+                let new = Name::from(e.guard);
+                self.guards.push(new.clone());
+                new
+            }
+        };
         self.events.push(RecordedEvent {
             t: e.t,
-            guard: Name::from(e.guard),
+            guard,
             from: e.from,
             to: e.to,
             energy_before: e.energy_before,

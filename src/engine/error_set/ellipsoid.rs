@@ -10,7 +10,7 @@
 //! of an orbit whose period depends on its energy), that sum swells the
 //! thin axes, which the parallelepiped beside it does not.
 
-use super::{TRACKED, unrolled};
+use super::TRACKED;
 
 /// The ellipsoid, for dimensions up to [`TRACKED`].
 #[derive(Debug, Clone)]
@@ -29,19 +29,12 @@ impl Ellipsoid {
         }
     }
 
-    /// Carry the set through `m` (row-major), clearing component `exact`,
-    /// and add a local error box of half-width `local` in the others.
-    pub(super) fn map(&mut self, m: &[f64], local: f64, exact: Option<usize>) {
-        // It runs at every step.
-        unrolled(
-            self.n,
-            #[inline(always)]
-            |n| self.map_sized(n, m, local, exact),
-        );
-    }
-
+    /// Carry the set of `n` components through `m` (row-major), clearing
+    /// component `exact`, and add a local error box of half-width `local`
+    /// in the others. Inlined where `n` is known (see
+    /// [`unrolled`](super::unrolled)).
     #[inline(always)]
-    fn map_sized(&mut self, n: usize, m: &[f64], local: f64, exact: Option<usize>) {
+    pub(super) fn map(&mut self, n: usize, m: &[f64], local: f64, exact: Option<usize>) {
         let mut mp = [0.0; TRACKED * TRACKED];
         for i in 0..n {
             for j in 0..n {
@@ -109,14 +102,14 @@ mod tests {
     fn a_map_is_carried_exactly_and_balls_add_their_radii() {
         // A unit ball stretched by 3 along x: its half-widths are 3 and 1.
         let mut e = Ellipsoid::new(2);
-        e.map(&[1.0, 0.0, 0.0, 1.0], 1.0 / 2f64.sqrt(), None);
-        e.map(&[3.0, 0.0, 0.0, 1.0], 0.0, None);
+        e.map(2, &[1.0, 0.0, 0.0, 1.0], 1.0 / 2f64.sqrt(), None);
+        e.map(2, &[3.0, 0.0, 0.0, 1.0], 0.0, None);
         assert!((e.along(&[1.0, 0.0]) - 3.0).abs() < 1e-12);
         assert!((e.along(&[0.0, 1.0]) - 1.0).abs() < 1e-12);
         // Two balls of radii 1 and 2: one of radius 3.
         let mut e = Ellipsoid::new(2);
-        e.map(&[1.0, 0.0, 0.0, 1.0], 1.0 / 2f64.sqrt(), None);
-        e.map(&[1.0, 0.0, 0.0, 1.0], 2.0 / 2f64.sqrt(), None);
+        e.map(2, &[1.0, 0.0, 0.0, 1.0], 1.0 / 2f64.sqrt(), None);
+        e.map(2, &[1.0, 0.0, 0.0, 1.0], 2.0 / 2f64.sqrt(), None);
         assert!((e.state_bound() - 3.0).abs() < 1e-12, "{}", e.state_bound());
     }
 }

@@ -117,8 +117,17 @@ impl ErrorSet {
             return;
         }
         if let Some((box_, ellipsoid)) = &mut self.enclosures {
-            box_.map(m, local, self.exact);
-            ellipsoid.map(m, local, self.exact);
+            let exact = self.exact;
+            // At every step: both maps copied for each size, their loops
+            // unrolled.
+            unrolled(
+                self.n,
+                #[inline(always)]
+                |n| {
+                    box_.map(n, m, local, exact);
+                    ellipsoid.map(n, m, local, exact);
+                },
+            );
         }
     }
 
@@ -234,7 +243,7 @@ mod tests {
         let mut columns: Vec<[f64; 4]> = Vec::new();
         for _ in 0..k {
             set.map(&m, l);
-            boxed.map(&m, l, None);
+            boxed.map(4, &m, l, None);
             for c in &mut columns {
                 *c = std::array::from_fn(|i| (0..4).map(|j| m[i * 4 + j] * c[j]).sum());
             }

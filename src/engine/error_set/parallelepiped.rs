@@ -13,7 +13,7 @@
 //! each time: the wrapping effect, which the ellipsoid beside it does not
 //! have.
 
-use super::{TRACKED, unrolled};
+use super::TRACKED;
 
 /// The parallelepiped, for dimensions up to [`TRACKED`].
 #[derive(Debug, Clone)]
@@ -43,19 +43,12 @@ impl Parallelepiped {
         }
     }
 
-    /// Carry the set through `m` (row-major), clearing component `exact`,
-    /// and add a local error box of half-width `local` in the others.
-    pub(super) fn map(&mut self, m: &[f64], local: f64, exact: Option<usize>) {
-        // It runs at every step.
-        unrolled(
-            self.n,
-            #[inline(always)]
-            |n| self.map_sized(n, m, local, exact),
-        );
-    }
-
+    /// Carry the set of `n` components through `m` (row-major), clearing
+    /// component `exact`, and add a local error box of half-width `local`
+    /// in the others. Inlined where `n` is known (see
+    /// [`unrolled`](super::unrolled)).
     #[inline(always)]
-    fn map_sized(&mut self, n: usize, m: &[f64], local: f64, exact: Option<usize>) {
+    pub(super) fn map(&mut self, n: usize, m: &[f64], local: f64, exact: Option<usize>) {
         let mut product = [0.0; TRACKED * TRACKED];
         // product = m * basis, column-major.
         for j in 0..n {
