@@ -24,6 +24,7 @@
 
 use crate::engine::error_set::{ErrorSet, TRACKED};
 use crate::engine::model::{HybridModel, Mode};
+use crate::engine::period_record::{HEADROOM, Op, PeriodRecord};
 use crate::engine::tangent::Tangents;
 use crate::engine::zeno;
 use crate::time::Time;
@@ -60,6 +61,80 @@ pub(crate) struct Bound {
     /// at an event, over its closing speed (a slow crossing's time is
     /// uncertain by far more ulps than its state).
     crossing_rounding: f64,
+    /// The operations of the last period, for a jump over whole periods.
+    record: PeriodRecord,
+}
+
+/// How far errors `along` a guard's gradient move its event in time, at
+/// closing speed `closing`: a guard that curves back after crossing (its dip
+/// `depth` deep) moves by more than `along / closing` towards its turning
+/// point: on the parabola through the crossing, by up to twice that as the
+/// error nears the depth (beyond it the crossing may vanish, which the graze
+/// check refuses).
+fn time_shift(along: f64, closing: f64, depth: f64) -> f64 {
+    let ratio = (along / depth).min(1.0);
+    along / closing.abs() * 2.0 / (1.0 + (1.0 - ratio).sqrt())
+}
+
+/// The graze check's uncertainty: the errors along `gradient`, and a
+/// step's `local` error along it.
+fn uncertainty(errors: &ErrorSet, gradient: &[f64], local: f64) -> f64 {
+    errors.along(gradient) + gradient.iter().map(|d| d.abs()).sum::<f64>() * local
+}
+
+/// One recorded period's operations on `errors`, its events `tau` apart,
+/// moving `times` (the largest event-time error, the last event's); false
+/// where a check fails.
+fn replay_period<'a>(
+    mut ops: impl Iterator<Item = Op<'a>>,
+    tau: f64,
+    errors: &mut ErrorSet,
+    (largest, last): &mut (f64, f64),
+) -> bool {
+    ops.all(|op| match op {
+        Op::Step { matrix, local } => {
+            errors.map(matrix, local);
+            true
+        }
+        Op::Margin {
+            gradient,
+            local,
+            limit,
+        } => limit > uncertainty(errors, gradient, local),
+        Op::Event {
+            gradient,
+            saltation,
+            closing,
+            depth,
+            widen,
+            timed,
+        } => {
+            let shift = time_shift(errors.along(gradient), closing, depth);
+            if timed {
+                *last = shift;
+                *largest = largest.max(shift);
+            }
+            if !shift.is_finite() || (timed && shift > 0.5 * tau) {
+                return false;
+            }
+            errors.map(saltation, widen);
+            true
+        }
+    })
+}
+
+/// Whether the graze checks that open a recorded period (its first step's,
+/// taken before a jump) hold with `errors`.
+fn opening_checks_hold<'a>(ops: impl Iterator<Item = Op<'a>>, errors: &ErrorSet) -> bool {
+    ops.map_while(|op| match op {
+        Op::Margin {
+            gradient,
+            local,
+            limit,
+        } => Some(limit > uncertainty(errors, gradient, local)),
+        _ => None,
+    })
+    .all(|holds| holds)
 }
 
 impl Bound {
@@ -86,6 +161,7 @@ impl Bound {
             clock,
             rate: vec![0.0; n],
             crossing_rounding: 0.0,
+            record: PeriodRecord::default(),
         }
     }
 
@@ -107,6 +183,9 @@ impl Bound {
     ) {
         if self.errors.tracked() {
             self.tangents.ode(model, mode, tau, at, &mut self.matrix);
+            self.record.step(&self.matrix, local);
+        } else {
+            self.record.broken();
         }
         self.errors.map(&self.matrix, local);
     }
@@ -123,6 +202,7 @@ impl Bound {
             self.tangents
                 .exact(model, mode, state, tau, &mut self.matrix);
             self.errors.map(&self.matrix, 0.0);
+            self.record.broken();
         }
     }
 
@@ -130,6 +210,7 @@ impl Bound {
     /// state stands in for an orbit it is not exactly on.
     pub fn widen(&mut self, jump: f64) {
         self.errors.widen(jump);
+        self.record.broken();
     }
 
     /// How far guard `g` of `mode` may be off at `state`: the errors so far
@@ -150,11 +231,12 @@ impl Bound {
             // guard per step).
             let sum = self.affine_sum(model, mode, g, state);
             let unit = [1.0];
+            self.record.broken();
             return sum * (self.errors.along(&unit) + local);
         }
         self.gradient_of(model, mode, g, state);
-        self.errors.along(&self.gradient)
-            + self.gradient.iter().map(|d| d.abs()).sum::<f64>() * local
+        self.record.margin(&self.gradient, local);
+        uncertainty(&self.errors, &self.gradient, local)
     }
 
     /// `sum |d g / d x_i|` of affine guard `g` of `mode`, once per mode.
@@ -277,6 +359,7 @@ impl Bound {
         method: &str,
     ) -> Result<(), String> {
         if self.errors.is_empty() || !self.errors.tracked() {
+            self.record.broken();
             return Ok(());
         }
         let guard = &model.guards(mode)[slot];
@@ -293,13 +376,7 @@ impl Bound {
             after,
             &mut self.matrix,
         );
-        // A guard that curves back after crossing (its dip `depth` deep)
-        // moves by more than `along / closing` towards its turning point:
-        // on the parabola through the crossing, by up to twice that as the
-        // error nears the depth (beyond it the crossing may vanish, which
-        // the graze check refuses).
-        let ratio = (along / depth).min(1.0);
-        let shift = along / closing.abs() * 2.0 / (1.0 + (1.0 - ratio).sqrt());
+        let shift = time_shift(along, closing, depth);
         let since = self.last_event.map(|last| t.since(last));
         // Events closer than the run can resolve are the Zeno watch's to
         // judge (it settles them or stops), not the error bound's: their
@@ -308,6 +385,7 @@ impl Bound {
             if self.matrix.iter().all(|m| m.is_finite()) {
                 self.errors.map(&self.matrix, 0.0);
             }
+            self.record.broken();
             return Ok(());
         }
         if !guard.internal {
@@ -347,9 +425,85 @@ impl Bound {
                     .zip(before)
                     .map(|(g, x)| (g * x).abs())
                     .sum::<f64>();
-        self.errors
-            .map(&self.matrix, jump * residual / closing.abs());
+        let widen = jump * residual / closing.abs();
+        self.errors.map(&self.matrix, widen);
+        self.record.event(
+            (&self.gradient, &self.matrix),
+            (closing, depth, widen),
+            !guard.internal,
+        );
         Ok(())
+    }
+
+    /// Record each period's operations from now on, for
+    /// [`Bound::replay`]; false where the errors are not tracked (nothing
+    /// to replay them on).
+    pub fn record_periods(&mut self) -> bool {
+        let tracked = self.errors.tracked();
+        if tracked {
+            self.record.start(self.gradient.len());
+        }
+        tracked
+    }
+
+    /// The uncertainty a step's scan is to prove a guard clear of, for the
+    /// graze check's `uncertainty`: more while periods are recorded (see
+    /// [`HEADROOM`]).
+    pub fn scan_uncertainty(&self, uncertainty: f64) -> f64 {
+        if self.record.on() {
+            uncertainty * HEADROOM
+        } else {
+            uncertainty
+        }
+    }
+
+    /// The scan of the last graze check found no margin below `margin`
+    /// (see [`Bound::scan_uncertainty`]), or could not say.
+    pub fn margin_found(&mut self, margin: Option<f64>) {
+        match margin {
+            Some(margin) => self.record.margin_limit(margin),
+            None => self.record.broken(),
+        }
+    }
+
+    /// Carry the errors over up to `periods` more periods, `tau` apart, each
+    /// as the last recorded one did, checks included (see
+    /// [`crate::engine::period_record`]); stop short of the first period
+    /// whose checks would fail, or after which the next one's first graze
+    /// checks would. How many periods were carried.
+    pub fn replay(&mut self, periods: u64, tau: f64) -> u64 {
+        let done = self.replayed(periods, tau);
+        if done > 0 {
+            // The period under way was checked against the errors before
+            // the jump.
+            self.record.broken();
+        }
+        done
+    }
+
+    /// [`Bound::replay`] without its closing note.
+    fn replayed(&mut self, periods: u64, tau: f64) -> u64 {
+        let Some(ops) = self.record.last() else {
+            return 0;
+        };
+        let mut done = 0;
+        while done < periods {
+            let saved = (
+                self.errors.clone(),
+                self.event_time_bound,
+                self.last_time_bound,
+            );
+            let mut times = (saved.1, saved.2);
+            if !replay_period(ops.clone(), tau, &mut self.errors, &mut times)
+                || !opening_checks_hold(ops.clone(), &self.errors)
+            {
+                (self.errors, self.event_time_bound, self.last_time_bound) = saved;
+                break;
+            }
+            (self.event_time_bound, self.last_time_bound) = times;
+            done += 1;
+        }
+        done
     }
 
     /// The run jumped over `periods` periods of `tau` (see

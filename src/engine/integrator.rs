@@ -166,6 +166,16 @@ impl Integrator {
         }
     }
 
+    /// Whether each step depends only on the state it starts from (and the
+    /// run's settings): Taylor's method chooses its step from the series
+    /// there, and the linear propagator steps a fixed length. The adaptive
+    /// pairs carry their step size over from the step before, and
+    /// Stormer-Verlet's dense output is scanned without the margins a
+    /// replayed bound checks (see [`crate::engine::periodic`]).
+    pub fn memoryless(&self) -> bool {
+        matches!(self, Integrator::Linear(_) | Integrator::Taylor(_))
+    }
+
     /// Forget the last step (the next starts from a reset state).
     pub fn restart(&mut self) {
         match self {

@@ -20,6 +20,7 @@ pub mod method;
 pub mod model;
 pub mod names;
 pub mod observer;
+pub mod period_record;
 pub mod periodic;
 pub mod problem;
 pub mod queue;

@@ -1,21 +1,33 @@
 //! Exactly periodic orbits, jumped over whole periods at a time.
 //!
-//! On an exact, autonomous flow the state after an event decides
-//! everything after it. When the state after an event is the state after
-//! the previous event, to round-off, with the same guard fired in the same
-//! mode and nothing between, the run is on a periodic orbit of one event
-//! per period: the next stretch repeats the last. A run whose observer does
-//! not look at events (no event log) then jumps over whole periods at once
-//! and counts their events, instead of firing each: a chattering mechanism's
-//! 2.5e8 impacts take microseconds ("model no more than a scene needs").
+//! On an autonomous flow the state after an event decides everything after
+//! it, for an exact flow and for steps that depend only on the state they
+//! start from (the linear propagator, Taylor's method; see
+//! [`Integrator::memoryless`](crate::engine::integrator::Integrator::memoryless)).
+//! When the state after an event is the state after the previous event, to
+//! round-off, with the same guard fired in the same mode and nothing
+//! between, the run is on a periodic orbit of one event per period: the
+//! next stretch repeats the last. A run whose observer does not look at
+//! events (no event log) then jumps over whole periods at once and counts
+//! their events, instead of firing each: a chattering mechanism's 2.5e8
+//! impacts take microseconds ("model no more than a scene needs").
+//!
+//! An exact flow jumps with nothing to carry. A stepped run's bound carries
+//! errors, and checks them at every step and event: it replays its last
+//! period's operations over each period jumped, checks included, and the
+//! jump stops short of the first period whose checks would fail (see
+//! [`crate::engine::period_record`]). Its stated bounds are those firing
+//! each event would state, to round-off.
 //!
 //! What it costs in accuracy: the run stays on the state it returned to,
 //! where firing each event would have walked away from it by round-off,
 //! at most [`RETURN_ULPS`] ulps of the state per period (else the return is
 //! not accepted). The run's stated bound already allows
 //! [`ROUNDOFF_ULPS`](crate::engine::bound::ROUNDOFF_ULPS) per event, more
-//! than that. The clock jumps by `k` periods as one exact product, where `k`
-//! additions round `k` times.
+//! than that (and more than a stepped period that differs from the last by
+//! a step at its end, whose replay misses that step's rounding). The clock
+//! jumps by `k` periods as one exact product, where `k` additions round
+//! `k` times.
 
 use crate::engine::model::Mode;
 use crate::time::Time;
@@ -41,8 +53,10 @@ pub(crate) struct Returns {
     slot: usize,
     t: Time,
     state: Vec<f64>,
-    /// Whether the last event returned to the one before it.
+    /// Whether the last event returned to the one before it, and how long
+    /// after it.
     returned: bool,
+    period: f64,
 }
 
 impl Returns {
@@ -56,6 +70,7 @@ impl Returns {
     /// Guard `slot` of `mode` fired at `t` and left the run in `mode` at
     /// `state`: note whether that is where the previous event left it.
     pub fn visit(&mut self, mode: Mode, slot: usize, t: Time, state: &[f64]) {
+        self.period = t.since(self.t);
         self.returned = self.known
             && self.mode == mode
             && self.slot == slot
@@ -70,6 +85,12 @@ impl Returns {
     /// before it left it.
     pub fn returned(&self) -> bool {
         self.returned
+    }
+
+    /// The time from the event before the last to the last: the period,
+    /// where the last returned.
+    pub fn period(&self) -> f64 {
+        self.period
     }
 }
 
@@ -104,8 +125,9 @@ mod tests {
         let mut r = Returns::default();
         r.visit(0, 0, Time::new(1.0), &[0.0, 1.0]);
         assert!(!r.returned(), "the first event returns to nothing");
-        r.visit(0, 0, Time::new(2.0), &[0.0, 1.0 + 2.0 * f64::EPSILON]);
+        r.visit(0, 0, Time::new(2.5), &[0.0, 1.0 + 2.0 * f64::EPSILON]);
         assert!(r.returned());
+        assert_eq!(r.period(), 1.5);
         r.visit(0, 1, Time::new(3.0), &[0.0, 1.0]);
         assert!(!r.returned(), "another guard");
         r.visit(0, 1, Time::new(4.0), &[0.0, 1.0 + 1e-12]);

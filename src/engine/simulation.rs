@@ -25,6 +25,7 @@ use crate::engine::method::Method;
 use crate::engine::model::{Affects, Direction, HybridModel, Mode};
 use crate::engine::names::Name;
 use crate::engine::observer::{EventRecord, Observer, SETTLE};
+use crate::engine::period_record::REPLAYED_AT_ONCE;
 use crate::engine::periodic::Returns;
 use crate::engine::queue::EventQueue;
 use crate::engine::run::{Options, Outcome, Status};
@@ -338,18 +339,32 @@ impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
             }
         };
         predicted?;
-        // An exact, autonomous flow with nothing to carry repeats from a
-        // repeated state (see `periodic`); only a run whose observer looks
-        // at no event may jump, so only such a run keeps the state.
+        // An autonomous flow repeats from a repeated state (see
+        // `periodic`): an exact one with nothing to carry, or steps that
+        // depend on nothing else, whose bound replays its last period. Only
+        // a run whose observer looks at no event may jump, so only such a
+        // run keeps the state.
+        let repeats = match self.motion {
+            Motion::Exact => self.bound.idle(),
+            Motion::Stepped => self.integrator.memoryless(),
+            Motion::Frozen => false,
+        };
         if !observer.wants_details()
             && !guard.internal
             && jump.mode == mode
-            && self.motion == Motion::Exact
+            && repeats
             && self.clock.is_none()
-            && self.bound.idle()
         {
             self.returns.visit(mode, slot, t, &self.state);
             self.repeated = (mode, slot, jump.event);
+            // Record the stepped bound's periods once the orbit has
+            // returned: a run that never does pays nothing for it.
+            if self.motion == Motion::Stepped
+                && self.returns.returned()
+                && !self.bound.record_periods()
+            {
+                self.returns.forget();
+            }
         } else {
             self.returns.forget();
         }
@@ -357,15 +372,38 @@ impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
     }
 
     fn period(&self) -> Option<f64> {
-        let (next, at) = self.queue.peek()?;
-        (self.returns.returned() && next == self.repeated.1).then(|| at.since(self.origin))
+        if !self.returns.returned() {
+            return None;
+        }
+        match self.motion {
+            Motion::Exact => {
+                let (next, at) = self.queue.peek()?;
+                (next == self.repeated.1).then(|| at.since(self.origin))
+            }
+            // Its steps repeat the last period's.
+            Motion::Stepped => Some(self.returns.period()),
+            Motion::Frozen => None,
+        }
     }
 
     fn jump(&mut self, periods: u64, tau: f64, ledger: &mut Ledger) {
+        // A stepped run's bound goes over the periods as firing each would
+        // have, as far as its checks allow.
+        let periods = match self.motion {
+            Motion::Stepped => self.bound.replay(periods.min(REPLAYED_AT_ONCE), tau),
+            _ => periods,
+        };
+        if periods == 0 {
+            return;
+        }
         let from = self.origin;
         self.origin = from.after_multiple(periods, tau);
         self.queue.postpone(periods, tau);
         self.bound.postpone(periods, tau);
+        // The step under way started at the event: it moves with it.
+        if self.step_end.is_some() {
+            self.step_end = Some(self.origin.after(self.integrator.h()));
+        }
         let (mode, slot, named) = &self.repeated;
         ledger.jumped(
             (*mode, *slot, named.as_ref()),
@@ -891,8 +929,18 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
                         self.bound
                             .guard_uncertainty(model, mode, g, &self.state, local)
                     };
-                    let scan = match self.integrator.locate(model, mode, g, start, uncertainty) {
-                        Some(Ok(scan)) => scan,
+                    // A recording run proves guards clear of more (see
+                    // `period_record`).
+                    let searched = self.bound.scan_uncertainty(uncertainty);
+                    let scan = match self.integrator.locate(model, mode, g, start, searched) {
+                        Some(Ok(scan)) => {
+                            if !guard.internal {
+                                let proven = scan.margin.is_finite() || searched > uncertainty;
+                                self.bound
+                                    .margin_found(proven.then(|| scan.margin.min(searched)));
+                            }
+                            scan
+                        }
                         Some(Err(why)) => {
                             return Err(End::failed(format!(
                                 "{} at t = {}: {why}",
@@ -901,6 +949,7 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
                             )));
                         }
                         None => {
+                            self.bound.margin_found(None);
                             let (step, x) = (&self.integrator, &mut self.before[..n]);
                             scan_step(guard, start, interpolant, uncertainty, |s| {
                                 step.eval(s * h, x);

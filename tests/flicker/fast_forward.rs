@@ -2,7 +2,8 @@
 //! against the written-out reference of [`crate::oscillator`]: the impact
 //! count to the impact, the final state and the samples within the run's
 //! stated bound, budgets kept, and runs that look at every event (an event
-//! log) firing every event.
+//! log) firing every event. Stepped runs (the linear propagator, Taylor's
+//! method) jump with the bounds and the stops that firing each event gives.
 
 use flicker::engine::{Options, Outcome, Recorder, Status, simulate, simulate_sampled};
 use flicker::models::mechanism::strain::FLIGHT;
@@ -204,4 +205,102 @@ fn the_summary_says_a_run_without_a_log_was_fast_forwarded() {
     let periods = quiet["fast_forward"]["periods"].as_u64().unwrap();
     assert!(periods + 5 >= quiet["events"].as_u64().unwrap(), "{quiet}");
     assert!(said.contains("fast-forwarded"), "{said}");
+}
+
+/// An oscillator `x'' = -x` bouncing elastically off a wall at `x = 0`,
+/// from the wall at unit speed: `x = |sin t|`, an impact every `pi`, with
+/// `guards` added to its transitions.
+fn bouncing_oscillator(guards: &str, t_end: f64) -> String {
+    format!(
+        r#"{{"model": "automaton", "states": ["x", "v"], "initial": {{"x": 0.0, "v": 1.0}},
+            "modes": {{"m": {{"flow": {{"x": "v", "v": "-x"}},
+              "transitions": [
+                {{"name": "impact", "guard": "x", "direction": "falling", "barrier": true,
+                  "reset": {{"x": "0", "v": "-v"}}}}{guards}]}}}},
+            "t_end": {t_end}}}"#
+    )
+}
+
+/// The summaries of `scene` run by `method` with its event log and without
+/// one (`--no-events`), which may jump.
+fn logged_and_quiet(scene: &str, method: &str) -> (serde_json::Value, serde_json::Value) {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("scene.json");
+    std::fs::write(&path, scene).unwrap();
+    let summary = |extra: &[&str], out: &str| {
+        let out = dir.path().join(out);
+        let mut args = vec!["run", path.to_str().unwrap(), "--quiet", "--method", method];
+        args.extend(["--out", out.to_str().unwrap()]);
+        args.extend(extra);
+        flicker(&args);
+        read_json(&out.join("summary.json"))
+    };
+    (summary(&[], "logged"), summary(&["--no-events"], "quiet"))
+}
+
+fn number(summary: &serde_json::Value, field: &str) -> f64 {
+    summary[field]
+        .as_f64()
+        .unwrap_or_else(|| panic!("no `{field}` in {summary}"))
+}
+
+#[test]
+fn stepped_runs_jump_with_the_bound_firing_each_event_would_state() {
+    let t_end = 3000.0;
+    let scene = bouncing_oscillator("", t_end);
+    let impacts = (t_end / std::f64::consts::PI).floor() as u64;
+    let phase = t_end % std::f64::consts::PI;
+    for method in ["linear", "taylor"] {
+        let (logged, quiet) = logged_and_quiet(&scene, method);
+        for s in [&logged, &quiet] {
+            assert_eq!(s["status"], "completed", "{method}: {s}");
+            assert_eq!(s["events"].as_u64(), Some(impacts), "{method}: {s}");
+        }
+        assert!(logged.get("fast_forward").is_none(), "{logged}");
+        let periods = quiet["fast_forward"]["periods"].as_u64().unwrap_or(0);
+        assert!(periods + 20 >= impacts, "{method}: {quiet}");
+        // The bound goes over the jumped periods as it would over fired
+        // ones: the same operations on states equal to round-off.
+        for field in ["error_bound", "event_time_bound"] {
+            let (a, b) = (number(&logged, field), number(&quiet, field));
+            assert!(
+                (a - b).abs() <= 1e-6 * a && a > 0.0,
+                "{method}: {field} {b:e} jumping, {a:e} firing each"
+            );
+        }
+        let fs = &quiet["final_state"];
+        let err = (number(fs, "x") - phase.sin())
+            .abs()
+            .max((number(fs, "v") - phase.cos()).abs());
+        assert!(
+            err <= number(&quiet, "error_bound"),
+            "{method}: error {err:e}, {quiet}"
+        );
+    }
+}
+
+#[test]
+fn a_jump_stops_short_of_the_period_whose_checks_fail() {
+    // A second guard comes within 1e-12 of zero at the top of each flight:
+    // once the carried errors reach that, the run cannot tell whether it
+    // fires, and stops. A jump must not carry it past that period.
+    let scene = bouncing_oscillator(
+        r#", {"name": "near", "guard": "1 + 1e-12 - x", "direction": "falling"}"#,
+        20000.0,
+    );
+    for method in ["linear", "taylor"] {
+        let (logged, quiet) = logged_and_quiet(&scene, method);
+        for s in [&logged, &quiet] {
+            assert_eq!(s["status"], "failed", "{method}: {s}");
+            let reason = s["reason"].as_str().unwrap_or("");
+            assert!(reason.contains("`near` grazes zero"), "{method}: {reason}");
+        }
+        assert!(quiet["fast_forward"]["periods"].as_u64().unwrap_or(0) > 100);
+        assert_eq!(logged["events"], quiet["events"], "{method}");
+        let (a, b) = (number(&logged, "t_reached"), number(&quiet, "t_reached"));
+        assert!(
+            (a - b).abs() <= 1e-12 * a,
+            "{method}: {a} firing, {b} jumping"
+        );
+    }
 }
