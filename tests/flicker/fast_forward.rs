@@ -221,21 +221,33 @@ fn bouncing_oscillator(guards: &str, t_end: f64) -> String {
     )
 }
 
-/// The summaries of `scene` run by `method` with its event log and without
-/// one (`--no-events`), which may jump.
-fn logged_and_quiet(scene: &str, method: &str) -> (serde_json::Value, serde_json::Value) {
+/// A run's summary and its samples `(t, x, v, bound)`.
+type Run = (serde_json::Value, Vec<[f64; 4]>);
+
+/// `scene` run by `method` with its event log and without one
+/// (`--no-events`, which may jump), each sampled at 7 times.
+fn logged_and_quiet(scene: &str, method: &str) -> (Run, Run) {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("scene.json");
     std::fs::write(&path, scene).unwrap();
-    let summary = |extra: &[&str], out: &str| {
+    let run = |extra: &[&str], out: &str| {
         let out = dir.path().join(out);
         let mut args = vec!["run", path.to_str().unwrap(), "--quiet", "--method", method];
-        args.extend(["--out", out.to_str().unwrap()]);
+        args.extend(["--samples", "7", "--out", out.to_str().unwrap()]);
         args.extend(extra);
         flicker(&args);
-        read_json(&out.join("summary.json"))
+        let samples = std::fs::read_to_string(out.join("samples.csv")).unwrap_or_default();
+        let rows = samples
+            .lines()
+            .skip(1)
+            .map(|line| {
+                let mut row = line.split(',').map(|x| x.parse::<f64>().unwrap());
+                std::array::from_fn(|_| row.next().unwrap())
+            })
+            .collect();
+        (read_json(&out.join("summary.json")), rows)
     };
-    (summary(&[], "logged"), summary(&["--no-events"], "quiet"))
+    (run(&[], "logged"), run(&["--no-events"], "quiet"))
 }
 
 fn number(summary: &serde_json::Value, field: &str) -> f64 {
@@ -251,14 +263,24 @@ fn stepped_runs_jump_with_the_bound_firing_each_event_would_state() {
     let impacts = (t_end / std::f64::consts::PI).floor() as u64;
     let phase = t_end % std::f64::consts::PI;
     for method in ["linear", "taylor"] {
-        let (logged, quiet) = logged_and_quiet(&scene, method);
+        let ((logged, _), (quiet, samples)) = logged_and_quiet(&scene, method);
         for s in [&logged, &quiet] {
             assert_eq!(s["status"], "completed", "{method}: {s}");
             assert_eq!(s["events"].as_u64(), Some(impacts), "{method}: {s}");
         }
         assert!(logged.get("fast_forward").is_none(), "{logged}");
+        // All but a few periods after the start and each sample.
         let periods = quiet["fast_forward"]["periods"].as_u64().unwrap_or(0);
-        assert!(periods + 20 >= impacts, "{method}: {quiet}");
+        assert!(periods + 40 >= impacts, "{method}: {quiet}");
+        assert_eq!(samples.len(), 7);
+        for [t, x, v, bound] in samples {
+            let phase = t % std::f64::consts::PI;
+            let err = (x - phase.sin()).abs().max((v - phase.cos()).abs());
+            assert!(
+                err <= bound,
+                "{method}: at t = {t}, error {err:e}, bound {bound:e}"
+            );
+        }
         // The bound goes over the jumped periods as it would over fired
         // ones: the same operations on states equal to round-off.
         for field in ["error_bound", "event_time_bound"] {
@@ -289,7 +311,7 @@ fn a_jump_stops_short_of_the_period_whose_checks_fail() {
         20000.0,
     );
     for method in ["linear", "taylor"] {
-        let (logged, quiet) = logged_and_quiet(&scene, method);
+        let ((logged, _), (quiet, _)) = logged_and_quiet(&scene, method);
         for s in [&logged, &quiet] {
             assert_eq!(s["status"], "failed", "{method}: {s}");
             let reason = s["reason"].as_str().unwrap_or("");
