@@ -76,22 +76,22 @@ fn time_shift(along: f64, closing: f64, depth: f64) -> f64 {
     along / closing.abs() * 2.0 / (1.0 + (1.0 - ratio).sqrt())
 }
 
-/// The graze check's uncertainty: the errors along `gradient`, and a
-/// step's `local` error along it.
-fn uncertainty(errors: &ErrorSet, gradient: &[f64], local: f64) -> f64 {
-    errors.along(gradient) + gradient.iter().map(|d| d.abs()).sum::<f64>() * local
+/// A step's `local` error along `gradient`: the graze check's uncertainty
+/// beside the carried errors'.
+fn spread(gradient: &[f64], local: f64) -> f64 {
+    gradient.iter().map(|d| d.abs()).sum::<f64>() * local
 }
 
 /// One recorded period's operations on `errors`, its events `tau` apart,
 /// moving `times` (the largest event-time error, the last event's); false
 /// where a check fails.
-fn replay_period<'a>(
-    mut ops: impl Iterator<Item = Op<'a>>,
+fn replay_period(
+    ops: &[Op<'_>],
     tau: f64,
     errors: &mut ErrorSet,
     (largest, last): &mut (f64, f64),
 ) -> bool {
-    ops.all(|op| match op {
+    ops.iter().all(|&op| match op {
         Op::Step { matrix, local } => {
             errors.map(matrix, local);
             true
@@ -100,7 +100,7 @@ fn replay_period<'a>(
             gradient,
             local,
             limit,
-        } => limit > uncertainty(errors, gradient, local),
+        } => errors.within(gradient, spread(gradient, local), limit),
         Op::Event {
             gradient,
             saltation,
@@ -125,16 +125,17 @@ fn replay_period<'a>(
 
 /// Whether the graze checks that open a recorded period (its first step's,
 /// taken before a jump) hold with `errors`.
-fn opening_checks_hold<'a>(ops: impl Iterator<Item = Op<'a>>, errors: &ErrorSet) -> bool {
-    ops.map_while(|op| match op {
-        Op::Margin {
-            gradient,
-            local,
-            limit,
-        } => Some(limit > uncertainty(errors, gradient, local)),
-        _ => None,
-    })
-    .all(|holds| holds)
+fn opening_checks_hold(ops: &[Op<'_>], errors: &ErrorSet) -> bool {
+    ops.iter()
+        .map_while(|&op| match op {
+            Op::Margin {
+                gradient,
+                local,
+                limit,
+            } => Some(errors.within(gradient, spread(gradient, local), limit)),
+            _ => None,
+        })
+        .all(|holds| holds)
 }
 
 impl Bound {
@@ -236,7 +237,7 @@ impl Bound {
         }
         self.gradient_of(model, mode, g, state);
         self.record.margin(&self.gradient, local);
-        uncertainty(&self.errors, &self.gradient, local)
+        self.errors.along(&self.gradient) + spread(&self.gradient, local)
     }
 
     /// `sum |d g / d x_i|` of affine guard `g` of `mode`, once per mode.
@@ -486,6 +487,7 @@ impl Bound {
         let Some(ops) = self.record.last() else {
             return 0;
         };
+        let ops: Vec<Op> = ops.collect();
         let mut done = 0;
         while done < periods {
             let saved = (
@@ -494,8 +496,8 @@ impl Bound {
                 self.last_time_bound,
             );
             let mut times = (saved.1, saved.2);
-            if !replay_period(ops.clone(), tau, &mut self.errors, &mut times)
-                || !opening_checks_hold(ops.clone(), &self.errors)
+            if !replay_period(&ops, tau, &mut self.errors, &mut times)
+                || !opening_checks_hold(&ops, &self.errors)
             {
                 (self.errors, self.event_time_bound, self.last_time_bound) = saved;
                 break;

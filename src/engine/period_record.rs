@@ -196,7 +196,7 @@ impl PeriodRecord {
     }
 
     /// The last period's operations, where it was recorded whole.
-    pub fn last(&self) -> Option<impl Iterator<Item = Op<'_>> + Clone> {
+    pub fn last(&self) -> Option<impl Iterator<Item = Op<'_>>> {
         let (n, period) = (self.n, &self.last);
         let x = &period.numbers;
         (self.on && period.whole).then(|| {

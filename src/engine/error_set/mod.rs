@@ -154,6 +154,18 @@ impl ErrorSet {
         }
     }
 
+    /// Whether `limit > self.along(gradient) + spread`, asking the cheaper
+    /// parallelepiped first: its answer bounds the smaller of the two, so
+    /// where it settles the question the ellipsoid need not be asked.
+    pub fn within(&self, gradient: &[f64], spread: f64, limit: f64) -> bool {
+        if let (Some((box_, _)), false) = (&self.enclosures, self.poisoned)
+            && limit > box_.along(gradient) + spread
+        {
+            return true;
+        }
+        limit > self.along(gradient) + spread
+    }
+
     /// The largest error of the linear function `gradient . x`. Where the
     /// set is not tracked, an optimistic scale instead: `sum |gradient_i|`
     /// times the root-sum-square of the local errors, as if independent.
@@ -176,6 +188,28 @@ mod tests {
     /// `columns` (each a vector): the sum of their `|i`-th components|.
     fn hull(columns: &[Vec<f64>], i: usize) -> f64 {
         columns.iter().map(|c| c[i].abs()).sum()
+    }
+
+    #[test]
+    fn within_gives_the_verdict_of_the_smaller_enclosure() {
+        // A sheared set, where the box and the ellipsoid answer differently
+        // along different directions: `within` must say exactly what
+        // comparing with `along` says, on either side of it.
+        let mut set = ErrorSet::new(2);
+        for _ in 0..50 {
+            set.map(&[1.0, 0.3, -0.2, 1.0], 1e-12);
+        }
+        for gradient in [[1.0, 0.0], [0.0, 1.0], [0.6, -0.8], [3.0, 1.0]] {
+            let along = set.along(&gradient);
+            assert!(along > 0.0);
+            for limit in [0.5, 0.99, 1.0, 1.01, 2.0].map(|f| f * (along + 1e-13)) {
+                assert_eq!(
+                    set.within(&gradient, 1e-13, limit),
+                    limit > along + 1e-13,
+                    "{gradient:?} at {limit:e} (along {along:e})"
+                );
+            }
+        }
     }
 
     #[test]
