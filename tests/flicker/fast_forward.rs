@@ -326,3 +326,32 @@ fn a_jump_stops_short_of_the_period_whose_checks_fail() {
         );
     }
 }
+
+#[test]
+fn a_periodic_section_marker_is_jumped_over_too() {
+    // x'' = -x from (0.3, 1), a marker where x rises through zero: no
+    // reset, the state after each crossing repeats every 2 pi.
+    let t_end: f64 = 3000.0;
+    let scene = r#"{"model": "automaton", "states": ["x", "v"], "initial": {"x": 0.3, "v": 1.0},
+        "modes": {"m": {"flow": {"x": "v", "v": "-x"},
+          "transitions": [{"name": "section", "guard": "x", "direction": "rising"}]}},
+        "t_end": 3000.0}"#;
+    let (x, v) = (
+        0.3 * t_end.cos() + t_end.sin(),
+        -0.3 * t_end.sin() + t_end.cos(),
+    );
+    // Rising crossings at 2 pi k - atan(0.3), k >= 1.
+    let crossings = ((t_end + 0.3f64.atan()) / std::f64::consts::TAU).floor() as u64;
+    for method in ["linear", "taylor"] {
+        let ((logged, _), (quiet, _)) = logged_and_quiet(scene, method);
+        for s in [&logged, &quiet] {
+            assert_eq!(s["status"], "completed", "{method}: {s}");
+            assert_eq!(s["events"].as_u64(), Some(crossings), "{method}: {s}");
+            let fs = &s["final_state"];
+            let err = (number(fs, "x") - x).abs().max((number(fs, "v") - v).abs());
+            assert!(err <= number(s, "error_bound"), "{method}: {err:e}, {s}");
+        }
+        let periods = quiet["fast_forward"]["periods"].as_u64().unwrap_or(0);
+        assert!(periods + 40 >= crossings, "{method}: {quiet}");
+    }
+}
