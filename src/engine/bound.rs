@@ -364,8 +364,7 @@ impl Bound {
             return Ok(());
         }
         let guard = &model.guards(mode)[slot];
-        self.tangents
-            .gradient(model, mode, slot, before, &mut self.gradient);
+        self.gradient_of(model, mode, slot, before);
         let along = self.errors.along(&self.gradient);
         let (closing, jump) = self.tangents.saltation(
             model,

@@ -75,6 +75,9 @@ struct Reset {
     /// The new values of `targets`, from the state before the event.
     tape: Tape,
     targets: Vec<usize>,
+    /// The rows of the Jacobian for `targets`, where the new values are
+    /// affine in the state: the same at every event, so taken once.
+    affine_rows: Option<Vec<f64>>,
     to: Mode,
     /// How the mode after is picked: `to`, or by the signs of a family's
     /// switching surfaces at the state after (see [`filippov`]).
@@ -83,6 +86,32 @@ struct Reset {
 }
 
 impl Reset {
+    /// Set `targets` of an `n`-component state from `tape`'s outputs, into
+    /// `to` as `pick` says.
+    fn new(
+        tape: Tape,
+        targets: Vec<usize>,
+        n: usize,
+        (to, pick): (Mode, Target),
+        terminal: bool,
+    ) -> Self {
+        // The forward pass of an affine tape gives the same derivatives at
+        // any state.
+        let affine_rows = (!targets.is_empty() && tape.affine()).then(|| {
+            let mut rows = vec![0.0; targets.len() * n];
+            jacobian_into(&tape, &vec![0.0; n], &mut rows);
+            rows
+        });
+        Reset {
+            tape,
+            targets,
+            affine_rows,
+            to,
+            pick,
+            terminal,
+        }
+    }
+
     /// Every new value from the values before the event, all at once.
     fn apply(&self, x: &mut [f64]) {
         // On the stack for the few states a reset names: no allocation per
@@ -246,22 +275,22 @@ impl Automaton {
                     barrier: t.barrier,
                 });
                 guard_tapes.push(tape);
-                resets.push(Reset {
-                    tape: new_values(&t.reset)?,
-                    targets: t.reset.iter().map(|(i, _)| *i).collect(),
-                    to: t.to,
-                    pick,
-                    terminal: t.terminal,
-                });
+                resets.push(Reset::new(
+                    new_values(&t.reset)?,
+                    t.reset.iter().map(|(i, _)| *i).collect(),
+                    n,
+                    (t.to, pick),
+                    t.terminal,
+                ));
             }
             let rest = match &mode.rest {
-                Some(r) => Some(Reset {
-                    tape: new_values(&r.reset)?,
-                    targets: r.reset.iter().map(|(i, _)| *i).collect(),
-                    to: r.to,
-                    pick: Target::Fixed,
-                    terminal: false,
-                }),
+                Some(r) => Some(Reset::new(
+                    new_values(&r.reset)?,
+                    r.reset.iter().map(|(i, _)| *i).collect(),
+                    n,
+                    (r.to, Target::Fixed),
+                    false,
+                )),
                 None => None,
             };
             let still = flow.constant().is_some_and(|c| c.iter().all(|&r| r == 0.0));
@@ -465,6 +494,12 @@ impl HybridModel for Automaton {
             out[i * n + i] = 1.0;
         }
         if reset.targets.is_empty() {
+            return true;
+        }
+        if let Some(rows) = &reset.affine_rows {
+            for (k, &i) in reset.targets.iter().enumerate() {
+                out[i * n..(i + 1) * n].copy_from_slice(&rows[k * n..(k + 1) * n]);
+            }
             return true;
         }
         // The rows of the states it sets, on the stack where they fit (an
