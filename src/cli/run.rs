@@ -369,12 +369,16 @@ fn print_report(
     }
     if let Some(f) = &o.fast_forward {
         say!(
-            "  fast-forwarded: {} periods of {:e} between t = {:e} and {:e}, one event each, counted, \
+            "  fast-forwarded: {} periods of {:e} between t = {:e} and {:e}, {} each, counted, \
              not fired (the orbit returned to its state to round-off; a run that writes its event log fires each)",
             f.periods,
             f.period,
             f.from,
-            f.to
+            f.to,
+            match f.events_per_period {
+                1 => "one event".to_string(),
+                k => format!("{k} events"),
+            }
         );
     }
     if let (Some(e0), Some(e1), Some(err)) = (o.energy_initial, o.energy_final, o.max_energy_error)

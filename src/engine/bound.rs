@@ -82,15 +82,9 @@ fn spread(gradient: &[f64], local: f64) -> f64 {
     gradient.iter().map(|d| d.abs()).sum::<f64>() * local
 }
 
-/// One recorded period's operations on `errors`, its events `tau` apart,
-/// moving `times` (the largest event-time error, the last event's); false
-/// where a check fails.
-fn replay_period(
-    ops: &[Op<'_>],
-    tau: f64,
-    errors: &mut ErrorSet,
-    (largest, last): &mut (f64, f64),
-) -> bool {
+/// One recorded period's operations on `errors`, moving `times` (the
+/// largest event-time error, the last event's); false where a check fails.
+fn replay_period(ops: &[Op<'_>], errors: &mut ErrorSet, (largest, last): &mut (f64, f64)) -> bool {
     ops.iter().all(|&op| match op {
         Op::Step { matrix, local } => {
             errors.map(matrix, local);
@@ -107,6 +101,7 @@ fn replay_period(
             closing,
             depth,
             widen,
+            since,
             timed,
         } => {
             let shift = time_shift(errors.along(gradient), closing, depth);
@@ -114,7 +109,7 @@ fn replay_period(
                 *last = shift;
                 *largest = largest.max(shift);
             }
-            if !shift.is_finite() || (timed && shift > 0.5 * tau) {
+            if !shift.is_finite() || (timed && shift > 0.5 * since) {
                 return false;
             }
             errors.map(saltation, widen);
@@ -430,7 +425,7 @@ impl Bound {
         self.record.event(
             (&self.gradient, &self.matrix),
             (closing, depth, widen),
-            !guard.internal,
+            (since.unwrap_or(f64::INFINITY), !guard.internal),
         );
         Ok(())
     }
@@ -444,6 +439,12 @@ impl Bound {
             self.record.start(self.gradient.len());
         }
         tracked
+    }
+
+    /// Something in the stretch since the last event depends on more than
+    /// the state the stretch started from: no replay may repeat it.
+    pub fn unrepeatable(&mut self) {
+        self.record.broken();
     }
 
     /// The uncertainty a step's scan is to prove a guard clear of, for the
@@ -466,13 +467,13 @@ impl Bound {
         }
     }
 
-    /// Carry the errors over up to `periods` more periods, `tau` apart, each
-    /// as the last recorded one did, checks included (see
+    /// Carry the errors over up to `periods` more periods of `events`
+    /// events each, as the last recorded period did, checks included (see
     /// [`crate::engine::period_record`]); stop short of the first period
     /// whose checks would fail, or after which the next one's first graze
     /// checks would. How many periods were carried.
-    pub fn replay(&mut self, periods: u64, tau: f64) -> u64 {
-        let done = self.replayed(periods, tau);
+    pub fn replay(&mut self, periods: u64, events: usize) -> u64 {
+        let done = self.replayed(periods, events);
         if done > 0 {
             // The period under way was checked against the errors before
             // the jump.
@@ -482,8 +483,8 @@ impl Bound {
     }
 
     /// [`Bound::replay`] without its closing note.
-    fn replayed(&mut self, periods: u64, tau: f64) -> u64 {
-        let Some(ops) = self.record.last() else {
+    fn replayed(&mut self, periods: u64, events: usize) -> u64 {
+        let Some(ops) = self.record.last(events) else {
             return 0;
         };
         let ops: Vec<Op> = ops.collect();
@@ -495,7 +496,7 @@ impl Bound {
                 self.last_time_bound,
             );
             let mut times = (saved.1, saved.2);
-            if !replay_period(&ops, tau, &mut self.errors, &mut times)
+            if !replay_period(&ops, &mut self.errors, &mut times)
                 || !opening_checks_hold(&ops, &self.errors)
             {
                 (self.errors, self.event_time_bound, self.last_time_bound) = saved;

@@ -167,8 +167,9 @@ impl Integrator {
     }
 
     /// Whether each step depends only on the state it starts from (and the
-    /// run's settings): Taylor's method chooses its step from the series
-    /// there, and the linear propagator steps a fixed length. The adaptive
+    /// run's settings), unless the run's end cuts it short: Taylor's method
+    /// chooses its step from the series there, and the linear propagator
+    /// steps a fixed length. The adaptive
     /// pairs carry their step size over from the step before, and
     /// Stormer-Verlet's dense output is scanned without the margins a
     /// replayed bound checks (see [`crate::engine::periodic`]).

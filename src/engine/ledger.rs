@@ -11,6 +11,7 @@ use std::time::Instant;
 use crate::engine::model::Mode;
 use crate::engine::names::Name;
 use crate::engine::observer::{EventRecord, Observer, SETTLE};
+use crate::engine::periodic::Counted;
 use crate::engine::run::{FastForward, Options, Outcome, Status};
 use crate::engine::run_loop::{BUDGET_CHECK, CLOCK_EVERY, End, PROGRESS_SECONDS};
 use crate::engine::zeno::ZenoWatch;
@@ -208,51 +209,58 @@ impl<'o> Ledger<'o> {
         }
     }
 
-    /// Events a jump over whole periods of `tau` from `now` may count,
-    /// so that the budget's rules hold as if each event fired: never past
-    /// the budget (the event past it fails the run), and not past the
-    /// budget's next projection where that projection (at the orbit's
-    /// rate, one event per period) would fail the run there.
-    pub fn jump_allowance(&self, tau: f64, now: Time) -> u64 {
+    /// Periods of `tau`, with `events` events each, that a jump from `now`
+    /// may count, so that the budget's rules hold as if each event fired:
+    /// never past the budget (the event past it fails the run), and not
+    /// past the budget's next projection where that projection (at the
+    /// orbit's rate) would fail the run there.
+    pub fn jump_allowance(&self, (tau, events): (f64, u64), now: Time) -> u64 {
         let max = self.options.max_events;
         let left = max.saturating_sub(self.events);
         let to_projection = self.budget_check.0.saturating_sub(self.events);
-        let needed = self.events as f64 + Time::new(self.options.t_end).since(now) / tau;
-        if left > to_projection && needed > max as f64 {
+        let needed =
+            self.events as f64 + Time::new(self.options.t_end).since(now) / tau * events as f64;
+        let allowed = if left > to_projection && needed > max as f64 {
             to_projection
         } else {
             left
-        }
+        };
+        allowed / events.max(1)
     }
 
     /// A jump over `periods` periods of `tau`, from `from` to `to`, each
-    /// with one event of guard `slot` in `mode` (or the name its reset
-    /// gives, `named`): count them as fired.
-    pub fn jumped(
+    /// with one event of each of `cycle` (a guard of a mode, or the name
+    /// its reset gives): count them as fired.
+    pub fn jumped<'a>(
         &mut self,
-        (mode, slot, named): (Mode, usize, Option<&Name>),
+        cycle: impl Iterator<Item = Counted<'a>>,
         periods: u64,
         tau: f64,
         (from, to): (Time, Time),
     ) {
-        self.events += periods;
+        let mut events = 0;
+        for (mode, slot, named) in cycle {
+            match named {
+                Some(name) => self.count_named_many(name, periods),
+                None => self.count_many(mode, slot, periods),
+            }
+            events += 1;
+        }
+        self.events += periods * events;
         if self.events > self.budget_check.0 {
             // The projections jumped over passed (see `jump_allowance`);
             // one the jump stops at is the loop's to make.
             self.budget_check = (self.events + BUDGET_CHECK, self.events, to);
         }
-        match named {
-            Some(name) => self.count_named_many(name, periods),
-            None => self.count_many(mode, slot, periods),
-        }
         let jump = self.fast_forward.get_or_insert(FastForward {
             periods: 0,
+            events_per_period: events,
             period: tau,
             from: from.value(),
             to: to.value(),
         });
         jump.periods += periods;
-        (jump.period, jump.to) = (tau, to.value());
+        (jump.events_per_period, jump.period, jump.to) = (events, tau, to.value());
     }
 
     /// Count a non-internal event of guard `slot` in `mode`.

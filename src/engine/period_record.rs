@@ -1,26 +1,30 @@
-//! What a stepped run's error bound did over the last period between two
-//! events, kept so that a jump over whole periods of a periodic orbit (see
-//! [`periodic`](crate::engine::periodic)) carries the bound over them as
-//! firing each would have.
+//! What a stepped run's error bound did between each of the last events
+//! and the one before it, kept so that a jump over whole periods of a
+//! periodic orbit (see [`periodic`](crate::engine::periodic)) carries the
+//! bound over them as firing each event would have.
 //!
 //! A run whose steps depend only on the state they start from (the linear
 //! propagator, Taylor's method) repeats its last period from a repeated
-//! state: the same steps, the same tangent maps, the same saltation. What
+//! state: the same steps, the same tangent maps, the same saltations. What
 //! changes from one period to the next is the set of errors they carry,
 //! and with it the checks that stop a run (a graze within the errors, an
-//! event time uncertain by half a period). So the bound records each
-//! operation of a period here: each step's tangent map and local error,
-//! each graze check's gradient and margin, the event's saltation; a jump
-//! replays them period by period, checks included (`Bound::replay` in
-//! `bound.rs`), and stops
-//! short of the first period whose checks would fail (the run then fires
-//! it, and fails there itself).
+//! event time uncertain by half the time since the event before). So the
+//! bound records each operation here: each step's tangent map and local
+//! error, each graze check's gradient and margin, each event's saltation;
+//! a jump replays the period's (the stretches between its events, in
+//! order) period by period, checks included (`Bound::replay` in
+//! `bound.rs`), and stops short of the first period whose checks would
+//! fail (the run then fires it, and fails there itself).
 //!
 //! A step's scan proves a guard clear only of the uncertainty it was given
 //! (its coefficients stay above it): a recording run scans with
 //! [`HEADROOM`] times the uncertainty, so a replayed check holds until the
 //! errors have grown that much. Scanning with more changes no crossing and
 //! no margin that the run compares, only which shortcut a scan takes.
+
+use std::collections::VecDeque;
+
+use crate::engine::periodic::MAX_CYCLE;
 
 /// The most periods one jump replays: a replay costs each period's maps,
 /// and the run loop reads the wall clock and looks for an interrupt between
@@ -50,6 +54,7 @@ enum Stored {
         closing: f64,
         depth: f64,
         widen: f64,
+        since: f64,
         timed: bool,
     },
 }
@@ -69,15 +74,17 @@ pub(crate) enum Op<'a> {
         limit: f64,
     },
     /// The event: the errors along its guard's `gradient` move it in time
-    /// (closing at `closing`, its dip `depth` deep); they go through the
-    /// `saltation` matrix, and `widen` is added. A `timed` event (not an
-    /// internal switch) has its time bounded.
+    /// (closing at `closing`, its dip `depth` deep, `since` after the event
+    /// before it); they go through the `saltation` matrix, and `widen` is
+    /// added. A `timed` event (not an internal switch) has its time
+    /// bounded.
     Event {
         gradient: &'a [f64],
         saltation: &'a [f64],
         closing: f64,
         depth: f64,
         widen: f64,
+        since: f64,
         timed: bool,
     },
 }
@@ -108,14 +115,15 @@ impl Period {
     }
 }
 
-/// The operations since the last event, and the last whole period's, of a
-/// run of dimension `n`.
+/// The operations since the last event, and those between each of the
+/// last [`MAX_CYCLE`] events and the one before it, oldest first, of a run
+/// of dimension `n`.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct PeriodRecord {
     n: usize,
     on: bool,
     current: Period,
-    last: Period,
+    last: VecDeque<Period>,
 }
 
 impl PeriodRecord {
@@ -178,7 +186,7 @@ impl PeriodRecord {
         &mut self,
         (gradient, saltation): (&[f64], &[f64]),
         (closing, depth, widen): (f64, f64, f64),
-        timed: bool,
+        (since, timed): (f64, bool),
     ) {
         if !self.on {
             return;
@@ -189,41 +197,55 @@ impl PeriodRecord {
                 closing,
                 depth,
                 widen,
+                since,
                 timed,
             });
-        std::mem::swap(&mut self.current, &mut self.last);
-        self.current.restart(true);
+        let mut next = if self.last.len() == MAX_CYCLE {
+            self.last.pop_front().unwrap_or_default()
+        } else {
+            Period::default()
+        };
+        next.restart(true);
+        self.last
+            .push_back(std::mem::replace(&mut self.current, next));
     }
 
-    /// The last period's operations, where it was recorded whole.
-    pub fn last(&self) -> Option<impl Iterator<Item = Op<'_>>> {
-        let (n, period) = (self.n, &self.last);
-        let x = &period.numbers;
-        (self.on && period.whole).then(|| {
-            period.ops.iter().map(move |op| match *op {
-                Stored::Step { at, local } => Op::Step {
-                    matrix: &x[at..at + n * n],
-                    local,
-                },
-                Stored::Margin { at, local, limit } => Op::Margin {
-                    gradient: &x[at..at + n],
-                    local,
-                    limit,
-                },
-                Stored::Event {
-                    at,
-                    closing,
-                    depth,
-                    widen,
-                    timed,
-                } => Op::Event {
-                    gradient: &x[at..at + n],
-                    saltation: &x[at + n..at + n + n * n],
-                    closing,
-                    depth,
-                    widen,
-                    timed,
-                },
+    /// The operations between the last `events` events and the one before
+    /// each, in order, where each stretch was recorded whole.
+    pub fn last(&self, events: usize) -> Option<impl Iterator<Item = Op<'_>>> {
+        let n = self.n;
+        let from = self.last.len().checked_sub(events)?;
+        let stretches = self.last.range(from..);
+        (self.on && events > 0 && stretches.clone().all(|p| p.whole)).then(|| {
+            stretches.flat_map(move |period| {
+                let x = &period.numbers;
+                period.ops.iter().map(move |op| match *op {
+                    Stored::Step { at, local } => Op::Step {
+                        matrix: &x[at..at + n * n],
+                        local,
+                    },
+                    Stored::Margin { at, local, limit } => Op::Margin {
+                        gradient: &x[at..at + n],
+                        local,
+                        limit,
+                    },
+                    Stored::Event {
+                        at,
+                        closing,
+                        depth,
+                        widen,
+                        since,
+                        timed,
+                    } => Op::Event {
+                        gradient: &x[at..at + n],
+                        saltation: &x[at + n..at + n + n * n],
+                        closing,
+                        depth,
+                        widen,
+                        since,
+                        timed,
+                    },
+                })
             })
         })
     }

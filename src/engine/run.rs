@@ -135,8 +135,10 @@ pub struct Outcome {
 /// The periods a run jumped over, summed over its jumps.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FastForward {
-    /// Whole periods jumped over, one event each (counted as if fired).
+    /// Whole periods jumped over (their events counted as if fired).
     pub periods: u64,
+    /// The events each period of the last jump held.
+    pub events_per_period: u64,
     /// The period of the last jump.
     pub period: f64,
     /// Where the first jump started and the last ended.

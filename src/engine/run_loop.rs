@@ -126,12 +126,13 @@ pub(crate) trait Segments {
         None
     }
 
-    /// The period of the orbit the last event showed to repeat, where the
-    /// source can prove it does (see [`periodic`]): the time from the
-    /// current origin to the next event, which is the same guard's again.
+    /// The period of the orbit the last event showed to repeat, and the
+    /// events each period holds, where the source can prove it does (see
+    /// [`periodic`]): from the current origin, the next period's events
+    /// repeat the last period's.
     ///
     /// [`periodic`]: crate::engine::periodic
-    fn period(&self) -> Option<f64> {
+    fn period(&self) -> Option<(f64, u64)> {
         None
     }
 
@@ -199,14 +200,14 @@ fn turns<S: Segments + ?Sized, O: Observer + ?Sized>(
                 source.fire(guard, t, ledger, observer)?;
                 // An observer that looks at events sees every one fired.
                 if !observer.wants_details()
-                    && let Some(tau) = source.period()
+                    && let Some((tau, events)) = source.period()
                     // Events closer than the run resolves are the Zeno
                     // watch's, not a period's.
-                    && tau > zeno::resolution(t.value(), t_end)
+                    && tau / events as f64 > zeno::resolution(t.value(), t_end)
                 {
                     let limit = samples.peek().map_or(t_end, |&s| s.min(t_end));
                     let periods = periodic::periods_to_skip(source.origin(), tau, limit)
-                        .min(ledger.jump_allowance(tau, source.origin()));
+                        .min(ledger.jump_allowance((tau, events), source.origin()));
                     if periods > 0 {
                         source.jump(periods, tau, ledger);
                     }

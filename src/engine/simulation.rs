@@ -23,7 +23,6 @@ use crate::engine::ledger::{Final, Ledger};
 use crate::engine::locate::{Start, scan_step};
 use crate::engine::method::Method;
 use crate::engine::model::{Affects, Direction, HybridModel, Mode};
-use crate::engine::names::Name;
 use crate::engine::observer::{EventRecord, Observer, SETTLE};
 use crate::engine::period_record::REPLAYED_AT_ONCE;
 use crate::engine::periodic::Returns;
@@ -155,10 +154,9 @@ struct Run<'m, 's, M: HybridModel + ?Sized> {
     /// The model's clock component and its value at `t = 0`: the clock
     /// reads the run's time from there.
     clock: Option<(usize, f64)>,
-    /// The state after the last event, to prove the orbit periodic, and
-    /// that event's mode, guard and name (what a period's event counts as).
+    /// The last events and the states they left, to prove the orbit
+    /// periodic.
     returns: Returns,
-    repeated: (Mode, usize, Option<Name>),
 }
 
 impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
@@ -349,19 +347,12 @@ impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
             Motion::Stepped => self.integrator.memoryless(),
             Motion::Frozen => false,
         };
-        if !observer.wants_details()
-            && !guard.internal
-            && jump.mode == mode
-            && repeats
-            && self.clock.is_none()
-        {
-            self.returns.visit(mode, slot, t, &self.state);
-            self.repeated = (mode, slot, jump.event);
+        if !observer.wants_details() && !guard.internal && repeats && self.clock.is_none() {
+            self.returns
+                .visit((mode, slot, jump.event), jump.mode, t, &self.state);
             // Record the stepped bound's periods once the orbit has
             // returned: a run that never does pays nothing for it.
-            if self.motion == Motion::Stepped
-                && self.returns.returned()
-                && !self.bound.record_periods()
+            if !self.bound.idle() && self.returns.cycle().is_some() && !self.bound.record_periods()
             {
                 self.returns.forget();
             }
@@ -371,27 +362,28 @@ impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
         Ok(())
     }
 
-    fn period(&self) -> Option<f64> {
-        if !self.returns.returned() {
-            return None;
-        }
+    fn period(&self) -> Option<(f64, u64)> {
+        let events = self.returns.cycle()?;
         match self.motion {
-            Motion::Exact => {
+            // The next event, predicted, is the same guard's again.
+            Motion::Exact if events == 1 => {
                 let (next, at) = self.queue.peek()?;
-                (next == self.repeated.1).then(|| at.since(self.origin))
+                (Some(next) == self.returns.last_slot()).then(|| (at.since(self.origin), 1))
             }
-            // Its steps repeat the last period's.
-            Motion::Stepped => Some(self.returns.period()),
+            // The events repeat the last period's, and so do the steps.
+            Motion::Exact | Motion::Stepped => Some((self.returns.period(), events as u64)),
             Motion::Frozen => None,
         }
     }
 
     fn jump(&mut self, periods: u64, tau: f64, ledger: &mut Ledger) {
-        // A stepped run's bound goes over the periods as firing each would
-        // have, as far as its checks allow.
-        let periods = match self.motion {
-            Motion::Stepped => self.bound.replay(periods.min(REPLAYED_AT_ONCE), tau),
-            _ => periods,
+        // A bound that carries errors goes over the periods as firing each
+        // event would have, as far as its checks allow.
+        let periods = if self.bound.idle() {
+            periods
+        } else {
+            let events = self.returns.cycle().unwrap_or(0);
+            self.bound.replay(periods.min(REPLAYED_AT_ONCE), events)
         };
         if periods == 0 {
             return;
@@ -404,13 +396,8 @@ impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
         if self.step_end.is_some() {
             self.step_end = Some(self.origin.after(self.integrator.h()));
         }
-        let (mode, slot, named) = &self.repeated;
-        ledger.jumped(
-            (*mode, *slot, named.as_ref()),
-            periods,
-            tau,
-            (from, self.origin),
-        );
+        self.returns.postpone(periods, tau);
+        ledger.jumped(self.returns.events(), periods, tau, (from, self.origin));
     }
 
     fn renew(&mut self, t: Time) -> Result<(), End> {
@@ -529,7 +516,6 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
             after: vec![0.0; n],
             clock: model.clock().map(|c| (c, x0[c])),
             returns: Returns::default(),
-            repeated: (mode, 0, None),
         }
     }
 
@@ -915,6 +901,11 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
                     return Err(self.step_failed(failure));
                 }
                 let h = self.integrator.h();
+                // A step the run's end cut short depends on more than its
+                // start: its period does not repeat.
+                if h >= remaining {
+                    self.bound.unrepeatable();
+                }
                 self.forcing_error = self.forcing_rounding(h);
                 let local = self.local_error();
                 let interpolant = self.integrator.interpolant();

@@ -15,8 +15,9 @@
 //! of the final state (`final_state`, by name) and of the last event's time
 //! (`last_event_time`); where the run jumped over whole periods of an
 //! exactly periodic orbit (no event log, see `engine::periodic`),
-//! `fast_forward`: `periods` (one event each, counted, not fired), `period` (the
-//! last jump's), `from` and `to` (where the jumps began and ended).
+//! `fast_forward`: `periods` (their events counted, not fired),
+//! `events_per_period`, `period` (the last jump's), `from` and `to` (where
+//! the jumps began and ended).
 
 use std::io;
 use std::path::Path;
@@ -61,6 +62,7 @@ pub fn summary(report: &Report, model: &str, scene: &Path, log: Option<&Path>) -
     if let Some(f) = &o.fast_forward {
         value["fast_forward"] = json!({
             "periods": f.periods,
+            "events_per_period": f.events_per_period,
             "period": f.period,
             "from": f.from,
             "to": f.to,

@@ -10,7 +10,7 @@ use flicker::models::mechanism::strain::FLIGHT;
 use flicker::models::mechanism::{Mechanism, StrainMechanism};
 
 use crate::oscillator::Unit;
-use crate::support::{flicker, read_json};
+use crate::support::{flicker, models, read_json};
 
 /// The issue's chattering case: below the critical load, strain 1e-14 at
 /// rest, impacts 4e-7 apart, 2.5e8 of them by t = 100.
@@ -224,18 +224,19 @@ fn bouncing_oscillator(guards: &str, t_end: f64) -> String {
 /// A run's summary and its samples `(t, x, v, bound)`.
 type Run = (serde_json::Value, Vec<[f64; 4]>);
 
-/// `scene` run by `method` with its event log and without one
-/// (`--no-events`, which may jump), each sampled at 7 times.
-fn logged_and_quiet(scene: &str, method: &str) -> (Run, Run) {
+/// `scene` run with `args` (`--method M`, or none), with its event log and
+/// without one (`--no-events`, which may jump), each sampled at 7 times.
+fn logged_and_quiet(scene: &str, args: &[&str]) -> (Run, Run) {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("scene.json");
     std::fs::write(&path, scene).unwrap();
     let run = |extra: &[&str], out: &str| {
         let out = dir.path().join(out);
-        let mut args = vec!["run", path.to_str().unwrap(), "--quiet", "--method", method];
-        args.extend(["--samples", "7", "--out", out.to_str().unwrap()]);
-        args.extend(extra);
-        flicker(&args);
+        let mut all = vec!["run", path.to_str().unwrap(), "--quiet"];
+        all.extend(args);
+        all.extend(["--samples", "7", "--out", out.to_str().unwrap()]);
+        all.extend(extra);
+        flicker(&all);
         let samples = std::fs::read_to_string(out.join("samples.csv")).unwrap_or_default();
         let rows = samples
             .lines()
@@ -263,7 +264,7 @@ fn stepped_runs_jump_with_the_bound_firing_each_event_would_state() {
     let impacts = (t_end / std::f64::consts::PI).floor() as u64;
     let phase = t_end % std::f64::consts::PI;
     for method in ["linear", "taylor"] {
-        let ((logged, _), (quiet, samples)) = logged_and_quiet(&scene, method);
+        let ((logged, _), (quiet, samples)) = logged_and_quiet(&scene, &["--method", method]);
         for s in [&logged, &quiet] {
             assert_eq!(s["status"], "completed", "{method}: {s}");
             assert_eq!(s["events"].as_u64(), Some(impacts), "{method}: {s}");
@@ -311,7 +312,7 @@ fn a_jump_stops_short_of_the_period_whose_checks_fail() {
         20000.0,
     );
     for method in ["linear", "taylor"] {
-        let ((logged, _), (quiet, _)) = logged_and_quiet(&scene, method);
+        let ((logged, _), (quiet, _)) = logged_and_quiet(&scene, &["--method", method]);
         for s in [&logged, &quiet] {
             assert_eq!(s["status"], "failed", "{method}: {s}");
             let reason = s["reason"].as_str().unwrap_or("");
@@ -343,7 +344,7 @@ fn a_periodic_section_marker_is_jumped_over_too() {
     // Rising crossings at 2 pi k - atan(0.3), k >= 1.
     let crossings = ((t_end + 0.3f64.atan()) / std::f64::consts::TAU).floor() as u64;
     for method in ["linear", "taylor"] {
-        let ((logged, _), (quiet, _)) = logged_and_quiet(scene, method);
+        let ((logged, _), (quiet, _)) = logged_and_quiet(scene, &["--method", method]);
         for s in [&logged, &quiet] {
             assert_eq!(s["status"], "completed", "{method}: {s}");
             assert_eq!(s["events"].as_u64(), Some(crossings), "{method}: {s}");
@@ -353,5 +354,116 @@ fn a_periodic_section_marker_is_jumped_over_too() {
         }
         let periods = quiet["fast_forward"]["periods"].as_u64().unwrap_or(0);
         assert!(periods + 40 >= crossings, "{method}: {quiet}");
+    }
+}
+
+#[test]
+fn a_ball_between_two_walls_jumps_over_both_impacts() {
+    // x' = v, v' = 0 from (0.5, 0.7) between walls at 0 and 1: a period of
+    // two impacts, 2 / 0.7 long; impacts at (0.5 + k) / 0.7.
+    let t_end: f64 = 3000.0;
+    let scene = r#"{"model": "automaton", "states": ["x", "v"], "initial": {"x": 0.5, "v": 0.7},
+        "modes": {"m": {"flow": {"x": "v", "v": "0"},
+          "transitions": [
+            {"name": "left", "guard": "x", "direction": "falling", "barrier": true,
+             "reset": {"x": "0", "v": "-v"}},
+            {"name": "right", "guard": "1 - x", "direction": "falling", "barrier": true,
+             "reset": {"x": "1", "v": "-v"}}]}},
+        "t_end": 3000.0}"#;
+    let impacts = (0.7 * t_end - 0.5).floor() as u64 + 1;
+    // The triangle wave through x = 0.5 rising at t = 0.
+    let phase = (0.5 + 0.7 * t_end) % 2.0;
+    let (x, v) = if phase < 1.0 {
+        (phase, 0.7)
+    } else {
+        (2.0 - phase, -0.7)
+    };
+    for method in ["linear", "taylor"] {
+        let ((logged, _), (quiet, _)) = logged_and_quiet(scene, &["--method", method]);
+        for s in [&logged, &quiet] {
+            assert_eq!(s["status"], "completed", "{method}: {s}");
+            assert_eq!(s["events"].as_u64(), Some(impacts), "{method}: {s}");
+            let fs = &s["final_state"];
+            let err = (number(fs, "x") - x).abs().max((number(fs, "v") - v).abs());
+            assert!(err <= number(s, "error_bound"), "{method}: {err:e}, {s}");
+        }
+        assert_eq!(logged["events_by_guard"], quiet["events_by_guard"]);
+        for field in ["error_bound", "event_time_bound"] {
+            let (a, b) = (number(&logged, field), number(&quiet, field));
+            assert!(
+                (a - b).abs() <= 1e-6 * a,
+                "{method}: {field} {b:e} jumping, {a:e} firing"
+            );
+        }
+        // Taylor's series of this flow ends at its first order: each step
+        // runs to the end of the run, which its length then depends on, so
+        // its periods do not repeat and nothing is jumped.
+        let jumped = &quiet["fast_forward"];
+        if method == "taylor" {
+            assert!(jumped.is_null(), "{quiet}");
+            continue;
+        }
+        assert_eq!(jumped["events_per_period"], 2, "{method}: {quiet}");
+        // All but a few periods after the start and each sample.
+        assert!(jumped["periods"].as_u64().unwrap() * 2 + 100 >= impacts);
+    }
+}
+
+#[test]
+fn periods_of_several_events_and_modes_are_jumped_as_firing_each_would_end() {
+    // The mechanism's angle as two charts: six events a period, among them
+    // the switches between the charts (modes).
+    let mut json = read_json(std::path::Path::new(&models(
+        "automata/mechanism_charts.json",
+    )));
+    json["t_end"] = 2000.0.into();
+    let ((logged, _), (quiet, _)) = logged_and_quiet(&json.to_string(), &[]);
+    for s in [&logged, &quiet] {
+        assert_eq!(s["status"], "completed", "{s}");
+    }
+    assert_eq!(logged["events_by_guard"], quiet["events_by_guard"]);
+    let jumped = &quiet["fast_forward"];
+    assert_eq!(jumped["events_per_period"], 6, "{quiet}");
+    assert!(jumped["periods"].as_u64() > Some(100), "{quiet}");
+    // Within round-off of firing each: the jump stays on the state it
+    // returned to, where firing walks away from it by an ulp or so.
+    let bound = number(&logged, "error_bound");
+    for field in ["error_bound", "event_time_bound"] {
+        let (a, b) = (number(&logged, field), number(&quiet, field));
+        assert!(
+            (a - b).abs() <= 1e-6 * a,
+            "{field} {b:e} jumping, {a:e} firing"
+        );
+    }
+    let (a, b) = (&logged["final_state"], &quiet["final_state"]);
+    for (name, value) in a.as_object().unwrap() {
+        let gap = (value.as_f64().unwrap() - number(b, name)).abs();
+        assert!(
+            gap <= 2.0 * bound,
+            "{name} differs by {gap:e}, bound {bound:e}"
+        );
+    }
+}
+
+#[test]
+fn a_period_whose_steps_run_to_the_end_is_not_jumped() {
+    // Stick-slip on a belt: while the block sticks its flow is a constant
+    // velocity, whose Taylor series ends at its first order, so each such
+    // step runs to the end of the run and depends on it. The periods do
+    // not repeat their steps, and the run fires every event, to the same
+    // bytes as with its log.
+    let mut json = read_json(std::path::Path::new(&models(
+        "automata/stick_slip_belt.json",
+    )));
+    json["t_end"] = 400.0.into();
+    let ((logged, _), (quiet, _)) = logged_and_quiet(&json.to_string(), &[]);
+    assert!(quiet["fast_forward"].is_null(), "{quiet}");
+    for field in [
+        "events_by_guard",
+        "final_state",
+        "error_bound",
+        "event_time_bound",
+    ] {
+        assert_eq!(logged[field], quiet[field], "{field}");
     }
 }
