@@ -24,7 +24,7 @@
 
 use crate::engine::error_set::{ErrorSet, TRACKED};
 use crate::engine::model::{HybridModel, Mode};
-use crate::engine::period_record::{HEADROOM, Op, PeriodRecord};
+use crate::engine::period_record::{EventFacts, HEADROOM, Op, PeriodRecord};
 use crate::engine::tangent::Tangents;
 use crate::engine::zeno;
 use crate::time::Time;
@@ -98,11 +98,14 @@ fn replay_period(ops: &[Op<'_>], errors: &mut ErrorSet, (largest, last): &mut (f
         Op::Event {
             gradient,
             saltation,
-            closing,
-            depth,
-            widen,
-            since,
-            timed,
+            facts:
+                EventFacts {
+                    closing,
+                    depth,
+                    widen,
+                    since,
+                    timed,
+                },
         } => {
             let shift = time_shift(errors.along(gradient), closing, depth);
             if timed {
@@ -422,11 +425,14 @@ impl Bound {
                     .sum::<f64>();
         let widen = jump * residual / closing.abs();
         self.errors.map(&self.matrix, widen);
-        self.record.event(
-            (&self.gradient, &self.matrix),
-            (closing, depth, widen),
-            (since.unwrap_or(f64::INFINITY), !guard.internal),
-        );
+        let facts = EventFacts {
+            closing,
+            depth,
+            widen,
+            since: since.unwrap_or(f64::INFINITY),
+            timed: !guard.internal,
+        };
+        self.record.event((&self.gradient, &self.matrix), facts);
         Ok(())
     }
 

@@ -40,23 +40,23 @@ pub const HEADROOM: f64 = 16.0;
 /// the period's numbers from `at`.
 #[derive(Debug, Clone, Copy)]
 enum Stored {
-    Step {
-        at: usize,
-        local: f64,
-    },
-    Margin {
-        at: usize,
-        local: f64,
-        limit: f64,
-    },
-    Event {
-        at: usize,
-        closing: f64,
-        depth: f64,
-        widen: f64,
-        since: f64,
-        timed: bool,
-    },
+    Step { at: usize, local: f64 },
+    Margin { at: usize, local: f64, limit: f64 },
+    Event { at: usize, facts: EventFacts },
+}
+
+/// An event's numbers besides its vectors: the errors along its guard's
+/// gradient move it in time (closing at `closing`, its dip `depth` deep,
+/// `since` after the event before it); `widen` is added after its
+/// saltation. A `timed` event (not an internal switch) has its time
+/// bounded.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct EventFacts {
+    pub closing: f64,
+    pub depth: f64,
+    pub widen: f64,
+    pub since: f64,
+    pub timed: bool,
 }
 
 /// One operation of the bound over a period, as a replay reads it.
@@ -73,19 +73,12 @@ pub(crate) enum Op<'a> {
         local: f64,
         limit: f64,
     },
-    /// The event: the errors along its guard's `gradient` move it in time
-    /// (closing at `closing`, its dip `depth` deep, `since` after the event
-    /// before it); they go through the `saltation` matrix, and `widen` is
-    /// added. A `timed` event (not an internal switch) has its time
-    /// bounded.
+    /// The event: the errors along its guard's `gradient` move it in time,
+    /// and go through the `saltation` matrix (see [`EventFacts`]).
     Event {
         gradient: &'a [f64],
         saltation: &'a [f64],
-        closing: f64,
-        depth: f64,
-        widen: f64,
-        since: f64,
-        timed: bool,
+        facts: EventFacts,
     },
 }
 
@@ -182,24 +175,12 @@ impl PeriodRecord {
 
     /// The event that ends the period (see [`Op::Event`]). The period
     /// becomes the last one, and the next begins.
-    pub fn event(
-        &mut self,
-        (gradient, saltation): (&[f64], &[f64]),
-        (closing, depth, widen): (f64, f64, f64),
-        (since, timed): (f64, bool),
-    ) {
+    pub fn event(&mut self, (gradient, saltation): (&[f64], &[f64]), facts: EventFacts) {
         if !self.on {
             return;
         }
         self.current
-            .push(&[gradient, saltation], |at| Stored::Event {
-                at,
-                closing,
-                depth,
-                widen,
-                since,
-                timed,
-            });
+            .push(&[gradient, saltation], |at| Stored::Event { at, facts });
         let mut next = if self.last.len() == MAX_CYCLE {
             self.last.pop_front().unwrap_or_default()
         } else {
@@ -229,21 +210,10 @@ impl PeriodRecord {
                         local,
                         limit,
                     },
-                    Stored::Event {
-                        at,
-                        closing,
-                        depth,
-                        widen,
-                        since,
-                        timed,
-                    } => Op::Event {
+                    Stored::Event { at, facts } => Op::Event {
                         gradient: &x[at..at + n],
                         saltation: &x[at + n..at + n + n * n],
-                        closing,
-                        depth,
-                        widen,
-                        since,
-                        timed,
+                        facts,
                     },
                 })
             })
