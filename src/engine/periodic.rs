@@ -67,7 +67,8 @@ struct Visit {
     state: Vec<f64>,
 }
 
-/// The last [`MAX_CYCLE`] events with nothing between them, to tell whether
+/// The last [`MAX_CYCLE`] events with nothing between them (and the one
+/// before them, which the last may have returned to), to tell whether
 /// the next one returns to where one of them left the run. Their buffers
 /// are kept across [`Returns::forget`]: no allocation per event.
 #[derive(Debug, Clone, Default)]
@@ -105,11 +106,12 @@ impl Returns {
         state: &[f64],
     ) {
         let from = self.visits.len() - self.known;
-        self.cycle = (1..=self.known).find(|&k| {
+        self.cycle = (1..=self.known.min(MAX_CYCLE)).find(|&k| {
             let v = &self.visits[from + self.known - k];
             v.mode == mode && v.slot == slot && v.after == after && v.t < t && same(&v.state, state)
         });
-        let mut visit = if self.visits.len() == MAX_CYCLE {
+        // The one returned to stays, [`MAX_CYCLE`] back at most.
+        let mut visit = if self.visits.len() > MAX_CYCLE {
             self.visits.pop_front().unwrap_or_default()
         } else {
             Visit::default()
@@ -118,7 +120,7 @@ impl Returns {
         visit.state.extend_from_slice(state);
         (visit.mode, visit.slot, visit.named, visit.after, visit.t) = (mode, slot, named, after, t);
         self.visits.push_back(visit);
-        self.known = (self.known + 1).min(MAX_CYCLE);
+        self.known = (self.known + 1).min(MAX_CYCLE + 1);
     }
 
     /// How many events the period holds, where the last event returned the
@@ -229,6 +231,13 @@ mod tests {
         assert_eq!(r.period(), 2.0);
         let counted: Vec<usize> = r.events().map(|(_, slot, _)| slot).collect();
         assert_eq!(counted, [1, 0]);
+        let mut r = Returns::default();
+        for (i, slot) in (0..MAX_CYCLE).chain([0]).enumerate() {
+            r.visit((0, slot, None), 0, Time::new(i as f64), &[slot as f64]);
+        }
+        assert_eq!(r.cycle(), Some(MAX_CYCLE), "the longest period");
+        assert_eq!(r.period(), MAX_CYCLE as f64);
+        assert_eq!(r.events().count(), MAX_CYCLE);
         let mut r = Returns::default();
         for (i, slot) in (0..MAX_CYCLE + 1).chain([0]).enumerate() {
             r.visit((0, slot, None), 0, Time::new(i as f64), &[slot as f64]);
