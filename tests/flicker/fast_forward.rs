@@ -257,6 +257,46 @@ fn number(summary: &serde_json::Value, field: &str) -> f64 {
         .unwrap_or_else(|| panic!("no `{field}` in {summary}"))
 }
 
+/// `summary` is of a completed run with `events` events, whose final
+/// `(x, v)` is within its stated bound of `want`.
+fn assert_completed_at(summary: &serde_json::Value, events: u64, want: (f64, f64), what: &str) {
+    assert_eq!(summary["status"], "completed", "{what}: {summary}");
+    assert_eq!(
+        summary["events"].as_u64(),
+        Some(events),
+        "{what}: {summary}"
+    );
+    let fs = &summary["final_state"];
+    let err = (number(fs, "x") - want.0)
+        .abs()
+        .max((number(fs, "v") - want.1).abs());
+    assert!(
+        err <= number(summary, "error_bound"),
+        "{what}: error {err:e}, {summary}"
+    );
+}
+
+/// The summaries of bundled scene `name` run to `t_end` by its own method,
+/// with its event log and without one.
+fn bundled_logged_and_quiet(name: &str, t_end: f64) -> (serde_json::Value, serde_json::Value) {
+    let mut json = read_json(std::path::Path::new(&models(name)));
+    json["t_end"] = t_end.into();
+    let ((logged, _), (quiet, _)) = logged_and_quiet(&json.to_string(), &[]);
+    (logged, quiet)
+}
+
+/// The bounds a jumping run states are those of firing each event: the
+/// same operations on states equal to round-off, so the same to 1e-6.
+fn assert_same_bounds(logged: &serde_json::Value, quiet: &serde_json::Value, what: &str) {
+    for field in ["error_bound", "event_time_bound"] {
+        let (a, b) = (number(logged, field), number(quiet, field));
+        assert!(
+            (a - b).abs() <= 1e-6 * a && a > 0.0,
+            "{what}: {field} {b:e} jumping, {a:e} firing each"
+        );
+    }
+}
+
 #[test]
 fn stepped_runs_jump_with_the_bound_firing_each_event_would_state() {
     let t_end = 3000.0;
@@ -266,8 +306,7 @@ fn stepped_runs_jump_with_the_bound_firing_each_event_would_state() {
     for method in ["linear", "taylor"] {
         let ((logged, _), (quiet, samples)) = logged_and_quiet(&scene, &["--method", method]);
         for s in [&logged, &quiet] {
-            assert_eq!(s["status"], "completed", "{method}: {s}");
-            assert_eq!(s["events"].as_u64(), Some(impacts), "{method}: {s}");
+            assert_completed_at(s, impacts, (phase.sin(), phase.cos()), method);
         }
         assert!(logged.get("fast_forward").is_none(), "{logged}");
         // All but a few periods after the start and each sample.
@@ -282,23 +321,7 @@ fn stepped_runs_jump_with_the_bound_firing_each_event_would_state() {
                 "{method}: at t = {t}, error {err:e}, bound {bound:e}"
             );
         }
-        // The bound goes over the jumped periods as it would over fired
-        // ones: the same operations on states equal to round-off.
-        for field in ["error_bound", "event_time_bound"] {
-            let (a, b) = (number(&logged, field), number(&quiet, field));
-            assert!(
-                (a - b).abs() <= 1e-6 * a && a > 0.0,
-                "{method}: {field} {b:e} jumping, {a:e} firing each"
-            );
-        }
-        let fs = &quiet["final_state"];
-        let err = (number(fs, "x") - phase.sin())
-            .abs()
-            .max((number(fs, "v") - phase.cos()).abs());
-        assert!(
-            err <= number(&quiet, "error_bound"),
-            "{method}: error {err:e}, {quiet}"
-        );
+        assert_same_bounds(&logged, &quiet, method);
     }
 }
 
@@ -346,11 +369,7 @@ fn a_periodic_section_marker_is_jumped_over_too() {
     for method in ["linear", "taylor"] {
         let ((logged, _), (quiet, _)) = logged_and_quiet(scene, &["--method", method]);
         for s in [&logged, &quiet] {
-            assert_eq!(s["status"], "completed", "{method}: {s}");
-            assert_eq!(s["events"].as_u64(), Some(crossings), "{method}: {s}");
-            let fs = &s["final_state"];
-            let err = (number(fs, "x") - x).abs().max((number(fs, "v") - v).abs());
-            assert!(err <= number(s, "error_bound"), "{method}: {err:e}, {s}");
+            assert_completed_at(s, crossings, (x, v), method);
         }
         let periods = quiet["fast_forward"]["periods"].as_u64().unwrap_or(0);
         assert!(periods + 40 >= crossings, "{method}: {quiet}");
@@ -381,20 +400,10 @@ fn a_ball_between_two_walls_jumps_over_both_impacts() {
     for method in ["linear", "taylor"] {
         let ((logged, _), (quiet, _)) = logged_and_quiet(scene, &["--method", method]);
         for s in [&logged, &quiet] {
-            assert_eq!(s["status"], "completed", "{method}: {s}");
-            assert_eq!(s["events"].as_u64(), Some(impacts), "{method}: {s}");
-            let fs = &s["final_state"];
-            let err = (number(fs, "x") - x).abs().max((number(fs, "v") - v).abs());
-            assert!(err <= number(s, "error_bound"), "{method}: {err:e}, {s}");
+            assert_completed_at(s, impacts, (x, v), method);
         }
         assert_eq!(logged["events_by_guard"], quiet["events_by_guard"]);
-        for field in ["error_bound", "event_time_bound"] {
-            let (a, b) = (number(&logged, field), number(&quiet, field));
-            assert!(
-                (a - b).abs() <= 1e-6 * a,
-                "{method}: {field} {b:e} jumping, {a:e} firing"
-            );
-        }
+        assert_same_bounds(&logged, &quiet, method);
         // Taylor's series of this flow ends at its first order: each step
         // runs to the end of the run, which its length then depends on, so
         // its periods do not repeat and nothing is jumped.
@@ -413,11 +422,7 @@ fn a_ball_between_two_walls_jumps_over_both_impacts() {
 fn periods_of_several_events_and_modes_are_jumped_as_firing_each_would_end() {
     // The mechanism's angle as two charts: six events a period, among them
     // the switches between the charts (modes).
-    let mut json = read_json(std::path::Path::new(&models(
-        "automata/mechanism_charts.json",
-    )));
-    json["t_end"] = 2000.0.into();
-    let ((logged, _), (quiet, _)) = logged_and_quiet(&json.to_string(), &[]);
+    let (logged, quiet) = bundled_logged_and_quiet("automata/mechanism_charts.json", 2000.0);
     for s in [&logged, &quiet] {
         assert_eq!(s["status"], "completed", "{s}");
     }
@@ -425,16 +430,10 @@ fn periods_of_several_events_and_modes_are_jumped_as_firing_each_would_end() {
     let jumped = &quiet["fast_forward"];
     assert_eq!(jumped["events_per_period"], 6, "{quiet}");
     assert!(jumped["periods"].as_u64() > Some(100), "{quiet}");
+    assert_same_bounds(&logged, &quiet, "charts");
     // Within round-off of firing each: the jump stays on the state it
     // returned to, where firing walks away from it by an ulp or so.
     let bound = number(&logged, "error_bound");
-    for field in ["error_bound", "event_time_bound"] {
-        let (a, b) = (number(&logged, field), number(&quiet, field));
-        assert!(
-            (a - b).abs() <= 1e-6 * a,
-            "{field} {b:e} jumping, {a:e} firing"
-        );
-    }
     let (a, b) = (&logged["final_state"], &quiet["final_state"]);
     for (name, value) in a.as_object().unwrap() {
         let gap = (value.as_f64().unwrap() - number(b, name)).abs();
@@ -452,11 +451,7 @@ fn a_period_whose_steps_run_to_the_end_is_not_jumped() {
     // step runs to the end of the run and depends on it. The periods do
     // not repeat their steps, and the run fires every event, to the same
     // bytes as with its log.
-    let mut json = read_json(std::path::Path::new(&models(
-        "automata/stick_slip_belt.json",
-    )));
-    json["t_end"] = 400.0.into();
-    let ((logged, _), (quiet, _)) = logged_and_quiet(&json.to_string(), &[]);
+    let (logged, quiet) = bundled_logged_and_quiet("automata/stick_slip_belt.json", 400.0);
     assert!(quiet["fast_forward"].is_null(), "{quiet}");
     for field in [
         "events_by_guard",
