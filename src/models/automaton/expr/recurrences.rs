@@ -131,13 +131,13 @@ impl Series {
                 Step::Neg(At { a, out, .. }) => m[out + k] = -m[a + k],
                 Step::ScaledRight(At { a, b, out }) => m[out + k] = m[a] * m[b + k],
                 Step::ScaledLeft(At { a, b, out }) => m[out + k] = m[a + k] * m[b],
-                Step::Mul(At { a, b, out }) => m[out + k] = conv(m, a, m, b, k, 0, |_| 1.0),
+                Step::Mul(At { a, b, out }) => m[out + k] = product(m, a, m, b, k, 0),
                 Step::DivConst(At { a, b, out }) => m[out + k] = m[a + k] / m[b],
                 Step::Div(At { a, b, out }) => {
                     let sum = if k == 0 {
                         0.0
                     } else {
-                        conv(m, b, m, out, k, 1, |_| 1.0)
+                        product(m, b, m, out, k, 1)
                     };
                     m[out + k] = (m[a + k] - sum) / m[b];
                 }
@@ -162,15 +162,15 @@ impl Series {
         for (i, &x) in x0.iter().enumerate() {
             out[i * w] = x;
         }
-        for k in 0..=order {
+        // The registers' order `order` would give the state's `order + 1`,
+        // which the series does not keep.
+        for k in 0..order {
             for &(from, to) in &self.loads {
                 self.main[to + k] = out[from + k];
             }
             self.order(k);
-            if k < order {
-                for (i, &o) in tape.outputs.iter().enumerate() {
-                    out[i * w + k + 1] = self.main[o as usize * w + k] / (k + 1) as f64;
-                }
+            for (i, &o) in tape.outputs.iter().enumerate() {
+                out[i * w + k + 1] = self.main[o as usize * w + k] / (k + 1) as f64;
             }
         }
     }
@@ -214,8 +214,8 @@ impl Series {
         // exp(b log a): aux 0 holds log a, aux 1 holds b log a.
         let log = log_coefficient(m, a, &self.aux[0], out, k);
         self.aux[0][out + k] = log;
-        let product = conv(m, b, &self.aux[0], out, k, 0, |_| 1.0);
-        self.aux[1][out + k] = product;
+        let exponent = product(m, b, &self.aux[0], out, k, 0);
+        self.aux[1][out + k] = exponent;
         if k == 0 {
             m[a].powf(m[b])
         } else {
@@ -392,6 +392,21 @@ fn conv(
     let mut sum = 0.0;
     for j in 0..n {
         sum += weight(lo + j) * x[j] * y[n - 1 - j];
+    }
+    sum
+}
+
+/// `sum_{j = lo..=k} x[xs + j] y[ys + k - j]`: [`conv`] unweighted, walked
+/// by iterators (`y` backwards), which need no bounds checks where
+/// indexing `y[n - 1 - j]` kept them (and unroll). The same products
+/// summed in the same order.
+#[inline(always)]
+fn product(x: &[f64], xs: usize, y: &[f64], ys: usize, k: usize, lo: usize) -> f64 {
+    let n = k + 1 - lo;
+    let (x, y) = (&x[xs + lo..xs + lo + n], &y[ys..ys + n]);
+    let mut sum = 0.0;
+    for (a, b) in x.iter().zip(y.iter().rev()) {
+        sum += a * b;
     }
     sum
 }
