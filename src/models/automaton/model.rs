@@ -12,11 +12,13 @@
 //! shape `[q; v]` with `q' = v` and `v'` free of `v` is second order.
 
 use std::cell::RefCell;
+use std::sync::Arc;
 
 use nalgebra::{DMatrix, DVector};
 
 use crate::engine::{Flow, Guard, HybridModel, Jump, Mode, Name};
 use crate::models::automaton::definition::{Definition, Source};
+use crate::models::automaton::expr::compiled::CompiledFlows;
 use crate::models::automaton::expr::derivative::{jacobian, jacobian_into, jacobian_tape};
 use crate::models::automaton::expr::recurrences::Series;
 use crate::models::automaton::expr::{Ast, Scope, Tape};
@@ -49,6 +51,9 @@ struct CompiledMode {
     name: String,
     /// The rate of every state component.
     flow: Tape,
+    /// Its Taylor series as machine code, where it compiles (shared by the
+    /// copies of the model a sweep's threads hold).
+    series_code: Arc<CompiledFlows>,
     /// Its Jacobian's entries, row-major, where compiled (a smooth flow).
     flow_jacobian: Option<Tape>,
     /// The text of each state's rate, for diagnoses.
@@ -319,6 +324,7 @@ impl Automaton {
                 rough,
                 name: mode.name.clone(),
                 flow,
+                series_code: Arc::default(),
                 flow_jacobian,
                 rates: mode.flow.clone(),
                 guards,
@@ -529,7 +535,11 @@ impl HybridModel for Automaton {
     }
 
     fn flow_series(&self, mode: Mode, x: &[f64], order: usize, series: &mut [f64]) {
-        SERIES.with_borrow_mut(|s| s.flow(&self.modes[mode].flow, x, order, series));
+        let m = &self.modes[mode];
+        match m.series_code.get(&m.flow, order) {
+            Some(code) => code.flow(x, series),
+            None => SERIES.with_borrow_mut(|s| s.flow(&m.flow, x, order, series)),
+        }
     }
 
     fn guard_series(

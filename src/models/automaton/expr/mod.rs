@@ -2,6 +2,7 @@
 //! ([`mod@parse`]), compiled to a register tape ([`tape`]) that is evaluated,
 //! differentiated and expanded in Taylor series without walking text.
 
+pub mod compiled;
 pub mod derivative;
 pub mod parse;
 pub mod recurrences;

@@ -1,0 +1,89 @@
+//! Where a compiled series finds each coefficient: three buffers, each
+//! addressed from its own base register.
+//!
+//! - the scratch: the main series of every computed register, then the
+//!   helper series (the partner `cos` of a `sin`), `width` coefficients
+//!   each, as the interpreter keeps them;
+//! - the output: the state's series, which the tape's inputs read in place
+//!   (the interpreter copies them into its registers order by order);
+//! - the pool, read only: each constant register's series (the constant,
+//!   then zeros), the integers up to `order + 1` that the recurrences
+//!   divide and weigh by, and `-1`.
+
+use crate::models::automaton::expr::tape::{Op, Reg, Tape};
+
+/// One of the buffers the compiled code is given.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Base {
+    Scratch,
+    Out,
+    Pool,
+}
+
+/// A coefficient's place: its buffer and byte offset there.
+pub type Place = (Base, i32);
+
+pub struct Layout {
+    pub pool: Vec<f64>,
+    /// Each register's series: its buffer and the index of its order 0.
+    series: Vec<(Base, usize)>,
+    /// Where the helper series start in the scratch.
+    helpers: usize,
+    /// Where the integers start in the pool.
+    integers: usize,
+}
+
+/// The byte offset of coefficient `index` (displacements are 32-bit; the
+/// sizes compiled are capped far below).
+fn bytes(index: usize) -> i32 {
+    i32::try_from(index * size_of::<f64>()).expect("compiled series are capped in size")
+}
+
+impl Layout {
+    pub fn new(tape: &Tape, width: usize) -> Layout {
+        let mut pool = Vec::new();
+        let series = (0..tape.ops.len())
+            .map(|r| match tape.ops[r] {
+                Op::Const(c) => {
+                    let at = pool.len();
+                    pool.push(c);
+                    pool.resize(at + width, 0.0);
+                    (Base::Pool, at)
+                }
+                Op::Input(i) => (Base::Out, i as usize * width),
+                _ => (Base::Scratch, r * width),
+            })
+            .collect();
+        let integers = pool.len();
+        pool.extend((0..=width).map(|j| j as f64));
+        pool.push(-1.0);
+        Layout {
+            pool,
+            series,
+            helpers: tape.ops.len() * width,
+            integers,
+        }
+    }
+
+    /// Coefficient `k` of register `r`.
+    pub fn at(&self, r: Reg, k: usize) -> Place {
+        let (base, start) = self.series[r as usize];
+        (base, bytes(start + k))
+    }
+
+    /// Coefficient `k` of register `r`'s helper series.
+    pub fn helper(&self, r: Reg, k: usize) -> Place {
+        let (_, start) = self.series[r as usize];
+        (Base::Scratch, bytes(self.helpers + start + k))
+    }
+
+    /// The integer `j` as a float.
+    pub fn integer(&self, j: usize) -> Place {
+        (Base::Pool, bytes(self.integers + j))
+    }
+
+    /// `-1`.
+    pub fn minus_one(&self) -> Place {
+        (Base::Pool, bytes(self.pool.len() - 1))
+    }
+}

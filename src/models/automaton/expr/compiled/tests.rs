@@ -1,0 +1,152 @@
+//! The compiled series against the interpreter's, bit for bit, and against
+//! closed forms.
+
+use super::*;
+use crate::models::automaton::expr::parse::parse;
+use crate::models::automaton::expr::recurrences::Series;
+use crate::models::automaton::expr::tape::Scope;
+
+fn tape(texts: &[&str], inputs: &[&str]) -> Tape {
+    let scope = Scope {
+        inputs: inputs.iter().map(|s| s.to_string()).collect(),
+        constants: vec![("c".into(), 0.3)],
+    };
+    let asts: Vec<_> = texts.iter().map(|t| parse(t).unwrap()).collect();
+    Tape::compile(&asts.iter().collect::<Vec<_>>(), &scope).unwrap()
+}
+
+/// Both series of `texts` from `x0`, bit for bit, at a few orders.
+fn same_as_interpreted(texts: &[&str], inputs: &[&str], x0: &[f64]) {
+    let t = tape(texts, inputs);
+    for order in [1, 2, 7, 20, 33] {
+        let w = order + 1;
+        let mut interpreted = vec![0.0; x0.len() * w];
+        Series::default().flow(&t, x0, order, &mut interpreted);
+        let compiled = CompiledFlow::new(&t, order);
+        if !cfg!(target_arch = "x86_64") {
+            assert!(compiled.is_none());
+            return;
+        }
+        let compiled = compiled.unwrap_or_else(|| panic!("{texts:?} does not compile"));
+        let mut out = vec![f64::NAN; x0.len() * w];
+        compiled.flow(x0, &mut out);
+        for (k, (a, b)) in interpreted.iter().zip(&out).enumerate() {
+            assert_eq!(
+                a.to_bits(),
+                b.to_bits(),
+                "{texts:?} at order {order}: coefficient {} of component {}: {a:e} interpreted, {b:e} compiled",
+                k % w,
+                k / w
+            );
+        }
+    }
+}
+
+#[test]
+fn every_compiled_instruction_gives_the_interpreters_bits() {
+    let xy = ["x", "y"];
+    let state = [0.7, -0.4];
+    // Sums, a negation, constants on either side, products, quotients.
+    same_as_interpreted(&["y", "-x - 2 * x * y"], &xy, &state);
+    same_as_interpreted(&["x * c + y", "c * y - x / 3"], &xy, &state);
+    same_as_interpreted(&["x / (1 + y^2)", "(x - y) / (2 + x)"], &xy, &state);
+    same_as_interpreted(&["1 / (3 + x)", "-y"], &xy, &state);
+    // Functions, with their helper series.
+    same_as_interpreted(&["y", "-sin(x)"], &xy, &state);
+    same_as_interpreted(&["cos(x + y)", "sin(2 * x) * cos(y)"], &xy, &state);
+    same_as_interpreted(&["sinh(x) - y", "cosh(y) * x"], &xy, &state);
+    same_as_interpreted(&["exp(-x) * y", "-exp(x * y)"], &xy, &state);
+    // A rate that is an input, or a constant (a clock), or the same
+    // register as another's.
+    same_as_interpreted(&["y", "x", "1"], &["x", "y", "t"], &[0.2, 0.1, 5.0]);
+    same_as_interpreted(&["x * y", "x * y"], &xy, &state);
+    // A forced oscillator: the clock inside a function.
+    same_as_interpreted(
+        &["v", "-x - 0.1 * v + 0.5 * cos(1.3 * t)", "1"],
+        &["x", "v", "t"],
+        &[0.3, 0.0, 12.5],
+    );
+}
+
+/// x' = v, v' = -x from (1, 0): x = cos t, v = -sin t, by the compiled
+/// series alone.
+#[test]
+fn the_compiled_oscillator_expands_to_cosine_and_sine() {
+    if !cfg!(target_arch = "x86_64") {
+        return;
+    }
+    let order = 20;
+    let flow = CompiledFlow::new(&tape(&["v", "-x"], &["x", "v"]), order).unwrap();
+    let mut out = vec![0.0; 2 * (order + 1)];
+    flow.flow(&[1.0, 0.0], &mut out);
+    let factorial = |k: usize| (1..=k).map(|i| i as f64).product::<f64>();
+    for k in 0..=order {
+        let (cos, minus_sin) = match k % 4 {
+            0 => (1.0, 0.0),
+            1 => (0.0, -1.0),
+            2 => (-1.0, 0.0),
+            _ => (0.0, 1.0),
+        };
+        assert!(
+            (out[k] - cos / factorial(k)).abs() <= 1e-15 / factorial(k),
+            "x_{k}"
+        );
+        assert!(
+            (out[order + 1 + k] - minus_sin / factorial(k)).abs() <= 1e-15 / factorial(k),
+            "v_{k}"
+        );
+    }
+}
+
+#[test]
+fn what_does_not_compile_is_left_to_the_interpreter() {
+    let xy = ["x", "y"];
+    for texts in [
+        ["x^1.5", "y"],
+        ["tan(x)", "y"],
+        ["atan2(y, x)", "x"],
+        ["sqrt(x)", "y"],
+    ] {
+        assert!(
+            CompiledFlow::new(&tape(&texts, &xy), 10).is_none(),
+            "{texts:?}"
+        );
+    }
+    // No order 0 (a flow's series has at least its rate) or past the
+    // largest.
+    let t = tape(&["y", "-x"], &xy);
+    assert!(CompiledFlow::new(&t, 0).is_none());
+    assert!(CompiledFlow::new(&t, MAX_ORDER + 1).is_none());
+    // The cache answers the same for a tape it cannot compile.
+    let flows = CompiledFlows::default();
+    assert!(flows.get(&tape(&["tan(x)", "y"], &xy), 10).is_none());
+}
+
+/// Threads of a sweep share one compiled flow, each with its own scratch.
+#[test]
+fn threads_share_a_compiled_flow() {
+    if !cfg!(target_arch = "x86_64") {
+        return;
+    }
+    let t = tape(&["y", "-x - 2 * x * y"], &["x", "y"]);
+    let flows = CompiledFlows::default();
+    let order = 12;
+    let expected = |x: f64| {
+        let mut out = vec![0.0; 2 * (order + 1)];
+        Series::default().flow(&t, &[x, 0.1], order, &mut out);
+        out
+    };
+    std::thread::scope(|s| {
+        for i in 0..4 {
+            let (flows, t) = (&flows, &t);
+            s.spawn(move || {
+                let x = 0.1 * i as f64;
+                let mut out = vec![0.0; 2 * (order + 1)];
+                for _ in 0..100 {
+                    flows.get(t, order).unwrap().flow(&[x, 0.1], &mut out);
+                }
+                assert_eq!(out, expected(x));
+            });
+        }
+    });
+}
