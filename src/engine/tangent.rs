@@ -10,7 +10,7 @@
 //!
 //! [`ErrorSet`]: crate::engine::error_set::ErrorSet
 
-use crate::engine::error_set::{TRACKED, unrolled};
+use crate::engine::error_set::TRACKED;
 use crate::engine::model::{Flow, HybridModel, Mode};
 use crate::engine::saltation;
 use crate::numerics::central_difference::step_for;
@@ -30,7 +30,6 @@ pub struct Tangents {
     up: Vec<f64>,
     down: Vec<f64>,
     a: Vec<f64>,
-    b: Vec<f64>,
     c: Vec<f64>,
     d: Vec<f64>,
     e: Vec<f64>,
@@ -63,7 +62,6 @@ impl Tangents {
             // Matrices only where errors are tracked (a long chain as an
             // ODE would hold gigabytes it never uses).
             a: vec![0.0; if n <= TRACKED { n * n } else { 0 }],
-            b: vec![0.0; if n <= TRACKED { EXP_SCRATCH * n * n } else { 0 }],
             c: vec![0.0; if n <= TRACKED { n * n } else { 0 }],
             d: vec![0.0; if n <= TRACKED { n * n } else { 0 }],
             e: vec![0.0; if n <= TRACKED { n * n } else { 0 }],
@@ -127,7 +125,6 @@ impl Tangents {
     ) {
         let n = self.n;
         let mut first = std::mem::take(&mut self.a);
-        let mut second = std::mem::take(&mut self.b);
         let mut x = std::mem::take(&mut self.c);
         if self.linear_part(model, mode).is_some() {
             // A linear flow: the tangent is exp(tau A), no states needed.
@@ -135,7 +132,7 @@ impl Tangents {
                 && *known == tau
             {
                 out.copy_from_slice(tangent);
-                (self.a, self.b, self.c) = (first, second, x);
+                (self.a, self.c) = (first, x);
                 return;
             }
             if let Some((_, Some(a))) = &self.linear {
@@ -144,7 +141,7 @@ impl Tangents {
                 }
             }
             without_clock(n, model.clock(), &mut x);
-            exp(n, &x, out, &mut second);
+            exp(n, &x, out);
             match &mut self.linear_tangent {
                 Some((known, tangent)) => {
                     *known = tau;
@@ -179,7 +176,7 @@ impl Tangents {
                     *o = tau * j;
                 }
                 without_clock(n, model.clock(), &mut x);
-                exp(n, &x, out, &mut second);
+                exp(n, &x, out);
             } else {
                 let mut piece = std::mem::take(&mut self.d);
                 let mut product = std::mem::take(&mut self.e);
@@ -191,7 +188,7 @@ impl Tangents {
                         *o = h * j;
                     }
                     without_clock(n, model.clock(), &mut x);
-                    exp(n, &x, &mut piece, &mut second);
+                    exp(n, &x, &mut piece);
                     if k == 0 {
                         out.copy_from_slice(&piece);
                     } else {
@@ -205,7 +202,6 @@ impl Tangents {
             }
         }
         self.a = first;
-        self.b = second;
         self.c = x;
     }
 
@@ -357,7 +353,7 @@ fn without_clock(n: usize, clock: Option<usize>, a: &mut [f64]) {
 /// approximant on `a / 2^s` with `|a / 2^s| <= 1/4`, then `s` squarings
 /// (scaling and squaring as Higham 2005, with the one degree a
 /// linearisation's short pieces need: about four products and a solve).
-fn exp(n: usize, a: &[f64], out: &mut [f64], scratch: &mut [f64]) {
+fn exp(n: usize, a: &[f64], out: &mut [f64]) {
     if n == 2 {
         return exp2(a, out);
     }
@@ -380,7 +376,7 @@ fn exp(n: usize, a: &[f64], out: &mut [f64], scratch: &mut [f64]) {
             }
         }
         let mut result = [0.0; TRACKED * TRACKED];
-        exp_dense(k, &small[..k * k], &mut result[..k * k], scratch);
+        exp_dense(k, &small[..k * k], &mut result[..k * k]);
         out.fill(0.0);
         for i in 0..n {
             out[i * n + i] = 1.0;
@@ -392,34 +388,39 @@ fn exp(n: usize, a: &[f64], out: &mut [f64], scratch: &mut [f64]) {
         }
         return;
     }
-    exp_dense(n, a, out, scratch)
+    exp_dense(n, a, out)
 }
 
 /// [`exp`] without looking for decoupled components.
-fn exp_dense(n: usize, a: &[f64], out: &mut [f64], scratch: &mut [f64]) {
+fn exp_dense(n: usize, a: &[f64], out: &mut [f64]) {
     match n {
         0 => {}
         1 => out[0] = a[0].exp(),
         2 => exp2(a, out),
-        // A Taylor step takes several of these.
-        n => unrolled(
-            n,
-            #[inline(always)]
-            |n| exp_sized(n, a, out, scratch),
-        ),
+        // A Taylor step takes several of these: each size its own code,
+        // with loops of constant length on the stack.
+        3 => exp_sized::<3>(a, out),
+        4 => exp_sized::<4>(a, out),
+        5 => exp_sized::<5>(a, out),
+        6 => exp_sized::<6>(a, out),
+        7 => exp_sized::<7>(a, out),
+        8 => exp_sized::<8>(a, out),
+        // No tangent is taken past TRACKED states (no error set is kept
+        // there): were one asked for, its bound would be infinite.
+        _ => out.fill(f64::NAN),
     }
 }
 
-/// Scratch matrices [`exp`] needs.
-const EXP_SCRATCH: usize = 4;
+/// An `N x N` matrix.
+type Square<const N: usize> = [[f64; N]; N];
 
-#[inline(always)]
-fn exp_sized(n: usize, a: &[f64], out: &mut [f64], scratch: &mut [f64]) {
-    let size = n * n;
-    let (x, rest) = scratch[..EXP_SCRATCH * size].split_at_mut(size);
-    let (x2, rest) = rest.split_at_mut(size);
-    let (term, next) = rest.split_at_mut(size);
-    let norm = row_norm(n, a);
+/// The row-major `a` as a [`Square`].
+fn square<const N: usize>(a: &[f64]) -> Square<N> {
+    std::array::from_fn(|i| std::array::from_fn(|j| a[i * N + j]))
+}
+
+fn exp_sized<const N: usize>(a: &[f64], out: &mut [f64]) {
+    let norm = row_norm(N, a);
     if !norm.is_finite() {
         // No exponential to take: the bound that uses it becomes infinite.
         out.fill(f64::NAN);
@@ -435,31 +436,29 @@ fn exp_sized(n: usize, a: &[f64], out: &mut [f64], scratch: &mut [f64]) {
     let scale = 0.5f64.powi(squarings);
     // exp(x) ~ (V(x) - U(x))^-1 (V(x) + U(x)), U odd, V even.
     const B: [f64; 6] = [30240.0, 15120.0, 3360.0, 420.0, 30.0, 1.0];
-    for (s, a) in x.iter_mut().zip(a) {
-        *s = scale * a;
-    }
-    mat_mul(n, x, x, x2);
-    // x^4 into out (spent below).
-    mat_mul(n, x2, x2, out);
+    let x = square::<N>(a).map(|row| row.map(|a| scale * a));
+    let x2 = product(&x, &x);
+    let x4 = product(&x2, &x2);
     // term = B5 x^4 + B3 x^2 + B1 I, next = B4 x^4 + B2 x^2 + B0 I.
-    for k in 0..size {
-        term[k] = B[5] * out[k] + B[3] * x2[k];
-        next[k] = B[4] * out[k] + B[2] * x2[k];
-    }
-    for i in 0..n {
-        term[i * n + i] += B[1];
-        next[i * n + i] += B[0];
-    }
-    // U = x term, into x2 (spent); then V - U into term, V + U into out.
-    mat_mul(n, x, term, x2);
-    for k in 0..size {
-        term[k] = next[k] - x2[k];
-        out[k] = next[k] + x2[k];
-    }
-    solve_in_place(n, term, out);
+    let even = |b4: f64, b2: f64, b0: f64| -> Square<N> {
+        std::array::from_fn(|i| {
+            std::array::from_fn(|j| {
+                let sum = b4 * x4[i][j] + b2 * x2[i][j];
+                if i == j { sum + b0 } else { sum }
+            })
+        })
+    };
+    let (term, next) = (even(B[5], B[3], B[1]), even(B[4], B[2], B[0]));
+    let u = product(&x, &term);
+    let mut denominator: Square<N> =
+        std::array::from_fn(|i| std::array::from_fn(|j| next[i][j] - u[i][j]));
+    let mut e: Square<N> = std::array::from_fn(|i| std::array::from_fn(|j| next[i][j] + u[i][j]));
+    solve_in_place(&mut denominator, &mut e);
     for _ in 0..squarings {
-        mat_mul(n, out, out, next);
-        out.copy_from_slice(next);
+        e = product(&e, &e);
+    }
+    for (o, row) in out.chunks_exact_mut(N).zip(&e) {
+        o.copy_from_slice(row);
     }
 }
 
@@ -467,43 +466,56 @@ fn exp_sized(n: usize, a: &[f64], out: &mut [f64], scratch: &mut [f64]) {
 /// round-off.
 const PADE_5_REACH: f64 = 0.25;
 
-/// `b = a^-1 b` for row-major `n x n` matrices by Gaussian elimination
-/// with partial pivoting (`a` is overwritten). Pade's denominator is close
-/// to the identity's multiple, so pivots never vanish for the norms it
-/// is asked at.
-#[inline(always)]
-fn solve_in_place(n: usize, a: &mut [f64], b: &mut [f64]) {
-    for col in 0..n {
-        let pivot = (col..n)
-            .max_by(|&i, &j| a[i * n + col].abs().total_cmp(&a[j * n + col].abs()))
-            .unwrap_or(col);
+/// `b = a^-1 b` by Gaussian elimination with partial pivoting (`a` is
+/// overwritten). Pade's denominator is close to the identity's multiple,
+/// so pivots never vanish for the norms it is asked at.
+fn solve_in_place<const N: usize>(a: &mut Square<N>, b: &mut Square<N>) {
+    for col in 0..N {
+        // The largest pivot, the last of equals.
+        let mut pivot = col;
+        for row in col + 1..N {
+            if a[row][col].abs().total_cmp(&a[pivot][col].abs()).is_ge() {
+                pivot = row;
+            }
+        }
         if pivot != col {
-            for k in 0..n {
-                a.swap(col * n + k, pivot * n + k);
-                b.swap(col * n + k, pivot * n + k);
-            }
+            a.swap(col, pivot);
+            b.swap(col, pivot);
         }
-        let p = a[col * n + col];
-        for row in col + 1..n {
-            let f = a[row * n + col] / p;
-            for k in col..n {
-                a[row * n + k] -= f * a[col * n + k];
+        let p = a[col][col];
+        for row in col + 1..N {
+            let f = a[row][col] / p;
+            for k in col..N {
+                a[row][k] -= f * a[col][k];
             }
-            for k in 0..n {
-                b[row * n + k] -= f * b[col * n + k];
+            for k in 0..N {
+                b[row][k] -= f * b[col][k];
             }
         }
     }
-    for col in (0..n).rev() {
-        let p = a[col * n + col];
-        for k in 0..n {
-            let mut v = b[col * n + k];
-            for j in col + 1..n {
-                v -= a[col * n + j] * b[j * n + k];
+    for col in (0..N).rev() {
+        let p = a[col][col];
+        for k in 0..N {
+            let mut v = b[col][k];
+            for j in col + 1..N {
+                v -= a[col][j] * b[j][k];
             }
-            b[col * n + k] = v / p;
+            b[col][k] = v / p;
         }
     }
+}
+
+/// `a b`, each entry summed over `l` in increasing order.
+fn product<const N: usize>(a: &Square<N>, b: &Square<N>) -> Square<N> {
+    std::array::from_fn(|i| {
+        std::array::from_fn(|j| {
+            let mut sum = a[i][0] * b[0][j];
+            for l in 1..N {
+                sum += a[i][l] * b[l][j];
+            }
+            sum
+        })
+    })
 }
 
 /// `out = a b` of row-major `n x n` matrices, each entry summed over `l`
@@ -525,15 +537,9 @@ fn mat_mul(n: usize, a: &[f64], b: &[f64], out: &mut [f64]) {
 }
 
 fn mat_mul_fixed<const N: usize>(a: &[f64], b: &[f64], out: &mut [f64]) {
-    let (a, b, out) = (&a[..N * N], &b[..N * N], &mut out[..N * N]);
-    for i in 0..N {
-        for j in 0..N {
-            let mut sum = a[i * N] * b[j];
-            for l in 1..N {
-                sum += a[i * N + l] * b[l * N + j];
-            }
-            out[i * N + j] = sum;
-        }
+    let p = product::<N>(&square(a), &square(b));
+    for (o, row) in out.chunks_exact_mut(N).zip(&p) {
+        o.copy_from_slice(row);
     }
 }
 
@@ -576,7 +582,7 @@ mod tests {
             exp2(&a, &mut closed);
             let big = [a[0], a[1], 0.0, a[2], a[3], 0.0, 0.0, 0.0, 0.0];
             let mut series = [0.0; 9];
-            exp(3, &big, &mut series, &mut [0.0; EXP_SCRATCH * 9]);
+            exp(3, &big, &mut series);
             for (c, s) in closed
                 .iter()
                 .zip([series[0], series[1], series[3], series[4]])
@@ -604,7 +610,7 @@ mod tests {
                 0.0, 0.0, 0.0, g,
             ];
             let mut out = [0.0; 16];
-            exp(4, &a, &mut out, &mut [0.0; EXP_SCRATCH * 16]);
+            exp(4, &a, &mut out);
             let (c, s, e) = (w.cos(), w.sin(), f64::exp(g));
             #[rustfmt::skip]
             let want = [
@@ -624,11 +630,48 @@ mod tests {
         }
     }
 
+    /// Every size up to TRACKED: a rotation by `w` beside a Jordan block
+    /// `g I + S` (`S` the shift), whose exponential is `e^g / (j - i)!`
+    /// above the diagonal.
+    #[test]
+    fn exp_of_a_rotation_beside_a_jordan_block_is_its_closed_form_at_every_size() {
+        let (w, g) = (0.7, 0.1);
+        for n in 3..=TRACKED {
+            let mut a = vec![0.0; n * n];
+            (a[1], a[n]) = (-w, w);
+            for i in 2..n {
+                a[i * n + i] = g;
+                if i + 1 < n {
+                    a[i * n + i + 1] = 1.0;
+                }
+            }
+            let mut out = vec![0.0; n * n];
+            exp(n, &a, &mut out);
+            let factorial = |k: usize| (1..=k).map(|i| i as f64).product::<f64>();
+            for i in 0..n {
+                for j in 0..n {
+                    let want = match (i, j) {
+                        (0, 0) | (1, 1) => w.cos(),
+                        (0, 1) => -w.sin(),
+                        (1, 0) => w.sin(),
+                        _ if i >= 2 && j >= i => g.exp() / factorial(j - i),
+                        _ => 0.0,
+                    };
+                    let got = out[i * n + j];
+                    assert!(
+                        (got - want).abs() < 1e-14,
+                        "n {n}, entry ({i}, {j}): {got} vs {want}"
+                    );
+                }
+            }
+        }
+    }
+
     #[test]
     fn exp_of_a_rotation_generator_is_the_rotation() {
         for angle in [0.0, 0.3, 2.0, 40.0] {
             let mut out = [0.0; 4];
-            exp(2, &[0.0, -angle, angle, 0.0], &mut out, &mut []);
+            exp(2, &[0.0, -angle, angle, 0.0], &mut out);
             let (c, s) = (f64::cos(angle), f64::sin(angle));
             for (got, want) in out.iter().zip([c, -s, s, c]) {
                 assert!(
