@@ -18,7 +18,7 @@ use nalgebra::{DMatrix, DVector};
 
 use crate::engine::{Flow, Guard, HybridModel, Jump, Mode, Name};
 use crate::models::automaton::definition::{Definition, Source};
-use crate::models::automaton::expr::compiled::CompiledFlows;
+use crate::models::automaton::expr::compiled::{CompiledFlows, CompiledTape};
 use crate::models::automaton::expr::derivative::{jacobian, jacobian_into, jacobian_tape};
 use crate::models::automaton::expr::recurrences::Series;
 use crate::models::automaton::expr::{Ast, Scope, Tape};
@@ -51,9 +51,9 @@ struct CompiledMode {
     name: String,
     /// The rate of every state component.
     flow: Tape,
-    /// Its Taylor series as machine code, where it compiles (shared by the
-    /// copies of the model a sweep's threads hold).
-    series_code: Arc<CompiledFlows>,
+    /// Its tapes as machine code, compiled as they are first asked for
+    /// (shared by the copies of the model a sweep's threads hold).
+    code: Arc<ModeCode>,
     /// Its Jacobian's entries, row-major, where compiled (a smooth flow).
     flow_jacobian: Option<Tape>,
     /// The text of each state's rate, for diagnoses.
@@ -73,6 +73,20 @@ struct CompiledMode {
     /// name), if it does: no Taylor series there. `None`: they hold over
     /// a whole step.
     rough: Option<String>,
+}
+
+/// A mode's tapes compiled (see [`crate::models::automaton::expr::compiled`]),
+/// each the first time a run asks for it.
+#[derive(Debug, Default)]
+struct ModeCode {
+    /// The flow's Taylor series, per order.
+    series: CompiledFlows,
+    /// The flow's rates.
+    rates: CompiledTape,
+    /// The flow's Jacobian, where it has a tape.
+    jacobian: CompiledTape,
+    /// Each guard's value.
+    guards: Vec<CompiledTape>,
 }
 
 #[derive(Debug, Clone)]
@@ -324,7 +338,13 @@ impl Automaton {
                 rough,
                 name: mode.name.clone(),
                 flow,
-                series_code: Arc::default(),
+                code: Arc::new(ModeCode {
+                    guards: guard_tapes
+                        .iter()
+                        .map(|_| CompiledTape::default())
+                        .collect(),
+                    ..ModeCode::default()
+                }),
                 flow_jacobian,
                 rates: mode.flow.clone(),
                 guards,
@@ -458,7 +478,10 @@ impl HybridModel for Automaton {
 
     #[inline]
     fn guard(&self, mode: Mode, guard: usize, x: &[f64]) -> f64 {
-        self.modes[mode].guard_tapes[guard].eval1(x)
+        let m = &self.modes[mode];
+        let mut value = [0.0];
+        m.code.guards[guard].eval(&m.guard_tapes[guard], x, &mut value);
+        value[0]
     }
 
     fn flow(&self, mode: Mode) -> Flow {
@@ -467,7 +490,8 @@ impl HybridModel for Automaton {
 
     #[inline]
     fn rhs(&self, mode: Mode, x: &[f64], dx: &mut [f64]) {
-        self.modes[mode].flow.eval_scratch(x, dx);
+        let m = &self.modes[mode];
+        m.code.rates.eval(&m.flow, x, dx);
     }
 
     fn has_rhs(&self, _: Mode) -> bool {
@@ -478,7 +502,7 @@ impl HybridModel for Automaton {
     fn jacobian(&self, mode: Mode, x: &[f64], jac: &mut [f64]) -> bool {
         let m = &self.modes[mode];
         match &m.flow_jacobian {
-            Some(tape) => tape.eval_scratch(x, jac),
+            Some(tape) => m.code.jacobian.eval(tape, x, jac),
             None => jacobian_into(&m.flow, x, jac),
         }
         true
@@ -536,7 +560,7 @@ impl HybridModel for Automaton {
 
     fn flow_series(&self, mode: Mode, x: &[f64], order: usize, series: &mut [f64]) {
         let m = &self.modes[mode];
-        match m.series_code.get(&m.flow, order) {
+        match m.code.series.get(&m.flow, order) {
             Some(code) => code.flow(x, series),
             None => SERIES.with_borrow_mut(|s| s.flow(&m.flow, x, order, series)),
         }

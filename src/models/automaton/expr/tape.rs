@@ -64,7 +64,7 @@ pub enum Fun2 {
     Hypot,
 }
 
-const FUNS: [(&str, Fun); 14] = [
+pub(crate) const FUNS: [(&str, Fun); 14] = [
     ("sin", Fun::Sin),
     ("cos", Fun::Cos),
     ("tan", Fun::Tan),
@@ -81,7 +81,7 @@ const FUNS: [(&str, Fun); 14] = [
     ("sign", Fun::Sign),
 ];
 
-const FUNS2: [(&str, Fun2); 4] = [
+pub(crate) const FUNS2: [(&str, Fun2); 4] = [
     ("atan2", Fun2::Atan2),
     ("min", Fun2::Min),
     ("max", Fun2::Max),

@@ -1,22 +1,25 @@
-//! Where a compiled series finds each coefficient: three buffers, each
-//! addressed from its own base register.
+//! Where compiled code finds each register's coefficients (a value is a
+//! series of one): three buffers, each addressed from its own base
+//! register.
 //!
-//! - the scratch: the main series of every computed register, then the
-//!   helper series (the partner `cos` of a `sin`), `width` coefficients
-//!   each, as the interpreter keeps them;
-//! - the output: the state's series, which the tape's inputs read in place
-//!   (the interpreter copies them into its registers order by order);
+//! - the work buffer: the main series of every computed register, then
+//!   the helper series (the partner `cos` of a `sin`), `width`
+//!   coefficients each, as the interpreter keeps them; an evaluation's
+//!   outputs after them;
+//! - the state: the inputs' series (a flow's, which its code writes
+//!   order by order) or values, read in place (the interpreter copies
+//!   them into its registers);
 //! - the pool, read only: each constant register's series (the constant,
-//!   then zeros), the integers up to `order + 1` that the recurrences
-//!   divide and weigh by, and `-1`.
+//!   then zeros), the integers up to `width` that the recurrences divide
+//!   and weigh by, and `-1`.
 
 use crate::models::automaton::expr::tape::{Op, Reg, Tape};
 
 /// One of the buffers the compiled code is given.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Base {
-    Scratch,
-    Out,
+    Work,
+    State,
     Pool,
 }
 
@@ -27,7 +30,7 @@ pub struct Layout {
     pub pool: Vec<f64>,
     /// Each register's series: its buffer and the index of its order 0.
     series: Vec<(Base, usize)>,
-    /// Where the helper series start in the scratch.
+    /// Where the helper series start in the work buffer.
     helpers: usize,
     /// Where the integers start in the pool.
     integers: usize,
@@ -50,8 +53,8 @@ impl Layout {
                     pool.resize(at + width, 0.0);
                     (Base::Pool, at)
                 }
-                Op::Input(i) => (Base::Out, i as usize * width),
-                _ => (Base::Scratch, r * width),
+                Op::Input(i) => (Base::State, i as usize * width),
+                _ => (Base::Work, r * width),
             })
             .collect();
         let integers = pool.len();
@@ -71,10 +74,21 @@ impl Layout {
         (base, bytes(start + k))
     }
 
-    /// Coefficient `k` of register `r`'s helper series.
+    /// Coefficient `k` of register `r`'s helper series (a computed
+    /// register's).
     pub fn helper(&self, r: Reg, k: usize) -> Place {
         let (_, start) = self.series[r as usize];
-        (Base::Scratch, bytes(self.helpers + start + k))
+        (Base::Work, bytes(self.helpers + start + k))
+    }
+
+    /// Where an evaluation leaves its output `i`.
+    pub fn output(&self, i: usize) -> Place {
+        (Base::Work, bytes(2 * self.helpers + i))
+    }
+
+    /// How long the work buffer is for `outputs` evaluated outputs.
+    pub fn work(&self, outputs: usize) -> usize {
+        2 * self.helpers + outputs
     }
 
     /// The integer `j` as a float.

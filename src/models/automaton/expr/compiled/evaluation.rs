@@ -1,0 +1,199 @@
+//! A tape's evaluation compiled: each instruction's value in turn, as
+//! [`Op::value`] takes it, arithmetic in place and every function,
+//! power and two-argument function by a call to the same Rust the
+//! interpreter calls. Every tape compiles (on x86-64); the values are the
+//! interpreter's bit for bit.
+
+use std::cell::RefCell;
+use std::sync::OnceLock;
+
+use crate::models::automaton::expr::compiled::layout::Layout;
+use crate::models::automaton::expr::compiled::machine::Code;
+use crate::models::automaton::expr::tape::{Op, Tape};
+
+/// A tape's evaluation, compiled the first time it is asked for. It
+/// belongs to one tape: the one each [`CompiledTape::eval`] is given.
+#[derive(Debug, Default)]
+pub struct CompiledTape {
+    code: OnceLock<Option<Evaluation>>,
+}
+
+thread_local! {
+    /// The registers' values (models are shared, read only, between the
+    /// threads of a sweep).
+    static WORK: RefCell<Vec<f64>> = const { RefCell::new(Vec::new()) };
+}
+
+impl CompiledTape {
+    /// The outputs of `tape` (always this cache's) at `inputs`, into
+    /// `out`: compiled where it can be, else by the interpreter.
+    #[inline]
+    pub fn eval(&self, tape: &Tape, inputs: &[f64], out: &mut [f64]) {
+        match self.code.get_or_init(|| Evaluation::new(tape)) {
+            Some(code) => code.eval(inputs, out),
+            None => tape.eval_scratch(inputs, out),
+        }
+    }
+
+    /// Whether the tape was compiled (not left to the interpreter).
+    #[cfg(test)]
+    pub fn compiled(&self) -> bool {
+        matches!(self.code.get(), Some(Some(_)))
+    }
+}
+
+/// The most instructions a compiled evaluation holds.
+const MAX_INSTRUCTIONS: usize = 1_000_000;
+
+struct Evaluation {
+    code: Code,
+    pool: Box<[f64]>,
+    /// How many inputs the tape reads (one past the largest read).
+    inputs: usize,
+    outputs: usize,
+    /// The work buffer's length, its outputs at the end.
+    work: usize,
+}
+
+impl std::fmt::Debug for Evaluation {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Evaluation")
+            .field("outputs", &self.outputs)
+            .field("code_bytes", &self.code.len())
+            .finish()
+    }
+}
+
+impl Evaluation {
+    fn new(tape: &Tape) -> Option<Evaluation> {
+        if tape.ops.len() > MAX_INSTRUCTIONS {
+            return None;
+        }
+        let layout = Layout::new(tape, 1);
+        let code = lower(tape, &layout)?;
+        let inputs = tape
+            .ops
+            .iter()
+            .filter_map(|op| match op {
+                Op::Input(i) => Some(*i as usize + 1),
+                _ => None,
+            })
+            .max()
+            .unwrap_or(0);
+        Some(Evaluation {
+            code,
+            inputs,
+            outputs: tape.outputs.len(),
+            work: layout.work(tape.outputs.len()),
+            pool: layout.pool.into_boxed_slice(),
+        })
+    }
+
+    fn eval(&self, inputs: &[f64], out: &mut [f64]) {
+        assert!(
+            inputs.len() >= self.inputs,
+            "a compiled tape reading {} inputs was given {}",
+            self.inputs,
+            inputs.len()
+        );
+        WORK.with_borrow_mut(|work| {
+            if work.len() < self.work {
+                work.resize(self.work, 0.0);
+            }
+            // The code reads `inputs[..self.inputs]` and `pool`, and
+            // writes `work[..self.work]`, at places fixed when it was
+            // compiled; the lengths were checked above. It writes no input.
+            self.code.run(
+                work.as_mut_ptr(),
+                inputs.as_ptr().cast_mut(),
+                self.pool.as_ptr(),
+            );
+            let results = &work[self.work - self.outputs..self.work];
+            for (o, r) in out.iter_mut().zip(results) {
+                *o = *r;
+            }
+        });
+    }
+}
+
+#[cfg(not(target_arch = "x86_64"))]
+fn lower(_: &Tape, _: &Layout) -> Option<Code> {
+    None
+}
+
+/// `f(a)`, `f` the `kind`-th of the tape's functions of one argument.
+#[cfg(target_arch = "x86_64")]
+extern "sysv64" fn call(kind: u32, a: f64, _: *mut f64, _: *mut f64) -> f64 {
+    use crate::models::automaton::expr::tape::FUNS;
+    FUNS[kind as usize].1.apply(a)
+}
+
+/// `f(a, b)`, `f` the `kind`-th of the tape's functions of two.
+#[cfg(target_arch = "x86_64")]
+extern "sysv64" fn call2(kind: u32, a: f64, b: f64, _: *mut f64, _: *mut f64) -> f64 {
+    use crate::models::automaton::expr::tape::FUNS2;
+    FUNS2[kind as usize].1.apply(a, b)
+}
+
+/// `a^b`.
+#[cfg(target_arch = "x86_64")]
+extern "sysv64" fn pow(_: u32, a: f64, b: f64, _: *mut f64, _: *mut f64) -> f64 {
+    a.powf(b)
+}
+
+#[cfg(target_arch = "x86_64")]
+fn lower(tape: &Tape, layout: &Layout) -> Option<Code> {
+    use crate::models::automaton::expr::compiled::machine::Emitter;
+    use crate::models::automaton::expr::tape::{FUNS, FUNS2};
+
+    let mut e = Emitter::new()?;
+    let anywhere = layout.output(0);
+    for (r, &op) in tape.ops.iter().enumerate() {
+        let r = r as u32;
+        match op {
+            Op::Const(_) | Op::Input(_) => continue,
+            Op::Add(a, b) => {
+                e.load(0, layout.at(a, 0));
+                e.add(0, layout.at(b, 0));
+            }
+            Op::Sub(a, b) => {
+                e.load(0, layout.at(a, 0));
+                e.sub(0, layout.at(b, 0));
+            }
+            Op::Mul(a, b) => {
+                e.load(0, layout.at(a, 0));
+                e.mul(0, layout.at(b, 0));
+            }
+            Op::Div(a, b) => {
+                e.load(0, layout.at(a, 0));
+                e.div(0, layout.at(b, 0));
+            }
+            Op::Neg(a) => {
+                e.load(0, layout.at(a, 0));
+                e.negate(0);
+            }
+            Op::Pow(a, b) => {
+                e.load(0, layout.at(a, 0));
+                e.load(1, layout.at(b, 0));
+                e.call(pow as *const (), 0, anywhere, anywhere);
+            }
+            Op::Call(f, a) => {
+                let kind = FUNS.iter().position(|&(_, g)| g == f)?;
+                e.load(0, layout.at(a, 0));
+                e.call(call as *const (), kind as u32, anywhere, anywhere);
+            }
+            Op::Call2(f, a, b) => {
+                let kind = FUNS2.iter().position(|&(_, g)| g == f)?;
+                e.load(0, layout.at(a, 0));
+                e.load(1, layout.at(b, 0));
+                e.call(call2 as *const (), kind as u32, anywhere, anywhere);
+            }
+        }
+        e.store(layout.at(r, 0), 0);
+    }
+    for (i, &o) in tape.outputs.iter().enumerate() {
+        e.load(0, layout.at(o, 0));
+        e.store(layout.output(i), 0);
+    }
+    e.finish()
+}

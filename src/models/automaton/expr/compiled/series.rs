@@ -1,0 +1,310 @@
+//! A flow's Taylor series compiled, as heyoka compiles its decomposition:
+//! the recurrences of [`Series::flow`] for one tape and one order,
+//! unrolled (every order, every term of every Cauchy sum), each operand at
+//! a fixed place.
+//!
+//! Tapes of sums, products, quotients, `sin`, `cos`, `sinh`, `cosh` and
+//! `exp` compile; a tape with anything else, or a very large one, keeps
+//! the interpreter. A function's value at the series' origin is taken by
+//! calling Rust's own (the interpreter's), its higher orders by its
+//! recurrence.
+//!
+//! [`Series::flow`]: crate::models::automaton::expr::recurrences::Series::flow
+
+use std::cell::RefCell;
+use std::sync::OnceLock;
+
+use crate::engine::taylor_method::MAX_ORDER;
+use crate::models::automaton::expr::compiled::layout::Layout;
+use crate::models::automaton::expr::compiled::machine::Code;
+use crate::models::automaton::expr::tape::{Op, Tape};
+
+/// A flow's series at each order, compiled the first time it is asked for
+/// (a run asks for one order; a sweep over tolerances, for a few).
+#[derive(Debug)]
+pub struct CompiledFlows {
+    by_order: Box<[OnceLock<Option<CompiledFlow>>]>,
+}
+
+impl Default for CompiledFlows {
+    fn default() -> Self {
+        CompiledFlows {
+            by_order: (0..=MAX_ORDER).map(|_| OnceLock::new()).collect(),
+        }
+    }
+}
+
+impl CompiledFlows {
+    /// The compiled series of `tape` (the flow this cache belongs to) at
+    /// `order`, if it compiles.
+    #[inline]
+    pub fn get(&self, tape: &Tape, order: usize) -> Option<&CompiledFlow> {
+        self.by_order
+            .get(order)?
+            .get_or_init(|| CompiledFlow::new(tape, order))
+            .as_ref()
+    }
+}
+
+thread_local! {
+    /// The registers' coefficients (models are shared, read only, between
+    /// the threads of a sweep).
+    static WORK: RefCell<Vec<f64>> = const { RefCell::new(Vec::new()) };
+}
+
+/// The series of one flow at one order, as machine code.
+pub struct CompiledFlow {
+    code: Code,
+    /// Constants the code reads (see [`Layout`]).
+    pool: Box<[f64]>,
+    /// Coefficients kept per register and state component (`order + 1`).
+    width: usize,
+    /// State components (the tape's outputs).
+    states: usize,
+    /// The work buffer's length.
+    work: usize,
+}
+
+impl std::fmt::Debug for CompiledFlow {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("CompiledFlow")
+            .field("order", &(self.width - 1))
+            .field("states", &self.states)
+            .field("code_bytes", &self.code.len())
+            .finish()
+    }
+}
+
+/// The most terms (coefficient operations) a compiled series may hold:
+/// about 25 bytes of code each, so 100 MB at most.
+const MAX_TERMS: usize = 4_000_000;
+
+impl CompiledFlow {
+    /// Compile the series of the flow `x' = tape(x)` at `order` (see
+    /// [`Series::flow`]); `None` where the tape, its size or the processor
+    /// is not one this compiles.
+    ///
+    /// [`Series::flow`]: crate::models::automaton::expr::recurrences::Series::flow
+    pub fn new(tape: &Tape, order: usize) -> Option<CompiledFlow> {
+        let states = tape.outputs.len();
+        let inputs_in_range = tape.ops.iter().all(|op| match op {
+            Op::Input(i) => (*i as usize) < states,
+            _ => true,
+        });
+        if order == 0 || order > MAX_ORDER || !inputs_in_range || terms(tape, order) > MAX_TERMS {
+            return None;
+        }
+        let width = order + 1;
+        let layout = Layout::new(tape, width);
+        let code = lower(tape, &layout, order)?;
+        Some(CompiledFlow {
+            code,
+            work: layout.work(0),
+            pool: layout.pool.into_boxed_slice(),
+            width,
+            states,
+        })
+    }
+
+    /// The series from `x0` into `out`, laid out as [`Series::flow`]
+    /// writes it (`out[i * (order + 1) + k]`).
+    ///
+    /// [`Series::flow`]: crate::models::automaton::expr::recurrences::Series::flow
+    pub fn flow(&self, x0: &[f64], out: &mut [f64]) {
+        let w = self.width;
+        assert!(
+            x0.len() == self.states && out.len() >= self.states * w,
+            "a compiled series of {} components was given {} initial values and room for {}",
+            self.states,
+            x0.len(),
+            out.len() / w
+        );
+        for (i, &x) in x0.iter().enumerate() {
+            out[i * w] = x;
+        }
+        WORK.with_borrow_mut(|work| {
+            if work.len() < self.work {
+                work.resize(self.work, 0.0);
+            }
+            // The code reads and writes `work[..self.work]`, `out[..states
+            // * width]` and `pool`, at places fixed when it was compiled
+            // from these sizes; the lengths were checked above.
+            self.code
+                .run(work.as_mut_ptr(), out.as_mut_ptr(), self.pool.as_ptr());
+        });
+    }
+}
+
+/// How many coefficient operations the series of `tape` at `order` takes
+/// (a product's order `k` is `k + 1`).
+fn terms(tape: &Tape, order: usize) -> usize {
+    tape.ops
+        .len()
+        .saturating_mul(order)
+        .saturating_mul(order + 1)
+}
+
+#[cfg(not(target_arch = "x86_64"))]
+fn lower(_: &Tape, _: &Layout, _: usize) -> Option<Code> {
+    None
+}
+
+/// The functions whose value the code asks Rust for at a series' origin.
+#[cfg(target_arch = "x86_64")]
+#[derive(Clone, Copy)]
+#[repr(u32)]
+enum Origin {
+    Sin,
+    Cos,
+    Sinh,
+    Cosh,
+    Exp,
+}
+
+/// A function's value at the origin (and its partner's: the `cos` of a
+/// `sin`), by the same calls as the interpreter's.
+#[cfg(target_arch = "x86_64")]
+extern "sysv64" fn origin(kind: u32, a: f64, value: *mut f64, partner: *mut f64) {
+    let (v, p) = match kind {
+        k if k == Origin::Sin as u32 => a.sin_cos(),
+        k if k == Origin::Cos as u32 => {
+            let (s, c) = a.sin_cos();
+            (c, s)
+        }
+        k if k == Origin::Sinh as u32 => (a.sinh(), a.cosh()),
+        k if k == Origin::Cosh as u32 => (a.cosh(), a.sinh()),
+        _ => (a.exp(), 0.0),
+    };
+    // SAFETY: the code passes two places of its work buffer, which the
+    // caller of `Code::run` sized for every register's series.
+    unsafe {
+        *value = v;
+        *partner = p;
+    }
+}
+
+/// The series of `tape` at `order`, `None` for an instruction this does
+/// not compile.
+#[cfg(target_arch = "x86_64")]
+fn lower(tape: &Tape, layout: &Layout, order: usize) -> Option<Code> {
+    use crate::models::automaton::expr::compiled::layout::Base;
+    use crate::models::automaton::expr::compiled::machine::Emitter;
+    use crate::models::automaton::expr::tape::Fun;
+
+    let mut e = Emitter::new()?;
+    let constant = |r: u32| matches!(tape.ops[r as usize], Op::Const(_));
+    let width = order + 1;
+    for k in 0..order {
+        for (r, &op) in tape.ops.iter().enumerate() {
+            let r = r as u32;
+            let out = layout.at(r, k);
+            match op {
+                Op::Const(_) | Op::Input(_) => continue,
+                Op::Add(a, b) => {
+                    e.load(0, layout.at(a, k));
+                    e.add(0, layout.at(b, k));
+                }
+                Op::Sub(a, b) => {
+                    e.load(0, layout.at(a, k));
+                    e.sub(0, layout.at(b, k));
+                }
+                Op::Neg(a) => {
+                    e.load(0, layout.at(a, k));
+                    e.negate(0);
+                }
+                Op::Mul(a, b) if constant(a) => {
+                    e.load(0, layout.at(a, 0));
+                    e.mul(0, layout.at(b, k));
+                }
+                Op::Mul(a, b) if constant(b) => {
+                    e.load(0, layout.at(a, k));
+                    e.mul(0, layout.at(b, 0));
+                }
+                Op::Mul(a, b) => e.product(0, |j| layout.at(a, j), |j| layout.at(b, j), k, 0),
+                Op::Div(a, b) if constant(b) => {
+                    e.load(0, layout.at(a, k));
+                    e.div(0, layout.at(b, 0));
+                }
+                Op::Div(a, b) => {
+                    // a = q b: q_k = (a_k - sum_{j=1..k} b_j q_{k-j}) / b_0.
+                    e.product(2, |j| layout.at(b, j), |j| layout.at(r, j), k, 1);
+                    e.load(0, layout.at(a, k));
+                    e.sub_registers(0, 2);
+                    e.div(0, layout.at(b, 0));
+                }
+                Op::Call(f @ (Fun::Sin | Fun::Cos | Fun::Sinh | Fun::Cosh), a) => {
+                    let hyperbolic = matches!(f, Fun::Sinh | Fun::Cosh);
+                    let is_sin = matches!(f, Fun::Sin | Fun::Sinh);
+                    if k == 0 {
+                        let kind = match f {
+                            Fun::Sin => Origin::Sin,
+                            Fun::Cos => Origin::Cos,
+                            Fun::Sinh => Origin::Sinh,
+                            _ => Origin::Cosh,
+                        };
+                        e.load(0, layout.at(a, 0));
+                        e.call(origin as *const (), kind as u32, out, layout.helper(r, 0));
+                        continue;
+                    }
+                    // s' = a' c, c' = -+ a' s: the rates j a_j times the
+                    // partner's (into xmm0) and the value's (xmm1).
+                    e.zero(0);
+                    e.zero(1);
+                    for j in 1..=k {
+                        e.load(2, layout.integer(j));
+                        e.mul(2, layout.at(a, j));
+                        e.copy(3, 2);
+                        e.mul(3, layout.helper(r, k - j));
+                        e.add_registers(0, 3);
+                        e.mul(2, layout.at(r, k - j));
+                        e.add_registers(1, 2);
+                    }
+                    e.div(0, layout.integer(k));
+                    e.div(1, layout.integer(k));
+                    // The sign times the one that changes sign.
+                    let sign = if hyperbolic {
+                        layout.integer(1)
+                    } else {
+                        layout.minus_one()
+                    };
+                    let signed = if is_sin { 1 } else { 0 };
+                    e.load(2, sign);
+                    e.mul_registers(2, signed);
+                    e.copy(signed, 2);
+                    e.store(layout.helper(r, k), 1);
+                }
+                Op::Call(Fun::Exp, a) => {
+                    if k == 0 {
+                        e.load(0, layout.at(a, 0));
+                        e.call(
+                            origin as *const (),
+                            Origin::Exp as u32,
+                            out,
+                            layout.helper(r, 0),
+                        );
+                        continue;
+                    }
+                    // e' = a' e.
+                    e.zero(0);
+                    for j in 1..=k {
+                        e.load(2, layout.integer(j));
+                        e.mul(2, layout.at(a, j));
+                        e.mul(2, layout.at(r, k - j));
+                        e.add_registers(0, 2);
+                    }
+                    e.div(0, layout.integer(k));
+                }
+                Op::Pow(..) | Op::Call(..) | Op::Call2(..) => return None,
+            }
+            e.store(out, 0);
+        }
+        // The state's order k + 1 is the rate's order k over k + 1.
+        for (i, &o) in tape.outputs.iter().enumerate() {
+            e.load(0, layout.at(o, k));
+            e.div(0, layout.integer(k + 1));
+            let to = i32::try_from((i * width + k + 1) * size_of::<f64>()).ok()?;
+            e.store((Base::State, to), 0);
+        }
+    }
+    e.finish()
+}
