@@ -44,9 +44,13 @@ const MAX_PIECES: usize = 64;
 
 /// The largest absolute row sum of a row-major `n x n` matrix.
 fn row_norm(n: usize, a: &[f64]) -> f64 {
-    (0..n)
-        .map(|i| (0..n).map(|j| a[i * n + j].abs()).sum::<f64>())
-        .fold(0.0, f64::max)
+    if n == 0 {
+        return 0.0;
+    }
+    // Each row summed from -0.0, in order, as `Sum` sums.
+    a[..n * n].chunks_exact(n).fold(0.0, |largest, row| {
+        largest.max(row.iter().fold(-0.0, |sum, x| sum + x.abs()))
+    })
 }
 
 impl Tangents {
