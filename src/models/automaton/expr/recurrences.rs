@@ -472,12 +472,13 @@ fn constant(tape: &Tape, r: u32) -> bool {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::models::automaton::expr::parse::parse;
     use crate::models::automaton::expr::tape::Scope;
 
-    fn tape(texts: &[&str], inputs: &[&str]) -> Tape {
+    /// The tape of `texts` over `inputs`, with a constant `c = 0.3`.
+    pub(crate) fn tape(texts: &[&str], inputs: &[&str]) -> Tape {
         let scope = Scope {
             inputs: inputs.iter().map(|s| s.to_string()).collect(),
             constants: vec![("c".into(), 0.3)],

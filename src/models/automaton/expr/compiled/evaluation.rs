@@ -143,6 +143,7 @@ extern "sysv64" fn pow(_: u32, a: f64, b: f64, _: *mut f64, _: *mut f64) -> f64 
 
 #[cfg(target_arch = "x86_64")]
 fn lower(tape: &Tape, layout: &Layout) -> Option<Code> {
+    use crate::models::automaton::expr::compiled::layout::Place;
     use crate::models::automaton::expr::compiled::machine::Emitter;
     use crate::models::automaton::expr::tape::{FUNS, FUNS2};
 
@@ -152,21 +153,15 @@ fn lower(tape: &Tape, layout: &Layout) -> Option<Code> {
         let r = r as u32;
         match op {
             Op::Const(_) | Op::Input(_) => continue,
-            Op::Add(a, b) => {
+            Op::Add(a, b) | Op::Sub(a, b) | Op::Mul(a, b) | Op::Div(a, b) => {
+                let apply: fn(&mut Emitter, u8, Place) = match op {
+                    Op::Add(..) => Emitter::add,
+                    Op::Sub(..) => Emitter::sub,
+                    Op::Mul(..) => Emitter::mul,
+                    _ => Emitter::div,
+                };
                 e.load(0, layout.at(a, 0));
-                e.add(0, layout.at(b, 0));
-            }
-            Op::Sub(a, b) => {
-                e.load(0, layout.at(a, 0));
-                e.sub(0, layout.at(b, 0));
-            }
-            Op::Mul(a, b) => {
-                e.load(0, layout.at(a, 0));
-                e.mul(0, layout.at(b, 0));
-            }
-            Op::Div(a, b) => {
-                e.load(0, layout.at(a, 0));
-                e.div(0, layout.at(b, 0));
+                apply(&mut e, 0, layout.at(b, 0));
             }
             Op::Neg(a) => {
                 e.load(0, layout.at(a, 0));

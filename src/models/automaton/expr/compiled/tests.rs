@@ -3,18 +3,8 @@
 
 use super::*;
 use crate::engine::taylor_method::MAX_ORDER;
-use crate::models::automaton::expr::parse::parse;
 use crate::models::automaton::expr::recurrences::Series;
-use crate::models::automaton::expr::tape::{Scope, Tape};
-
-fn tape(texts: &[&str], inputs: &[&str]) -> Tape {
-    let scope = Scope {
-        inputs: inputs.iter().map(|s| s.to_string()).collect(),
-        constants: vec![("c".into(), 0.3)],
-    };
-    let asts: Vec<_> = texts.iter().map(|t| parse(t).unwrap()).collect();
-    Tape::compile(&asts.iter().collect::<Vec<_>>(), &scope).unwrap()
-}
+use crate::models::automaton::expr::recurrences::tests::tape;
 
 /// Both series of `texts` from `x0`, bit for bit, at a few orders.
 fn same_as_interpreted(texts: &[&str], inputs: &[&str], x0: &[f64]) {
