@@ -1,7 +1,8 @@
 //! Tapes compiled to machine code, as heyoka compiles its decomposition:
-//! a flow's Taylor series at one order ([`series`]) and a tape's plain
-//! evaluation ([`evaluation`]), both straight-line x86-64 ([`machine`])
-//! with each operand at a fixed place ([`layout`]).
+//! a flow's Taylor series at one order ([`CompiledFlow`], `series.rs`) and
+//! a tape's plain evaluation ([`CompiledTape`], `evaluation.rs`), both
+//! straight-line x86-64 (`machine.rs`) with each operand at a fixed place
+//! (`layout.rs`).
 //!
 //! The interpreter pays about ten instructions of dispatch, indexing and
 //! loop control for each floating-point operation; this code pays one or
