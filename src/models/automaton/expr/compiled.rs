@@ -11,13 +11,15 @@
 //! fused, functions are Rust's own), so its results are the interpreter's
 //! bit for bit: no result moves. Compiling Henon-Heiles' series at order
 //! 20 takes 0.1 ms, a chain of 100 states 3.5 ms (heyoka's LLVM takes
-//! 66-146 ms). Other processors, and what does not compile, keep the
-//! interpreter.
+//! 66-146 ms). A tape is compiled once it has been asked for 64
+//! times (`tiered.rs`): a short run never pays for it. Other
+//! processors, and what does not compile, keep the interpreter.
 
 mod evaluation;
 mod layout;
 mod machine;
 mod series;
+mod tiered;
 
 pub use evaluation::CompiledTape;
 pub use series::{CompiledFlow, CompiledFlows};

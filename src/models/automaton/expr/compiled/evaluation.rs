@@ -5,17 +5,17 @@
 //! interpreter's bit for bit.
 
 use std::cell::RefCell;
-use std::sync::OnceLock;
 
 use crate::models::automaton::expr::compiled::layout::Layout;
 use crate::models::automaton::expr::compiled::machine::Code;
+use crate::models::automaton::expr::compiled::tiered::Tiered;
 use crate::models::automaton::expr::tape::{Op, Tape};
 
-/// A tape's evaluation, compiled the first time it is asked for. It
+/// A tape's evaluation, compiled once warmed up (see `tiered.rs`). It
 /// belongs to one tape: the one each [`CompiledTape::eval`] is given.
 #[derive(Debug, Default)]
 pub struct CompiledTape {
-    code: OnceLock<Option<Evaluation>>,
+    code: Tiered<Evaluation>,
 }
 
 thread_local! {
@@ -29,7 +29,7 @@ impl CompiledTape {
     /// `out`: compiled where it can be, else by the interpreter.
     #[inline]
     pub fn eval(&self, tape: &Tape, inputs: &[f64], out: &mut [f64]) {
-        match self.code.get_or_init(|| Evaluation::new(tape)) {
+        match self.code.get(|| Evaluation::new(tape)) {
             Some(code) => code.eval(inputs, out),
             None => tape.eval_scratch(inputs, out),
         }
@@ -38,7 +38,7 @@ impl CompiledTape {
     /// Whether the tape was compiled (not left to the interpreter).
     #[cfg(test)]
     pub fn compiled(&self) -> bool {
-        matches!(self.code.get(), Some(Some(_)))
+        self.code.compiled()
     }
 }
 

@@ -12,37 +12,37 @@
 //! [`Series::flow`]: crate::models::automaton::expr::recurrences::Series::flow
 
 use std::cell::RefCell;
-use std::sync::OnceLock;
 
 use crate::engine::taylor_method::MAX_ORDER;
 use crate::models::automaton::expr::compiled::layout::Layout;
 use crate::models::automaton::expr::compiled::machine::Code;
+use crate::models::automaton::expr::compiled::tiered::Tiered;
 use crate::models::automaton::expr::tape::{Op, Tape};
 
-/// A flow's series at each order, compiled the first time it is asked for
-/// (a run asks for one order; a sweep over tolerances, for a few).
+/// A flow's series at each order, compiled once warmed up (see
+/// `tiered.rs`; a run asks for one order, a sweep over tolerances for a
+/// few).
 #[derive(Debug)]
 pub struct CompiledFlows {
-    by_order: Box<[OnceLock<Option<CompiledFlow>>]>,
+    by_order: Box<[Tiered<CompiledFlow>]>,
 }
 
 impl Default for CompiledFlows {
     fn default() -> Self {
         CompiledFlows {
-            by_order: (0..=MAX_ORDER).map(|_| OnceLock::new()).collect(),
+            by_order: (0..=MAX_ORDER).map(|_| Tiered::default()).collect(),
         }
     }
 }
 
 impl CompiledFlows {
     /// The compiled series of `tape` (the flow this cache belongs to) at
-    /// `order`, if it compiles.
+    /// `order`, if it is warmed up and compiles.
     #[inline]
     pub fn get(&self, tape: &Tape, order: usize) -> Option<&CompiledFlow> {
         self.by_order
             .get(order)?
-            .get_or_init(|| CompiledFlow::new(tape, order))
-            .as_ref()
+            .get(|| CompiledFlow::new(tape, order))
     }
 }
 

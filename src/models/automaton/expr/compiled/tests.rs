@@ -108,38 +108,73 @@ fn what_does_not_compile_is_left_to_the_interpreter() {
     let t = tape(&["y", "-x"], &xy);
     assert!(CompiledFlow::new(&t, 0).is_none());
     assert!(CompiledFlow::new(&t, MAX_ORDER + 1).is_none());
-    // The cache answers the same for a tape it cannot compile.
+    // The cache answers the same for a tape it cannot compile, warmed up
+    // or not.
     let flows = CompiledFlows::default();
-    assert!(flows.get(&tape(&["tan(x)", "y"], &xy), 10).is_none());
+    let t = tape(&["tan(x)", "y"], &xy);
+    assert!((0..=tiered::WARM_UP).all(|_| flows.get(&t, 10).is_none()));
 }
 
-/// Threads of a sweep share one compiled flow, each with its own scratch.
+/// Threads of a sweep share one compiled flow, each with its own work
+/// buffer: the interpreter answers until the flow is warmed up, the
+/// compiled code after, and every answer is the same.
 #[test]
 fn threads_share_a_compiled_flow() {
-    if !cfg!(target_arch = "x86_64") {
-        return;
-    }
     let t = tape(&["y", "-x - 2 * x * y"], &["x", "y"]);
     let flows = CompiledFlows::default();
     let order = 12;
-    let expected = |x: f64| {
+    let interpreted = |x: f64| {
         let mut out = vec![0.0; 2 * (order + 1)];
         Series::default().flow(&t, &[x, 0.1], order, &mut out);
         out
     };
-    std::thread::scope(|s| {
-        for i in 0..4 {
-            let (flows, t) = (&flows, &t);
-            s.spawn(move || {
-                let x = 0.1 * i as f64;
-                let mut out = vec![0.0; 2 * (order + 1)];
-                for _ in 0..100 {
-                    flows.get(t, order).unwrap().flow(&[x, 0.1], &mut out);
-                }
-                assert_eq!(out, expected(x));
-            });
-        }
+    let compiled_calls = std::thread::scope(|s| {
+        let threads: Vec<_> = (0..4)
+            .map(|i| {
+                let (flows, t, interpreted) = (&flows, &t, &interpreted);
+                s.spawn(move || {
+                    let x = 0.1 * i as f64;
+                    let expected = interpreted(x);
+                    let mut out = vec![0.0; 2 * (order + 1)];
+                    let mut compiled = 0;
+                    for _ in 0..100 {
+                        if let Some(code) = flows.get(t, order) {
+                            code.flow(&[x, 0.1], &mut out);
+                            assert_eq!(out, expected);
+                            compiled += 1;
+                        }
+                    }
+                    compiled
+                })
+            })
+            .collect();
+        threads.into_iter().map(|t| t.join().unwrap()).sum::<u32>()
     });
+    // 400 calls, the first WARM_UP of them (all threads together) to the
+    // interpreter.
+    if cfg!(target_arch = "x86_64") {
+        assert_eq!(compiled_calls, 400 - tiered::WARM_UP);
+    }
+}
+
+/// A tape is interpreted for its first WARM_UP calls and compiled on the
+/// next; the answers are the same bits throughout.
+#[test]
+fn a_tape_is_compiled_once_warmed_up() {
+    let t = tape(&["x * y - sin(x)", "exp(y) / (1 + x^2)"], &["x", "y"]);
+    let code = CompiledTape::default();
+    let mut want = [0.0; 2];
+    t.eval_scratch(&[0.4, -0.2], &mut want);
+    for call in 0..=tiered::WARM_UP {
+        assert_eq!(
+            code.compiled(),
+            cfg!(target_arch = "x86_64") && call > tiered::WARM_UP
+        );
+        let mut out = [f64::NAN; 2];
+        code.eval(&t, &[0.4, -0.2], &mut out);
+        assert_eq!(out.map(f64::to_bits), want.map(f64::to_bits), "call {call}");
+    }
+    assert_eq!(code.compiled(), cfg!(target_arch = "x86_64"));
 }
 
 /// Every instruction and every function, evaluated compiled and
@@ -159,6 +194,10 @@ fn every_compiled_evaluation_gives_the_interpreters_bits() {
         &["x", "y", "t"],
     );
     let code = CompiledTape::default();
+    // Warmed up (see `a_tape_is_compiled_once_warmed_up`).
+    for _ in 0..tiered::WARM_UP {
+        code.eval(&t, &[0.3, -0.7, 2.5], &mut [0.0; 6]);
+    }
     for point in [
         [0.3, -0.7, 2.5],
         [-1.5, 0.0, -3.0],
