@@ -51,8 +51,8 @@ struct CompiledMode {
     name: String,
     /// The rate of every state component.
     flow: Tape,
-    /// Its tapes as machine code, compiled as they are first asked for
-    /// (shared by the copies of the model a sweep's threads hold).
+    /// Its tapes as machine code, compiled once warmed up (shared by the
+    /// copies of the model a sweep's threads hold).
     code: Arc<ModeCode>,
     /// Its Jacobian's entries, row-major, where compiled (a smooth flow).
     flow_jacobian: Option<Tape>,
@@ -76,7 +76,7 @@ struct CompiledMode {
 }
 
 /// A mode's tapes compiled (see [`crate::models::automaton::expr::compiled`]),
-/// each the first time a run asks for it.
+/// each once a run has asked for it often enough to repay it.
 #[derive(Debug, Default)]
 struct ModeCode {
     /// The flow's Taylor series, per order.
