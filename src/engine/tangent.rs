@@ -395,6 +395,9 @@ fn exp(n: usize, a: &[f64], out: &mut [f64]) {
     exp_dense(n, a, out)
 }
 
+// `exp_dense` has an arm for each size up to TRACKED.
+const _: () = assert!(TRACKED == 8);
+
 /// [`exp`] without looking for decoupled components.
 fn exp_dense(n: usize, a: &[f64], out: &mut [f64]) {
     match n {
@@ -632,6 +635,20 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// The largest absolute row sum, whatever the entries' signs.
+    #[test]
+    fn the_row_norm_is_the_largest_absolute_row_sum() {
+        #[rustfmt::skip]
+        let a = [
+            1.0, -2.0, 0.5,
+            -4.0, 0.0, -0.25,
+            0.0, 3.0, -1.0,
+        ];
+        assert_eq!(row_norm(3, &a), 4.25);
+        assert_eq!(row_norm(1, &[-0.5]), 0.5);
+        assert_eq!(row_norm(0, &[]), 0.0);
     }
 
     /// Every size up to TRACKED: a rotation by `w` beside a Jordan block
