@@ -98,7 +98,11 @@ pub fn state_series(
     }
 }
 
-/// [`state_series`] for an augmented state of `M` components.
+/// [`state_series`] for an augmented state of `M` components. The
+/// augmented row of `M` is zero, so from the first product on the term's
+/// last component is zero and its column is skipped: it would add exact
+/// zeros to sums that start from `+0` (the same bits, half the products
+/// for a state of two).
 fn state_series_of<const M: usize>(rows: &[f64], y: &[f64], series: &mut [f64]) {
     let w = ORDER + 1;
     let n = series.len() / w;
@@ -106,18 +110,29 @@ fn state_series_of<const M: usize>(rows: &[f64], y: &[f64], series: &mut [f64]) 
     for (i, row) in a.iter_mut().enumerate() {
         row.copy_from_slice(&rows[i * M..(i + 1) * M]);
     }
+    // The first product (its scale 1 / 1!), with the augmented column;
+    // `term[M - 1]` stays 0.
     let mut term = [0.0; M];
-    term.copy_from_slice(y);
-    for k in 0..w {
+    for (o, row) in term[..M - 1].iter_mut().zip(&a) {
+        let mut sum = 0.0;
+        for (x, t) in row.iter().zip(y) {
+            sum += x * t;
+        }
+        *o = sum;
+    }
+    for i in 0..n {
+        series[i * w] = y[i];
+    }
+    for k in 1..w {
         for i in 0..n {
             series[i * w + k] = term[i];
         }
         if k < ORDER {
             let scale = 1.0 / (k + 1) as f64;
             let mut next = [0.0; M];
-            for (o, row) in next.iter_mut().zip(&a) {
+            for (o, row) in next[..M - 1].iter_mut().zip(&a) {
                 let mut sum = 0.0;
-                for (x, t) in row.iter().zip(&term) {
+                for (x, t) in row[..M - 1].iter().zip(&term[..M - 1]) {
                     sum += x * t;
                 }
                 *o = sum * scale;

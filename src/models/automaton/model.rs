@@ -87,6 +87,11 @@ struct ModeCode {
     jacobian: CompiledTape,
     /// Each guard's value.
     guards: Vec<CompiledTape>,
+    /// Each transition's reset, and the rest's (an event's new state).
+    resets: Vec<CompiledTape>,
+    rest: CompiledTape,
+    /// The energy, where the file gives one (evaluated at every event).
+    energy: CompiledTape,
 }
 
 #[derive(Debug, Clone)]
@@ -131,8 +136,9 @@ impl Reset {
         }
     }
 
-    /// Every new value from the values before the event, all at once.
-    fn apply(&self, x: &mut [f64]) {
+    /// Every new value from the values before the event, all at once, by
+    /// `code` (this reset's compiled tape).
+    fn apply(&self, code: &CompiledTape, x: &mut [f64]) {
         // On the stack for the few states a reset names: no allocation per
         // event.
         let (mut small, mut large) = ([0.0; 8], Vec::new());
@@ -143,7 +149,7 @@ impl Reset {
                 &mut large
             }
         };
-        self.tape.eval_scratch(x, new);
+        code.eval(&self.tape, x, new);
         for (&i, &v) in self.targets.iter().zip(new.iter()) {
             x[i] = v;
         }
@@ -343,6 +349,7 @@ impl Automaton {
                         .iter()
                         .map(|_| CompiledTape::default())
                         .collect(),
+                    resets: resets.iter().map(|_| CompiledTape::default()).collect(),
                     ..ModeCode::default()
                 }),
                 flow_jacobian,
@@ -587,8 +594,9 @@ impl HybridModel for Automaton {
     }
 
     fn reset(&self, mode: Mode, guard: usize, x: &mut [f64]) -> Jump {
-        let reset = &self.modes[mode].resets[guard];
-        reset.apply(x);
+        let m = &self.modes[mode];
+        let reset = &m.resets[guard];
+        reset.apply(&m.code.resets[guard], x);
         let (to, named) = match reset.pick {
             Target::Fixed => (reset.to, None),
             Target::Leave(guard) => return Jump::to(reset.to).leaving(guard),
@@ -613,8 +621,9 @@ impl HybridModel for Automaton {
 
     /// The mode's `rest`, where its barriers' events pile up.
     fn settle(&self, mode: Mode, x: &mut [f64]) -> Option<Mode> {
-        let rest = self.modes[mode].rest.as_ref()?;
-        rest.apply(x);
+        let m = &self.modes[mode];
+        let rest = m.rest.as_ref()?;
+        rest.apply(&m.code.rest, x);
         Some(rest.to)
     }
 
@@ -631,7 +640,11 @@ impl HybridModel for Automaton {
     }
 
     fn energy(&self, mode: Mode, x: &[f64]) -> Option<f64> {
-        self.energy.as_ref().map(|e| e[mode].eval1(x))
+        self.energy.as_ref().map(|e| {
+            let mut value = [0.0];
+            self.modes[mode].code.energy.eval(&e[mode], x, &mut value);
+            value[0]
+        })
     }
 
     /// A file's resets may take energy away (a restitution) or rewrite
@@ -705,4 +718,51 @@ thread_local! {
     /// Scratch for Taylor series (models are shared, read only, between
     /// the threads of a sweep).
     static SERIES: RefCell<Series> = RefCell::new(Series::default());
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::engine::model::HybridModel;
+    use crate::models::automaton::{AutomatonBuilder, TransitionBuilder};
+
+    /// The energy and each transition's reset are compiled once warmed up
+    /// (64 calls): past that, each still reads its own expression, at
+    /// every state, the two transitions' resets not swapped.
+    #[test]
+    fn energy_and_resets_keep_their_expressions_once_compiled() {
+        let model = AutomatonBuilder::new()
+            .parameter("k", 3.0)
+            .state("x", 1.0)
+            .state("v", 0.0)
+            .mode(
+                "flight",
+                [("x", "v"), ("v", "-k * x")],
+                [
+                    TransitionBuilder::new("low", "x + 1")
+                        .falling()
+                        .reset("v", "-0.5 * v"),
+                    TransitionBuilder::new("high", "2 - x")
+                        .falling()
+                        .reset("v", "x * v - 1"),
+                ],
+            )
+            .energy("v^2 / 2 + k * x^2 / 2 + sin(x)")
+            .build()
+            .unwrap();
+        for i in 0..200 {
+            let (x, v) = (0.37 * i as f64 - 20.0, 1.5 - 0.011 * i as f64);
+            let energy = model.energy(0, &[x, v]).unwrap();
+            assert_eq!(
+                energy,
+                v.powi(2) / 2.0 + 3.0 * x.powi(2) / 2.0 + x.sin(),
+                "{i}"
+            );
+            let mut low = [x, v];
+            model.reset(0, 0, &mut low);
+            assert_eq!(low, [x, -0.5 * v], "{i}");
+            let mut high = [x, v];
+            model.reset(0, 1, &mut high);
+            assert_eq!(high, [x, x * v - 1.0], "{i}");
+        }
+    }
 }
