@@ -16,7 +16,10 @@
 //!   and any longer one wins it back;
 //! - for each guard that is affine in the state, `g(x) = c . x + d`, the
 //!   rows `[c, d] M^k / k!`: the guard's Taylor coefficients along any step
-//!   are their products with `y`, with no series of the state in between.
+//!   are their products with `y`, with no series of the state in between;
+//! - the same rows for each state component, `e_i M^k / k!`: the state's
+//!   own series where a step needs it (an event's state), each coefficient
+//!   one product, independent of the others.
 
 use nalgebra::DMatrix;
 
@@ -51,6 +54,9 @@ pub struct AffineMode {
     /// Per guard: the rows `[c, d] M^k / k!`, `k = 0..=ORDER`, one after
     /// another, for a guard affine in the state of a mode solved once.
     pub guard_rows: Vec<Option<Vec<f64>>>,
+    /// Where the mode is small: each state component's rows (see
+    /// [`AffineMode::state_rows`]).
+    pub state_rows: Option<Vec<f64>>,
 }
 
 /// `out = a v` for a square matrix `a` laid out row by row.
@@ -63,9 +69,10 @@ pub fn mat_vec(a: &[f64], v: &[f64], out: &mut [f64]) {
 
 /// The series of `exp(M tau) y`, component by component: `series[i *
 /// (ORDER + 1) + k]` is `(M^k y)_i / k!` for the first `series.len() /
-/// (ORDER + 1)` components (the layout of [`HybridModel::flow_series`]).
-/// `term` and `next` are scratch of `y`'s length. Small states take a loop
-/// unrolled for their size (the same sums in the same order).
+/// (ORDER + 1)` components (the layout of [`HybridModel::flow_series`]),
+/// by `ORDER` products with `M`: for a mode too large to be solved once
+/// (a small one has [`AffineMode::state_rows`]). `term` and `next` are
+/// scratch of `y`'s length.
 pub fn state_series(
     rows: &[f64],
     y: &[f64],
@@ -73,72 +80,35 @@ pub fn state_series(
     term: &mut [f64],
     next: &mut [f64],
 ) {
-    match y.len() {
-        2 => state_series_of::<2>(rows, y, series),
-        3 => state_series_of::<3>(rows, y, series),
-        4 => state_series_of::<4>(rows, y, series),
-        5 => state_series_of::<5>(rows, y, series),
-        _ => {
-            let w = ORDER + 1;
-            let n = series.len() / w;
-            term.copy_from_slice(y);
-            for k in 0..w {
-                for i in 0..n {
-                    series[i * w + k] = term[i];
-                }
-                if k < ORDER {
-                    mat_vec(rows, term, next);
-                    let scale = 1.0 / (k + 1) as f64;
-                    for (t, v) in term.iter_mut().zip(next.iter()) {
-                        *t = v * scale;
-                    }
-                }
+    let w = ORDER + 1;
+    let n = series.len() / w;
+    term.copy_from_slice(y);
+    for k in 0..w {
+        for i in 0..n {
+            series[i * w + k] = term[i];
+        }
+        if k < ORDER {
+            mat_vec(rows, term, next);
+            let scale = 1.0 / (k + 1) as f64;
+            for (t, v) in term.iter_mut().zip(next.iter()) {
+                *t = v * scale;
             }
         }
     }
 }
 
-/// [`state_series`] for an augmented state of `M` components. The
-/// augmented row of `M` is zero, so from the first product on the term's
-/// last component is zero and its column is skipped: it would add exact
-/// zeros to sums that start from `+0` (the same bits, half the products
-/// for a state of two).
-fn state_series_of<const M: usize>(rows: &[f64], y: &[f64], series: &mut [f64]) {
-    let w = ORDER + 1;
-    let n = series.len() / w;
-    let mut a = [[0.0; M]; M];
-    for (i, row) in a.iter_mut().enumerate() {
-        row.copy_from_slice(&rows[i * M..(i + 1) * M]);
-    }
-    // The first product (its scale 1 / 1!), with the augmented column;
-    // `term[M - 1]` stays 0.
-    let mut term = [0.0; M];
-    for (o, row) in term[..M - 1].iter_mut().zip(&a) {
-        let mut sum = 0.0;
-        for (x, t) in row.iter().zip(y) {
-            sum += x * t;
-        }
-        *o = sum;
-    }
-    for i in 0..n {
-        series[i * w] = y[i];
-    }
-    for k in 1..w {
-        for i in 0..n {
-            series[i * w + k] = term[i];
-        }
-        if k < ORDER {
-            let scale = 1.0 / (k + 1) as f64;
-            let mut next = [0.0; M];
-            for (o, row) in next[..M - 1].iter_mut().zip(&a) {
-                let mut sum = 0.0;
-                for (x, t) in row[..M - 1].iter().zip(&term[..M - 1]) {
-                    sum += x * t;
-                }
-                *o = sum * scale;
-            }
-            term = next;
-        }
+/// [`state_series`] for a mode solved once, from its
+/// [`AffineMode::state_rows`]: each coefficient is one product of a cached
+/// row with `y`, rounded once, and the products are independent of each
+/// other (a chain of `ORDER` products with `M` waits on each in turn).
+pub fn state_series_by_rows(state_rows: &[f64], y: &[f64], series: &mut [f64]) {
+    const ZEROS: [f64; SOLVED_DIMENSION + 1] = [0.0; SOLVED_DIMENSION + 1];
+    let (w, m) = (ORDER + 1, y.len());
+    for (rows, out) in state_rows
+        .chunks_exact(w * m)
+        .zip(series.chunks_exact_mut(w))
+    {
+        guard_series(rows, y, &ZEROS[..m], out);
     }
 }
 
@@ -228,8 +198,10 @@ impl AffineMode {
             propagator: None,
             series_steps: 0,
             guard_rows: vec![None; model.guards(mode).len()],
+            state_rows: None,
         };
         if n <= SOLVED_DIMENSION {
+            solved.state_rows = Some(solved.state_rows(n));
             for g in 0..solved.guard_rows.len() {
                 solved.guard_rows[g] = solved.affine_guard_rows(model, mode, g, n);
             }
@@ -310,8 +282,28 @@ impl AffineMode {
         if !row.iter().all(|v| v.is_finite()) {
             return None;
         }
+        Some(self.powers(&row))
+    }
+
+    /// Each state component's rows `e_i M^k / k!`, `k = 0..=ORDER`, one
+    /// component after another: its Taylor coefficients along any step are
+    /// their products with `y`, each rounded once.
+    fn state_rows(&self, n: usize) -> Vec<f64> {
+        let m = n + 1;
+        let mut all = Vec::with_capacity(n * (ORDER + 1) * m);
+        for i in 0..n {
+            let mut unit = vec![0.0; m];
+            unit[i] = 1.0;
+            all.extend(self.powers(&unit));
+        }
+        all
+    }
+
+    /// `row M^k / k!` for `k = 0..=ORDER`, one after another.
+    fn powers(&self, row: &[f64]) -> Vec<f64> {
+        let m = row.len();
         let mut out = vec![0.0; (ORDER + 1) * m];
-        out[..m].copy_from_slice(&row);
+        out[..m].copy_from_slice(row);
         for k in 1..=ORDER {
             // row_k = row_{k-1} M / k.
             let (done, rest) = out.split_at_mut(k * m);
@@ -326,7 +318,7 @@ impl AffineMode {
                     * scale;
             }
         }
-        Some(out)
+        out
     }
 }
 
@@ -344,6 +336,7 @@ mod tests {
             propagator: None,
             series_steps: 0,
             guard_rows: Vec::new(),
+            state_rows: None,
         };
         let p = mode.propagator_over(1.0, 3);
         let (c, s) = (1.0_f64.cos(), 1.0_f64.sin());
@@ -362,5 +355,42 @@ mod tests {
             norm.round().abs() < 4.0 / 15511210043330985984000000.0,
             "{norm:?}"
         );
+    }
+
+    #[test]
+    fn state_rows_give_the_cosine_and_sine_series() {
+        // x' = y + 1, y' = -x from (0, 0) (the augmented 1 last): x = sin t,
+        // y = cos t - 1.
+        let rows = vec![0.0, 1.0, 1.0, -1.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+        let mode = AffineMode {
+            rows,
+            h_bound: 1.0 / 2.0,
+            propagator: None,
+            series_steps: 0,
+            guard_rows: Vec::new(),
+            state_rows: None,
+        };
+        let w = ORDER + 1;
+        let mut series = vec![0.0; 2 * w];
+        state_series_by_rows(&mode.state_rows(2), &[0.0, 0.0, 1.0], &mut series);
+        let mut factorial = 1.0;
+        for k in 0..w {
+            if k > 0 {
+                factorial *= k as f64;
+            }
+            let sign = if k % 4 < 2 { 1.0 } else { -1.0 };
+            // sin t at odd k, cos t - 1 at even k > 0: +-1 / k!.
+            let (x, y) = match k {
+                0 => (0.0, 0.0),
+                k if k % 2 == 0 => (0.0, sign / factorial),
+                _ => (sign / factorial, 0.0),
+            };
+            for (got, want) in [(series[k], x), (series[w + k], y)] {
+                assert!(
+                    (got - want).abs() <= 4.0 * f64::EPSILON * want.abs(),
+                    "{k}: {got} vs {want}"
+                );
+            }
+        }
     }
 }

@@ -7,11 +7,11 @@
 //!
 //! A small mode is solved once ([`AffineMode`]): a whole step is one
 //! product with its propagator `exp(M h)`, and an affine guard's series
-//! along the step are products of its cached rows with the state. The
-//! state's own series (`ORDER` matrix-vector products) is summed only where
-//! the run asks for a state inside the step (an event, the error bound) or
-//! for a step cut short, by compensated Horner: exact to a few ulps, with
-//! no matrix exponential.
+//! along the step are products of its cached rows with the state, and so
+//! is the state's own series. That series (a large mode's: `ORDER`
+//! matrix-vector products) is summed only where the run asks for a state
+//! inside the step (an event, the error bound) or for a step cut short, by
+//! compensated Horner: exact to a few ulps, with no matrix exponential.
 //!
 //! A whole step keeps what rounding its end left out, and the next step,
 //! if it starts there, starts from the end unrounded (its guards' series,
@@ -33,7 +33,9 @@ use nalgebra::{DMatrix, DVector};
 
 use crate::engine::adaptive::StepFailure;
 pub use crate::engine::affine_mode::ORDER;
-use crate::engine::affine_mode::{AffineMode, guard_series, mat_vec, state_series};
+use crate::engine::affine_mode::{
+    AffineMode, guard_series, mat_vec, state_series, state_series_by_rows,
+};
 use crate::engine::locate::{Start, StepScan};
 use crate::engine::model::{HybridModel, Mode};
 use crate::numerics::double_double::dot;
@@ -196,14 +198,14 @@ impl Linear {
         let solved = self.modes[self.mode]
             .as_ref()
             .expect("a step solved its mode");
-        let (term, next) = &mut *self.terms.borrow_mut();
-        state_series(
-            &solved.rows,
-            &self.y0,
-            &mut self.series.borrow_mut(),
-            term,
-            next,
-        );
+        let mut series = self.series.borrow_mut();
+        match &solved.state_rows {
+            Some(rows) => state_series_by_rows(rows, &self.y0, &mut series),
+            None => {
+                let (term, next) = &mut *self.terms.borrow_mut();
+                state_series(&solved.rows, &self.y0, &mut series, term, next);
+            }
+        }
         let (once, twice) = &mut *self.lo_terms.borrow_mut();
         mat_vec(&solved.rows, &self.y0_lo, once);
         mat_vec(&solved.rows, once, twice);
