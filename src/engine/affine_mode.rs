@@ -54,8 +54,8 @@ pub struct AffineMode {
     /// Per guard: the rows `[c, d] M^k / k!`, `k = 0..=ORDER`, one after
     /// another, for a guard affine in the state of a mode solved once.
     pub guard_rows: Vec<Option<Vec<f64>>>,
-    /// Where the mode is small: each state component's rows (see
-    /// [`AffineMode::state_rows`]).
+    /// Where the mode is small: each state component's rows `e_i M^k / k!`,
+    /// `k = 0..=ORDER`, one component after another.
     pub state_rows: Option<Vec<f64>>,
 }
 
@@ -201,7 +201,7 @@ impl AffineMode {
             state_rows: None,
         };
         if n <= SOLVED_DIMENSION {
-            solved.state_rows = Some(solved.state_rows(n));
+            solved.state_rows = Some(solved.component_rows(n));
             for g in 0..solved.guard_rows.len() {
                 solved.guard_rows[g] = solved.affine_guard_rows(model, mode, g, n);
             }
@@ -288,7 +288,7 @@ impl AffineMode {
     /// Each state component's rows `e_i M^k / k!`, `k = 0..=ORDER`, one
     /// component after another: its Taylor coefficients along any step are
     /// their products with `y`, each rounded once.
-    fn state_rows(&self, n: usize) -> Vec<f64> {
+    fn component_rows(&self, n: usize) -> Vec<f64> {
         let m = n + 1;
         let mut all = Vec::with_capacity(n * (ORDER + 1) * m);
         for i in 0..n {
@@ -372,7 +372,7 @@ mod tests {
         };
         let w = ORDER + 1;
         let mut series = vec![0.0; 2 * w];
-        state_series_by_rows(&mode.state_rows(2), &[0.0, 0.0, 1.0], &mut series);
+        state_series_by_rows(&mode.component_rows(2), &[0.0, 0.0, 1.0], &mut series);
         let mut factorial = 1.0;
         for k in 0..w {
             if k > 0 {
