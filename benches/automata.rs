@@ -9,7 +9,11 @@
 //!   `t mod T_imp` in doubles, is about 1e-11 at 10^6 impacts);
 //! - impacts per second, medians of 5 runs, on heyoka's case (eta 0.8,
 //!   H0 0.1, starting at an impact, to t = 10^5: 43,468 impacts) for
-//!   `taylor` and for the built-in exact model, and their ratio.
+//!   `taylor` and for the built-in exact model, and their ratio; then
+//!   the automaton by its default method (the linear propagator) and the
+//!   built-in model each writing its event log to a file, so that every
+//!   impact fires (a run without a log jumps the periodic orbit), and
+//!   their ratio.
 //!
 //! - the angle formulation as two charts (`models/automata/
 //!   mechanism_charts.json`) by DOP853 at `rtol = atol = 1e-10` beside the
@@ -24,6 +28,7 @@ use std::time::Instant;
 
 use serde_json::{Value, json};
 
+use flicker::log::JsonlWriter;
 use flicker::models::mechanism::{ExactOrbit, Mechanism};
 use flicker::runner::Control;
 use flicker::scene::Registry;
@@ -127,6 +132,39 @@ fn main() {
         "  built-in exact      {exact_impacts} impacts in {exact_seconds:.4} s: {:.0} impacts/s ({:.1}x taylor's speed)",
         exact_impacts as f64 / exact_seconds,
         taylor / exact_seconds
+    );
+    // With an event log every impact fires (no period is jumped), as a
+    // `flicker run` writing events.jsonl does: the automaton by its
+    // default method (the exact linear propagator) against the built-in
+    // model, each writing its log to a file.
+    let mut automaton: Value = serde_json::from_str(
+        &std::fs::read_to_string(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/models/automata/mechanism.json"
+        ))
+        .unwrap(),
+    )
+    .unwrap();
+    automaton["parameters"] = parameters.clone();
+    automaton["initial"] = initial.clone();
+    automaton["t_end"] = json!(1e5);
+    let automaton = Registry::builtin().from_value(&automaton).unwrap();
+    let log = std::env::temp_dir().join(format!("flicker_bench_{}.jsonl", std::process::id()));
+    let logged = |scene: &flicker::scene::Scene| {
+        median_of(5, || {
+            let file = std::io::BufWriter::new(std::fs::File::create(&log).unwrap());
+            let mut writer = JsonlWriter::new(file);
+            let report = scene.run(&Control::default(), &mut writer).unwrap();
+            writer.flush().unwrap();
+            report.outcome.events
+        })
+    };
+    let (logged_automaton, logged_impacts) = logged(&automaton);
+    let (logged_builtin, _) = logged(&builtin);
+    let _ = std::fs::remove_file(&log);
+    println!(
+        "  with their event logs ({logged_impacts} impacts fired): the automaton (linear) {logged_automaton:.4} s, the built-in model {logged_builtin:.4} s ({:.2}x)",
+        logged_automaton / logged_builtin
     );
 
     println!();
