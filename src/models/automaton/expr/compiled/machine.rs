@@ -22,8 +22,11 @@ mod x64 {
 
     /// Compiled code: one function of three buffers.
     pub struct Code {
+        /// The mapped code, kept for as long as `function` is called.
         buffer: ExecutableBuffer,
-        entry: AssemblyOffset,
+        /// Its entry, taken once (the buffer's mapping does not move with
+        /// `Code`): a run is then one indirect call.
+        function: Entry,
     }
 
     type Entry = extern "sysv64" fn(*mut f64, *mut f64, *const f64);
@@ -36,11 +39,7 @@ mod x64 {
         /// Run the code on the three buffers, which must be as long as the
         /// layout it was compiled for says.
         pub fn run(&self, work: *mut f64, state: *mut f64, pool: *const f64) {
-            // SAFETY: the buffer holds a complete function with this
-            // signature, emitted by an `Emitter` from `new` to `finish`,
-            // and stays mapped executable for as long as `self` lives.
-            let entry: Entry = unsafe { std::mem::transmute(self.buffer.ptr(self.entry)) };
-            entry(work, state, pool);
+            (self.function)(work, state, pool);
         }
     }
 
@@ -96,7 +95,12 @@ mod x64 {
             );
             let entry = self.entry;
             let buffer = self.asm.finalize().ok()?;
-            Some(Code { buffer, entry })
+            // SAFETY: the buffer holds a complete function with this
+            // signature, emitted by an `Emitter` from `new` to `finish`,
+            // and stays mapped executable for as long as the `Code` that
+            // owns it lives.
+            let function: Entry = unsafe { std::mem::transmute(buffer.ptr(entry)) };
+            Some(Code { buffer, function })
         }
 
         pub fn load(&mut self, x: u8, place: Place) {
