@@ -45,6 +45,7 @@ impl CompiledTape {
 /// The most instructions a compiled evaluation holds.
 const MAX_INSTRUCTIONS: usize = 1_000_000;
 
+#[derive(Debug)]
 struct Evaluation {
     code: Code,
     pool: Box<[f64]>,
@@ -53,15 +54,6 @@ struct Evaluation {
     outputs: usize,
     /// The work buffer's length, its outputs at the end.
     work: usize,
-}
-
-impl std::fmt::Debug for Evaluation {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Evaluation")
-            .field("outputs", &self.outputs)
-            .field("code_bytes", &self.code.len())
-            .finish()
-    }
 }
 
 impl Evaluation {

@@ -31,11 +31,14 @@ mod x64 {
 
     type Entry = extern "sysv64" fn(*mut f64, *mut f64, *const f64);
 
-    impl Code {
-        pub fn len(&self) -> usize {
-            self.buffer.len()
+    /// Its size, not its bytes.
+    impl std::fmt::Debug for Code {
+        fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+            write!(f, "Code({} bytes)", self.buffer.len())
         }
+    }
 
+    impl Code {
         /// Run the code on the three buffers, which must be as long as the
         /// layout it was compiled for says.
         pub fn run(&self, work: *mut f64, state: *mut f64, pool: *const f64) {
@@ -188,12 +191,10 @@ mod x64 {
 #[cfg(not(target_arch = "x86_64"))]
 mod other {
     /// No code: nothing compiles on this processor.
+    #[derive(Debug)]
     pub enum Code {}
 
     impl Code {
-        pub fn len(&self) -> usize {
-            match *self {}
-        }
         pub fn run(&self, _: *mut f64, _: *mut f64, _: *const f64) {
             match *self {}
         }

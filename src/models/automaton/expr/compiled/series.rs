@@ -53,6 +53,7 @@ thread_local! {
 }
 
 /// The series of one flow at one order, as machine code.
+#[derive(Debug)]
 pub struct CompiledFlow {
     code: Code,
     /// Constants the code reads (see [`Layout`]).
@@ -63,16 +64,6 @@ pub struct CompiledFlow {
     states: usize,
     /// The work buffer's length.
     work: usize,
-}
-
-impl std::fmt::Debug for CompiledFlow {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("CompiledFlow")
-            .field("order", &(self.width - 1))
-            .field("states", &self.states)
-            .field("code_bytes", &self.code.len())
-            .finish()
-    }
 }
 
 /// The most terms (coefficient operations) a compiled series may hold:
