@@ -33,6 +33,7 @@ pub struct Tangents {
     c: Vec<f64>,
     d: Vec<f64>,
     e: Vec<f64>,
+    middle: Vec<f64>,
 }
 
 /// The largest `||tau J||` (row sums) of one piece of a nonlinear step's
@@ -69,6 +70,7 @@ impl Tangents {
             c: vec![0.0; if n <= TRACKED { n * n } else { 0 }],
             d: vec![0.0; if n <= TRACKED { n * n } else { 0 }],
             e: vec![0.0; if n <= TRACKED { n * n } else { 0 }],
+            middle: vec![0.0; if n <= TRACKED { n * n } else { 0 }],
         }
     }
 
@@ -184,11 +186,21 @@ impl Tangents {
             } else {
                 let mut piece = std::mem::take(&mut self.d);
                 let mut product = std::mem::take(&mut self.e);
+                let mut jacobian = std::mem::take(&mut self.middle);
                 let h = tau / pieces as f64;
                 for k in 0..pieces {
-                    at((k as f64 + 0.5) * h, &mut x[..n]);
-                    self.jacobian(model, mode, &x[..n], &mut first);
-                    for (o, j) in x.iter_mut().zip(first.iter()) {
+                    let s = (k as f64 + 0.5) * h;
+                    // The middle piece of an odd count is centred where
+                    // the step's Jacobian was taken (when its time rounds
+                    // to the same): that one serves.
+                    let j = if s == 0.5 * tau {
+                        &first
+                    } else {
+                        at(s, &mut x[..n]);
+                        self.jacobian(model, mode, &x[..n], &mut jacobian);
+                        &jacobian
+                    };
+                    for (o, j) in x.iter_mut().zip(j.iter()) {
                         *o = h * j;
                     }
                     without_clock(n, model.clock(), &mut x);
@@ -203,6 +215,7 @@ impl Tangents {
                 }
                 self.d = piece;
                 self.e = product;
+                self.middle = jacobian;
             }
         }
         self.a = first;
@@ -421,9 +434,30 @@ fn exp_dense(n: usize, a: &[f64], out: &mut [f64]) {
 /// An `N x N` matrix.
 type Square<const N: usize> = [[f64; N]; N];
 
-/// The row-major `a` as a [`Square`].
-fn square<const N: usize>(a: &[f64]) -> Square<N> {
-    std::array::from_fn(|i| std::array::from_fn(|j| a[i * N + j]))
+/// The row-major `a` times `scale`, as a [`Square`].
+///
+/// The squares here are filled by loops, not `array::from_fn` or
+/// `array::map`, whose closures the compiler leaves as calls.
+fn square<const N: usize>(a: &[f64], scale: f64) -> Square<N> {
+    let mut out = [[0.0; N]; N];
+    for (row, a) in out.iter_mut().zip(a.chunks_exact(N)) {
+        for (x, a) in row.iter_mut().zip(a) {
+            *x = scale * a;
+        }
+    }
+    out
+}
+
+/// `b4 x4 + b2 x2 + b0 I`.
+fn even<const N: usize>(x4: &Square<N>, x2: &Square<N>, b4: f64, b2: f64, b0: f64) -> Square<N> {
+    let mut out = [[0.0; N]; N];
+    for (i, row) in out.iter_mut().enumerate() {
+        for (j, x) in row.iter_mut().enumerate() {
+            let sum = b4 * x4[i][j] + b2 * x2[i][j];
+            *x = if i == j { sum + b0 } else { sum };
+        }
+    }
+    out
 }
 
 fn exp_sized<const N: usize>(a: &[f64], out: &mut [f64]) {
@@ -443,23 +477,20 @@ fn exp_sized<const N: usize>(a: &[f64], out: &mut [f64]) {
     let scale = 0.5f64.powi(squarings);
     // exp(x) ~ (V(x) - U(x))^-1 (V(x) + U(x)), U odd, V even.
     const B: [f64; 6] = [30240.0, 15120.0, 3360.0, 420.0, 30.0, 1.0];
-    let x = square::<N>(a).map(|row| row.map(|a| scale * a));
+    let x = square::<N>(a, scale);
     let x2 = product(&x, &x);
     let x4 = product(&x2, &x2);
     // term = B5 x^4 + B3 x^2 + B1 I, next = B4 x^4 + B2 x^2 + B0 I.
-    let even = |b4: f64, b2: f64, b0: f64| -> Square<N> {
-        std::array::from_fn(|i| {
-            std::array::from_fn(|j| {
-                let sum = b4 * x4[i][j] + b2 * x2[i][j];
-                if i == j { sum + b0 } else { sum }
-            })
-        })
-    };
-    let (term, next) = (even(B[5], B[3], B[1]), even(B[4], B[2], B[0]));
+    let term = even(&x4, &x2, B[5], B[3], B[1]);
+    let next = even(&x4, &x2, B[4], B[2], B[0]);
     let u = product(&x, &term);
-    let mut denominator: Square<N> =
-        std::array::from_fn(|i| std::array::from_fn(|j| next[i][j] - u[i][j]));
-    let mut e: Square<N> = std::array::from_fn(|i| std::array::from_fn(|j| next[i][j] + u[i][j]));
+    let (mut denominator, mut e) = (next, next);
+    for ((d, e), u) in denominator.iter_mut().zip(&mut e).zip(&u) {
+        for ((d, e), u) in d.iter_mut().zip(e.iter_mut()).zip(u) {
+            *d -= u;
+            *e += u;
+        }
+    }
     solve_in_place(&mut denominator, &mut e);
     for _ in 0..squarings {
         e = product(&e, &e);
@@ -477,6 +508,9 @@ const PADE_5_REACH: f64 = 0.25;
 /// overwritten). Pade's denominator is close to the identity's multiple,
 /// so pivots never vanish for the norms it is asked at.
 fn solve_in_place<const N: usize>(a: &mut Square<N>, b: &mut Square<N>) {
+    // Whole rows at a time, so that each update is a few vector
+    // instructions; every entry sees the same operations in the same order
+    // as entry by entry.
     for col in 0..N {
         // The largest pivot, the last of equals.
         let mut pivot = col;
@@ -490,39 +524,53 @@ fn solve_in_place<const N: usize>(a: &mut Square<N>, b: &mut Square<N>) {
             b.swap(col, pivot);
         }
         let p = a[col][col];
-        for row in col + 1..N {
-            let f = a[row][col] / p;
-            for k in col..N {
-                a[row][k] -= f * a[col][k];
+        let (above, below) = a.split_at_mut(col + 1);
+        let (b_above, b_below) = b.split_at_mut(col + 1);
+        for (a_row, b_row) in below.iter_mut().zip(b_below.iter_mut()) {
+            let f = a_row[col] / p;
+            // The entries left of `col` are never read again: updating
+            // them too keeps the row whole.
+            for (x, y) in a_row.iter_mut().zip(&above[col]) {
+                *x -= f * y;
             }
-            for k in 0..N {
-                b[row][k] -= f * b[col][k];
+            for (x, y) in b_row.iter_mut().zip(&b_above[col]) {
+                *x -= f * y;
             }
         }
     }
     for col in (0..N).rev() {
         let p = a[col][col];
-        for k in 0..N {
-            let mut v = b[col][k];
-            for j in col + 1..N {
-                v -= a[col][j] * b[j][k];
+        let mut v = b[col];
+        for j in col + 1..N {
+            let f = a[col][j];
+            for (x, y) in v.iter_mut().zip(&b[j]) {
+                *x -= f * y;
             }
-            b[col][k] = v / p;
         }
+        for x in &mut v {
+            *x /= p;
+        }
+        b[col] = v;
     }
 }
 
 /// `a b`, each entry summed over `l` in increasing order.
 fn product<const N: usize>(a: &Square<N>, b: &Square<N>) -> Square<N> {
-    std::array::from_fn(|i| {
-        std::array::from_fn(|j| {
-            let mut sum = a[i][0] * b[0][j];
-            for l in 1..N {
-                sum += a[i][l] * b[l][j];
+    // Row by row (a vector instruction per few entries), each entry's sum
+    // in the same order.
+    let mut out = [[0.0; N]; N];
+    for (row, a) in out.iter_mut().zip(a) {
+        *row = b[0];
+        for x in row.iter_mut() {
+            *x *= a[0];
+        }
+        for (a, b) in a.iter().zip(b).skip(1) {
+            for (x, y) in row.iter_mut().zip(b) {
+                *x += a * y;
             }
-            sum
-        })
-    })
+        }
+    }
+    out
 }
 
 /// `out = a b` of row-major `n x n` matrices, each entry summed over `l`
@@ -544,7 +592,7 @@ fn mat_mul(n: usize, a: &[f64], b: &[f64], out: &mut [f64]) {
 }
 
 fn mat_mul_fixed<const N: usize>(a: &[f64], b: &[f64], out: &mut [f64]) {
-    let p = product::<N>(&square(a), &square(b));
+    let p = product::<N>(&square(a, 1.0), &square(b, 1.0));
     for (o, row) in out.chunks_exact_mut(N).zip(&p) {
         o.copy_from_slice(row);
     }

@@ -29,7 +29,7 @@ use crate::engine::adaptive::{StepFailure, Tolerances};
 use crate::engine::locate::{Start, StepScan};
 use crate::engine::model::{Direction, HybridModel, Mode};
 use crate::numerics::first_crossing::{eval2, first_fall};
-use crate::numerics::polynomial::{eval, eval_compensated};
+use crate::numerics::polynomial::{eval, eval_compensated_rows};
 
 /// The tolerance `taylor` takes unless told: machine epsilon, as heyoka.
 pub const DEFAULT_TOLERANCE: f64 = f64::EPSILON;
@@ -208,15 +208,24 @@ impl Taylor {
         self.eval(h, &mut end);
         model.rhs(mode, &end, &mut rate);
         let tolerance = 1e3 * allowed.max(self.local_error);
-        let solves = self.series.chunks_exact(w).zip(&rate).all(|(c, fi)| {
-            // The series' derivative at h, and the size of its terms.
-            let (mut slope, mut size) = (0.0, fi.abs());
-            for k in (1..w).rev() {
-                slope = slope * h + k as f64 * c[k];
-                size = size * h + k as f64 * c[k].abs();
-            }
-            (slope - fi).abs() * h <= tolerance + 16.0 * f64::EPSILON * size * h
-        });
+        // Four (then two) components at a time: their Horner chains run
+        // side by side.
+        let fours = rate.len() / 4 * 4;
+        let twos = fours + (rate.len() - fours) / 2 * 2;
+        let (four_rows, rest) = self.series.split_at(fours * w);
+        let (two_rows, one_rows) = rest.split_at((twos - fours) * w);
+        let solves = four_rows
+            .chunks_exact(4 * w)
+            .zip(rate[..fours].chunks_exact(4))
+            .all(|(c, f)| defects_within::<4>(c, f, h, tolerance))
+            && two_rows
+                .chunks_exact(2 * w)
+                .zip(rate[fours..twos].chunks_exact(2))
+                .all(|(c, f)| defects_within::<2>(c, f, h, tolerance))
+            && one_rows
+                .chunks_exact(w)
+                .zip(&rate[twos..])
+                .all(|(c, f)| defects_within::<1>(c, std::slice::from_ref(f), h, tolerance));
         (self.end, self.rate) = (end, rate);
         self.end_known = solves;
         solves
@@ -232,9 +241,7 @@ impl Taylor {
     /// period cancel, and plain Horner's few ulps per step would add up
     /// over millions of steps to the phase error the run is after).
     pub fn eval(&self, tau: f64, x: &mut [f64]) {
-        for (xi, c) in x.iter_mut().zip(self.series.chunks_exact(self.order + 1)) {
-            *xi = eval_compensated(c, tau);
-        }
+        eval_compensated_rows(&self.series, self.order + 1, tau, x);
     }
 
     /// The state at the end of the step (found by the step's own check of
@@ -342,6 +349,24 @@ pub(crate) fn locate_on_series<M: HybridModel + ?Sized>(
         margin,
         margin_at: (at / h).min(1.0),
     })
+}
+
+/// Whether each of `L` components' series (`c`, one after another) solves
+/// the flow at `h`: the series' derivative there against the flow `f`,
+/// times `h`, within `tolerance` or the rounding of both.
+fn defects_within<const L: usize>(c: &[f64], f: &[f64], h: f64, tolerance: f64) -> bool {
+    let w = c.len() / L;
+    // The series' derivatives at h, and the sizes of their terms.
+    let mut slope = [0.0; L];
+    let mut size: [f64; L] = std::array::from_fn(|l| f[l].abs());
+    for k in (1..w).rev() {
+        for l in 0..L {
+            let ck = c[l * w + k];
+            slope[l] = slope[l] * h + k as f64 * ck;
+            size[l] = size[l] * h + k as f64 * ck.abs();
+        }
+    }
+    (0..L).all(|l| (slope[l] - f[l]).abs() * h <= tolerance + 16.0 * f64::EPSILON * size[l] * h)
 }
 
 /// The order for `tolerances`: `ceil(-ln(eps) / 2) + 1`, `eps = min(rtol,
@@ -549,6 +574,31 @@ mod tests {
         assert!(end > 0.1 && end < 0.2, "{end}");
         assert!(stays_above(&c, h, 0.1));
         assert!(!stays_above(&c, h, 0.2));
+    }
+
+    #[test]
+    fn four_defects_at_once_are_each_defect_alone() {
+        // The series of e^t (coefficients 1/k!) against the flow e^h, and
+        // three others off by growing amounts: four lanes must pass exactly
+        // when each lane alone passes, at tolerances either side of the
+        // defects.
+        let (w, h) = (20, 0.5_f64);
+        let factorial = |k: usize| (1..=k).map(|i| i as f64).product::<f64>();
+        let c: Vec<f64> = (0..4)
+            .flat_map(|l| (0..w).map(move |k| (1.0 + 1e-9 * l as f64) / factorial(k)))
+            .collect();
+        let f = [h.exp(); 4];
+        for tolerance in [1e-14, 1e-10, 3e-10, 1e-9, 1.0] {
+            let alone = (0..4)
+                .all(|l| defects_within::<1>(&c[l * w..(l + 1) * w], &f[l..=l], h, tolerance));
+            assert_eq!(
+                defects_within::<4>(&c, &f, h, tolerance),
+                alone,
+                "{tolerance}"
+            );
+        }
+        assert!(defects_within::<1>(&c[..w], &f[..1], h, 1e-14));
+        assert!(!defects_within::<1>(&c[3 * w..], &f[..1], h, 1e-10));
     }
 
     #[test]

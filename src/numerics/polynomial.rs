@@ -54,6 +54,62 @@ pub fn eval_compensated_plus(c: &[f64], s: f64, extra: f64) -> f64 {
     sum + (error + extra)
 }
 
+/// Each row of `rows` (coefficients `width` apiece, one polynomial after
+/// another) at `s` into `out`, by compensated Horner
+/// ([`eval_compensated`], bit for bit). Rows run four (then two) in
+/// lockstep: each row's Horner chain waits on its last step, and
+/// independent chains fill the time one would leave idle.
+pub fn eval_compensated_rows(rows: &[f64], width: usize, s: f64, out: &mut [f64]) {
+    if width == 0 {
+        out.fill(-0.0);
+        return;
+    }
+    let count = out.len().min(rows.len() / width);
+    let fours = count / 4 * 4;
+    let twos = fours + (count - fours) / 2 * 2;
+    let (four_rows, rest) = rows[..count * width].split_at(fours * width);
+    let (two_rows, one_rows) = rest.split_at((twos - fours) * width);
+    let (four_out, rest) = out[..count].split_at_mut(fours);
+    let (two_out, one_out) = rest.split_at_mut(twos - fours);
+    for (group, out) in four_rows
+        .chunks_exact(4 * width)
+        .zip(four_out.chunks_exact_mut(4))
+    {
+        lockstep::<4>(group, width, s, out);
+    }
+    for (group, out) in two_rows
+        .chunks_exact(2 * width)
+        .zip(two_out.chunks_exact_mut(2))
+    {
+        lockstep::<2>(group, width, s, out);
+    }
+    for (c, o) in one_rows.chunks_exact(width).zip(one_out) {
+        *o = eval_compensated(c, s);
+    }
+}
+
+/// [`eval_compensated`] of `L` rows of `width >= 1` coefficients at once.
+#[inline(always)]
+fn lockstep<const L: usize>(group: &[f64], width: usize, s: f64, out: &mut [f64]) {
+    let mut sum: [f64; L] = std::array::from_fn(|l| group[l * width + width - 1]);
+    let mut error = [0.0; L];
+    for k in (0..width - 1).rev() {
+        for l in 0..L {
+            let ck = group[l * width + k];
+            let product = sum[l] * s;
+            let product_error = sum[l].mul_add(s, -product);
+            let next = product + ck;
+            let t = next - product;
+            let sum_error = (product - (next - t)) + (ck - t);
+            error[l] = error[l] * s + (product_error + sum_error);
+            sum[l] = next;
+        }
+    }
+    for l in 0..L {
+        out[l] = sum[l] + (error[l] + -0.0);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -67,6 +123,33 @@ mod tests {
         assert_eq!(eval(&[], 3.0), 0.0);
         assert_eq!(eval_compensated(&c, 1.5), 0.875);
         assert_eq!(eval_compensated(&[], 3.0), 0.0);
+    }
+
+    #[test]
+    fn rows_in_lockstep_are_each_row_alone() {
+        // One to nine rows (groups of four, of two, and one left over) of a
+        // width with cancelling terms: each must equal its own compensated
+        // Horner, bit for bit.
+        let width = 7;
+        let rows: Vec<f64> = (0..9 * width)
+            .map(|k| ((k * 37 % 11) as f64 - 5.0) * 1.3f64.powi((k % width) as i32))
+            .collect();
+        for count in 1..=9 {
+            for s in [0.0, -0.7, 0.37, 1.9] {
+                let mut out = vec![f64::NAN; count];
+                eval_compensated_rows(&rows[..count * width], width, s, &mut out);
+                for (o, c) in out.iter().zip(rows.chunks_exact(width)) {
+                    assert_eq!(
+                        o.to_bits(),
+                        eval_compensated(c, s).to_bits(),
+                        "{count} at {s}"
+                    );
+                }
+            }
+        }
+        let mut out = [1.0; 3];
+        eval_compensated_rows(&[], 0, 0.5, &mut out);
+        assert!(out.iter().all(|o| *o == 0.0));
     }
 
     #[test]
