@@ -254,6 +254,15 @@ pub trait HybridModel {
         None
     }
 
+    /// The Jacobian of the flow in `mode` in the state, where it is the same
+    /// everywhere, its clock's column zero (the clock carries no error): a
+    /// linear flow's `A`, or that of a linear flow driven by a function of
+    /// time, `x' = A x + f(t)`. An error then moves by `exp(tau A)` over a
+    /// stretch `tau`, exactly, wherever the state is.
+    fn constant_jacobian(&self, mode: Mode) -> Option<DMatrix<f64>> {
+        self.linear(mode).map(|(a, _)| a)
+    }
+
     /// Whether the flow in `mode` is linear (what [`linear`](HybridModel::linear)
     /// says), without building its matrices: a model whose `A` is large
     /// answers cheaply.

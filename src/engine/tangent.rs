@@ -20,10 +20,10 @@ use crate::numerics::central_difference::step_for;
 #[derive(Debug, Clone)]
 pub struct Tangents {
     n: usize,
-    /// The exact Jacobian of the last mode asked about, if its flow is
-    /// linear.
+    /// The Jacobian of the last mode asked about, if it is constant (a
+    /// linear flow, or one driven by a function of time).
     linear: Option<(Mode, Option<Vec<f64>>)>,
-    /// The last tangent of a linear flow and its `tau`: a fixed-step method
+    /// The last tangent of such a flow and its `tau`: a fixed-step method
     /// asks for the same one at every step.
     linear_tangent: Option<(f64, Vec<f64>)>,
     x: Vec<f64>,
@@ -74,14 +74,14 @@ impl Tangents {
         }
     }
 
-    /// `A` if `mode`'s flow is linear, `x' = A x + b` (asked of the model
-    /// once per change of mode).
+    /// `A` if `mode`'s flow is `x' = A x + f(t)` (asked of the model once
+    /// per change of mode).
     fn linear_part<M: HybridModel + ?Sized>(&mut self, model: &M, mode: Mode) -> Option<&[f64]> {
         let n = self.n;
         if self.linear.as_ref().is_none_or(|(m, _)| *m != mode) {
             let exact = model
-                .linear(mode)
-                .map(|(a, _)| (0..n * n).map(|k| a[(k / n, k % n)]).collect());
+                .constant_jacobian(mode)
+                .map(|a| (0..n * n).map(|k| a[(k / n, k % n)]).collect());
             self.linear = Some((mode, exact));
             self.linear_tangent = None;
         }

@@ -68,6 +68,9 @@ struct CompiledMode {
     rest: Option<Reset>,
     kind: Flow,
     linear: Option<(DMatrix<f64>, DVector<f64>)>,
+    /// The flow's Jacobian in the state where it is constant (linear, or
+    /// linear and driven by the clock), its clock's column zero.
+    constant_jacobian: Option<DMatrix<f64>>,
     second_order: bool,
     /// Where the mode reads `abs`, `min` or `max` (its flow, or a guard by
     /// name), if it does: no Taylor series there. `None`: they hold over
@@ -325,6 +328,22 @@ impl Automaton {
                 flow.eval_scratch(&vec![0.0; n], &mut b);
                 (a, DVector::from_vec(b))
             });
+            let clock_input = clock.then(|| (n - 1) as u32);
+            let constant_jacobian = match &linear {
+                Some((a, _)) => Some(a.clone()),
+                None if clock && flow.affine_beside(clock_input) => {
+                    // The same at every state: read at the origin, at
+                    // t = 1 (a forcing may be singular at t = 0, and its
+                    // infinite slope would turn the state's zero
+                    // derivatives into NaN).
+                    let mut at = vec![0.0; n];
+                    at[n - 1] = 1.0;
+                    let mut a = jacobian(&flow, &at);
+                    a.column_mut(n - 1).fill(0.0);
+                    a.iter().all(|v| v.is_finite()).then_some(a)
+                }
+                None => None,
+            };
             let half = n / 2;
             let second_order = !clock
                 && n % 2 == 0
@@ -361,6 +380,7 @@ impl Automaton {
                 rest,
                 kind: if still { Flow::Frozen } else { Flow::Ode },
                 linear,
+                constant_jacobian,
                 second_order,
             });
         }
@@ -593,6 +613,10 @@ impl HybridModel for Automaton {
         self.modes[mode].linear.is_some()
     }
 
+    fn constant_jacobian(&self, mode: Mode) -> Option<DMatrix<f64>> {
+        self.modes[mode].constant_jacobian.clone()
+    }
+
     fn reset(&self, mode: Mode, guard: usize, x: &mut [f64]) -> Jump {
         let m = &self.modes[mode];
         let reset = &m.resets[guard];
@@ -724,6 +748,39 @@ thread_local! {
 mod tests {
     use crate::engine::model::HybridModel;
     use crate::models::automaton::{AutomatonBuilder, TransitionBuilder};
+
+    /// A driven linear oscillator's Jacobian in the state is constant
+    /// (its clock's column zero); a parametric one's, `x'' = -(1 + cos t)
+    /// x`, is not, nor a nonlinear one's.
+    #[test]
+    fn a_driven_linear_flow_has_a_constant_jacobian() {
+        let model = |rate: &str| {
+            AutomatonBuilder::new()
+                .parameter("z", 0.25)
+                .state("x", 1.0)
+                .state("v", 0.0)
+                .mode("m", [("x", "v"), ("v", rate)], [])
+                .build()
+                .unwrap()
+        };
+        let driven = model("cos(0.8 * t) - 2 * z * v - 4 * x");
+        assert_eq!(driven.clock(), Some(2));
+        let a = driven.constant_jacobian(0).expect("constant");
+        #[rustfmt::skip]
+        let want = [
+            0.0, 1.0, 0.0,
+            -4.0, -0.5, 0.0,
+            0.0, 0.0, 0.0,
+        ];
+        assert_eq!(a.transpose().as_slice(), want);
+        // A model's own linear flow: its A.
+        let free = model("-2 * z * v - 4 * x");
+        assert_eq!(free.constant_jacobian(0), free.linear(0).map(|(a, _)| a));
+        assert!(free.constant_jacobian(0).is_some());
+        for rate in ["-(1 + cos(t)) * x", "-sin(x)", "-t * v"] {
+            assert_eq!(model(rate).constant_jacobian(0), None, "{rate}");
+        }
+    }
 
     /// The energy and each transition's reset are compiled once warmed up
     /// (64 calls): past that, each still reads its own expression, at

@@ -330,22 +330,40 @@ impl Tape {
     /// judged from the instructions: products and quotients by constants,
     /// sums, negations; anything else of an input is not.
     pub fn affine(&self) -> bool {
-        // 0: constant, 1: affine, 2: not.
-        let mut degree = vec![0u8; self.ops.len()];
+        self.affine_beside(None)
+    }
+
+    /// Whether every output is `A x + f(t)`: affine in the inputs other
+    /// than `forcing` (the clock `t`), with constant coefficients, plus any
+    /// function of `forcing` alone. A driven linear oscillator's flow is;
+    /// its Jacobian in the state is then the same everywhere. Judged as
+    /// [`affine`](Tape::affine) is, a term that reads only `forcing` being
+    /// free to enter any function or product but another such term's.
+    pub fn affine_beside(&self, forcing: Option<u32>) -> bool {
+        // Each register's kind, ordered: a constant, a function of the
+        // forcing alone, affine in the others, neither.
+        const CONSTANT: u8 = 0;
+        const FORCING: u8 = 1;
+        const AFFINE: u8 = 2;
+        const OTHER: u8 = 3;
+        let mut kind = vec![CONSTANT; self.ops.len()];
         for (i, op) in self.ops.iter().enumerate() {
-            let d = |r: Reg| degree[r as usize];
-            degree[i] = match *op {
-                Op::Const(_) => 0,
-                Op::Input(_) => 1,
-                Op::Add(a, b) | Op::Sub(a, b) => d(a).max(d(b)),
-                Op::Neg(a) => d(a),
-                Op::Mul(a, b) if d(a) == 0 || d(b) == 0 => d(a).max(d(b)),
-                Op::Div(a, b) if d(b) == 0 => d(a),
-                _ if op.operands().all(|r| d(r) == 0) => 0,
-                _ => 2,
+            let k = |r: Reg| kind[r as usize];
+            kind[i] = match *op {
+                Op::Const(_) => CONSTANT,
+                Op::Input(j) if Some(j) == forcing => FORCING,
+                Op::Input(_) => AFFINE,
+                Op::Add(a, b) | Op::Sub(a, b) => k(a).max(k(b)),
+                Op::Neg(a) => k(a),
+                Op::Mul(a, b) if k(a) == CONSTANT || k(b) == CONSTANT => k(a).max(k(b)),
+                Op::Div(a, b) if k(b) == CONSTANT => k(a),
+                _ => match op.operands().map(k).max().unwrap_or(CONSTANT) {
+                    kind if kind <= FORCING => kind,
+                    _ => OTHER,
+                },
             };
         }
-        self.outputs.iter().all(|&r| degree[r as usize] <= 1)
+        self.outputs.iter().all(|&r| kind[r as usize] <= AFFINE)
     }
 
     /// Whether every instruction is smooth: no `abs`, `sign`, `min` or
@@ -709,6 +727,30 @@ mod tests {
         let tape = compile(&["v", "-k*x + sin(t)"]).unwrap();
         assert!(tape.depends_on(0, 1) && !tape.depends_on(0, 0));
         assert!(tape.depends_on(1, 0) && tape.depends_on(1, 2) && !tape.depends_on(1, 1));
+    }
+
+    #[test]
+    fn a_linear_flow_driven_by_the_clock_is_affine_beside_it() {
+        // The clock is input 2: a function of it alone may be added, and
+        // may multiply constants or other functions of it, but not a state.
+        let t = Some(2);
+        for text in [
+            "g*cos(k*t) - 2*v - x",
+            "sin(t)*cos(t) + x/k",
+            "t/2 - v + exp(-t^2)",
+            "(x + sqrt(t + 1)) - k*(v - t)",
+        ] {
+            assert!(compile(&[text]).unwrap().affine_beside(t), "{text}");
+        }
+        for text in ["t*x", "x/t", "cos(t + x)", "x*v + t", "sin(t)*v", "x^2"] {
+            assert!(!compile(&[text]).unwrap().affine_beside(t), "{text}");
+        }
+        // Without a forcing, it is `affine`: t is a state like the others.
+        for text in ["g*cos(k*t) - x", "2*x - v/k + 3"] {
+            let tape = compile(&[text]).unwrap();
+            assert_eq!(tape.affine_beside(None), tape.affine(), "{text}");
+        }
+        assert!(!compile(&["g*cos(k*t) - x"]).unwrap().affine());
     }
 
     #[test]
