@@ -169,17 +169,18 @@ mod x64 {
             );
         }
 
-        /// `sum_{j = lo..=k} a_j b_{k - j}` into `x`, from zero upwards.
+        /// `sum_{j in terms} a_j b_{k - j}` into `x`, from zero upwards (the
+        /// terms of `lo..=k` that are not known zeros).
         pub fn product(
             &mut self,
             x: u8,
             a: impl Fn(usize) -> Place,
             b: impl Fn(usize) -> Place,
             k: usize,
-            lo: usize,
+            terms: std::ops::RangeInclusive<usize>,
         ) {
             self.zero(x);
-            for j in lo..=k {
+            for j in terms {
                 self.load(1, a(j));
                 self.mul(1, b(k - j));
                 self.add_registers(x, 1);

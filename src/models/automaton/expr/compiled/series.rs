@@ -17,7 +17,7 @@ use crate::engine::taylor_method::MAX_ORDER;
 use crate::models::automaton::expr::compiled::layout::Layout;
 use crate::models::automaton::expr::compiled::machine::Code;
 use crate::models::automaton::expr::compiled::tiered::Tiered;
-use crate::models::automaton::expr::tape::{Op, Tape};
+use crate::models::automaton::expr::tape::{Op, Reg, Tape};
 
 /// A flow's series at each order, compiled once warmed up (see
 /// `tiered.rs`; a run asks for one order, a sweep over tolerances for a
@@ -135,6 +135,48 @@ fn terms(tape: &Tape, order: usize) -> usize {
         .saturating_mul(order + 1)
 }
 
+/// The degree of each register's series where it is a polynomial in the
+/// step (a constant's is 0, the clock's 1, a product's the sum), else
+/// `usize::MAX`. A state is a polynomial of one degree more than its rate
+/// where that is one. Coefficients past a register's degree are exact
+/// zeros, so the Cauchy sums leave out the terms they would multiply: a
+/// forcing `cos(w t)` then costs one term an order, not `k`. Leaving out
+/// an exact zero moves no sum (one that starts at `+0` never becomes
+/// `-0`), so the code still gives the interpreter's bits.
+#[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
+pub(super) fn degrees(tape: &Tape) -> Vec<usize> {
+    const ANY: usize = usize::MAX;
+    let mut states = vec![ANY; tape.outputs.len()];
+    let mut degree = vec![ANY; tape.ops.len()];
+    // Each pass settles at least one more state of a chain of polynomials
+    // (t, then t^2 / 2, ...), or none at all.
+    for _ in 0..=states.len() {
+        for (i, op) in tape.ops.iter().enumerate() {
+            let d = |r: Reg| degree[r as usize];
+            degree[i] = match *op {
+                Op::Const(_) => 0,
+                Op::Input(j) => states[j as usize],
+                Op::Add(a, b) | Op::Sub(a, b) => d(a).max(d(b)),
+                Op::Neg(a) => d(a),
+                Op::Mul(a, b) => d(a).saturating_add(d(b)),
+                Op::Div(a, b) if d(b) == 0 => d(a),
+                _ if op.operands().all(|r| d(r) == 0) => 0,
+                _ => ANY,
+            };
+        }
+        let next: Vec<usize> = tape
+            .outputs
+            .iter()
+            .map(|&o| degree[o as usize].saturating_add(1))
+            .collect();
+        if next == states {
+            break;
+        }
+        states = next;
+    }
+    degree
+}
+
 #[cfg(not(target_arch = "x86_64"))]
 fn lower(_: &Tape, _: &Layout, _: usize) -> Option<Code> {
     None
@@ -184,6 +226,12 @@ fn lower(tape: &Tape, layout: &Layout, order: usize) -> Option<Code> {
 
     let mut e = Emitter::new()?;
     let constant = |r: u32| matches!(tape.ops[r as usize], Op::Const(_));
+    let degree = degrees(tape);
+    // The terms `j` of a Cauchy sum `sum_j a_j b_(k - j)` (from `lo`) whose
+    // factors are not past their degrees.
+    let terms = |a: u32, b: u32, k: usize, lo: usize| {
+        lo.max(k.saturating_sub(degree[b as usize]))..=k.min(degree[a as usize])
+    };
     let width = order + 1;
     for k in 0..order {
         for (r, &op) in tape.ops.iter().enumerate() {
@@ -211,14 +259,26 @@ fn lower(tape: &Tape, layout: &Layout, order: usize) -> Option<Code> {
                     e.load(0, layout.at(a, k));
                     e.mul(0, layout.at(b, 0));
                 }
-                Op::Mul(a, b) => e.product(0, |j| layout.at(a, j), |j| layout.at(b, j), k, 0),
+                Op::Mul(a, b) => e.product(
+                    0,
+                    |j| layout.at(a, j),
+                    |j| layout.at(b, j),
+                    k,
+                    terms(a, b, k, 0),
+                ),
                 Op::Div(a, b) if constant(b) => {
                     e.load(0, layout.at(a, k));
                     e.div(0, layout.at(b, 0));
                 }
                 Op::Div(a, b) => {
                     // a = q b: q_k = (a_k - sum_{j=1..k} b_j q_{k-j}) / b_0.
-                    e.product(2, |j| layout.at(b, j), |j| layout.at(r, j), k, 1);
+                    e.product(
+                        2,
+                        |j| layout.at(b, j),
+                        |j| layout.at(r, j),
+                        k,
+                        terms(b, r, k, 1),
+                    );
                     e.load(0, layout.at(a, k));
                     e.sub_registers(0, 2);
                     e.div(0, layout.at(b, 0));
@@ -241,7 +301,7 @@ fn lower(tape: &Tape, layout: &Layout, order: usize) -> Option<Code> {
                     // partner's (into xmm0) and the value's (xmm1).
                     e.zero(0);
                     e.zero(1);
-                    for j in 1..=k {
+                    for j in 1..=k.min(degree[a as usize]) {
                         e.load(2, layout.integer(j));
                         e.mul(2, layout.at(a, j));
                         e.copy(3, 2);
@@ -277,7 +337,7 @@ fn lower(tape: &Tape, layout: &Layout, order: usize) -> Option<Code> {
                     }
                     // e' = a' e.
                     e.zero(0);
-                    for j in 1..=k {
+                    for j in 1..=k.min(degree[a as usize]) {
                         e.load(2, layout.integer(j));
                         e.mul(2, layout.at(a, j));
                         e.mul(2, layout.at(r, k - j));

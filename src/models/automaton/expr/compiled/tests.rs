@@ -5,6 +5,7 @@ use super::*;
 use crate::engine::taylor_method::MAX_ORDER;
 use crate::models::automaton::expr::recurrences::Series;
 use crate::models::automaton::expr::recurrences::tests::tape;
+use crate::models::automaton::expr::tape::Op;
 
 /// Both series of `texts` from `x0`, bit for bit, at a few orders.
 fn same_as_interpreted(texts: &[&str], inputs: &[&str], x0: &[f64]) {
@@ -33,6 +34,36 @@ fn same_as_interpreted(texts: &[&str], inputs: &[&str], x0: &[f64]) {
     }
 }
 
+/// The degrees the compiled sums stop at: the clock's 1, a state driven
+/// by it one more, products the sum, anything of a state that is not a
+/// polynomial none; and each such coefficient is zero in the series.
+#[test]
+fn polynomial_states_have_their_degrees() {
+    let t = tape(
+        &["1", "t", "p * t", "-x + q * cos(2 * t)"],
+        &["t", "p", "q", "x"],
+    );
+    let degree = series::degrees(&t);
+    let input = |j: u32| {
+        let r = t.ops.iter().position(|op| *op == Op::Input(j)).unwrap();
+        degree[r]
+    };
+    assert_eq!(
+        [input(0), input(1), input(2), input(3)],
+        [1, 2, 4, usize::MAX]
+    );
+    let order = 9;
+    let mut out = vec![0.0; 4 * (order + 1)];
+    Series::default().flow(&t, &[0.5, 0.25, -1.0, 0.3], order, &mut out);
+    for (i, d) in [1, 2, 4].into_iter().enumerate() {
+        let c = &out[i * (order + 1)..(i + 1) * (order + 1)];
+        assert!(
+            c[d] != 0.0 && c[d + 1..].iter().all(|&x| x == 0.0),
+            "{i}: {c:?}"
+        );
+    }
+}
+
 #[test]
 fn every_compiled_instruction_gives_the_interpreters_bits() {
     let xy = ["x", "y"];
@@ -56,6 +87,22 @@ fn every_compiled_instruction_gives_the_interpreters_bits() {
         &["v", "-x - 0.1 * v + 0.5 * cos(1.3 * t)", "1"],
         &["x", "v", "t"],
         &[0.3, 0.0, 12.5],
+    );
+    // Polynomials in the step, whose Cauchy sums leave out the terms past
+    // their degrees: the clock (degree 1), a state driven by it (p' = t,
+    // degree 2) and by that one (q' = p t, degree 4), in products,
+    // quotients and functions with states that are not polynomials, and a
+    // function of constants (degree 0).
+    same_as_interpreted(
+        &[
+            "1",
+            "t",
+            "p * t",
+            "-x * (1 + q) + exp(-0.1 * t) * sin(p)",
+            "x / (2 + t) - cos(3) * x * t * p + sinh(0.5 * t) / (1 + x^2)",
+        ],
+        &["t", "p", "q", "x", "y"],
+        &[1.5, -0.25, 0.125, 0.4, -0.3],
     );
 }
 
