@@ -208,24 +208,21 @@ impl Taylor {
         self.eval(h, &mut end);
         model.rhs(mode, &end, &mut rate);
         let tolerance = 1e3 * allowed.max(self.local_error);
-        // Four (then two) components at a time: their Horner chains run
-        // side by side.
-        let fours = rate.len() / 4 * 4;
-        let twos = fours + (rate.len() - fours) / 2 * 2;
-        let (four_rows, rest) = self.series.split_at(fours * w);
-        let (two_rows, one_rows) = rest.split_at((twos - fours) * w);
-        let solves = four_rows
+        // Four components at a time, and the last one to three together:
+        // their Horner chains run side by side.
+        let whole = rate.len() / 4 * 4;
+        let (fours, rest) = self.series.split_at(whole * w);
+        let rest = &rest[..(rate.len() - whole) * w];
+        let solves = fours
             .chunks_exact(4 * w)
-            .zip(rate[..fours].chunks_exact(4))
+            .zip(rate[..whole].chunks_exact(4))
             .all(|(c, f)| defects_within::<4>(c, f, h, tolerance))
-            && two_rows
-                .chunks_exact(2 * w)
-                .zip(rate[fours..twos].chunks_exact(2))
-                .all(|(c, f)| defects_within::<2>(c, f, h, tolerance))
-            && one_rows
-                .chunks_exact(w)
-                .zip(&rate[twos..])
-                .all(|(c, f)| defects_within::<1>(c, std::slice::from_ref(f), h, tolerance));
+            && match rate.len() - whole {
+                1 => defects_within::<1>(rest, &rate[whole..], h, tolerance),
+                2 => defects_within::<2>(rest, &rate[whole..], h, tolerance),
+                3 => defects_within::<3>(rest, &rate[whole..], h, tolerance),
+                _ => true,
+            };
         (self.end, self.rate) = (end, rate);
         self.end_known = solves;
         solves

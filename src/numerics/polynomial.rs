@@ -56,35 +56,29 @@ pub fn eval_compensated_plus(c: &[f64], s: f64, extra: f64) -> f64 {
 
 /// Each row of `rows` (coefficients `width` apiece, one polynomial after
 /// another) at `s` into `out`, by compensated Horner
-/// ([`eval_compensated`], bit for bit). Rows run four (then two) in
-/// lockstep: each row's Horner chain waits on its last step, and
-/// independent chains fill the time one would leave idle.
+/// ([`eval_compensated`], bit for bit). Rows run four in lockstep, and the
+/// last one to three together: each row's Horner chain waits on its last
+/// step, and independent chains fill the time one would leave idle.
 pub fn eval_compensated_rows(rows: &[f64], width: usize, s: f64, out: &mut [f64]) {
     if width == 0 {
         out.fill(-0.0);
         return;
     }
     let count = out.len().min(rows.len() / width);
-    let fours = count / 4 * 4;
-    let twos = fours + (count - fours) / 2 * 2;
-    let (four_rows, rest) = rows[..count * width].split_at(fours * width);
-    let (two_rows, one_rows) = rest.split_at((twos - fours) * width);
-    let (four_out, rest) = out[..count].split_at_mut(fours);
-    let (two_out, one_out) = rest.split_at_mut(twos - fours);
-    for (group, out) in four_rows
+    let whole = count / 4 * 4;
+    let (fours, rest) = rows[..count * width].split_at(whole * width);
+    let (four_out, rest_out) = out[..count].split_at_mut(whole);
+    for (group, out) in fours
         .chunks_exact(4 * width)
         .zip(four_out.chunks_exact_mut(4))
     {
         lockstep::<4>(group, width, s, out);
     }
-    for (group, out) in two_rows
-        .chunks_exact(2 * width)
-        .zip(two_out.chunks_exact_mut(2))
-    {
-        lockstep::<2>(group, width, s, out);
-    }
-    for (c, o) in one_rows.chunks_exact(width).zip(one_out) {
-        *o = eval_compensated(c, s);
+    match rest_out.len() {
+        1 => lockstep::<1>(rest, width, s, rest_out),
+        2 => lockstep::<2>(rest, width, s, rest_out),
+        3 => lockstep::<3>(rest, width, s, rest_out),
+        _ => {}
     }
 }
 
