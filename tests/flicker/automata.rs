@@ -375,7 +375,9 @@ fn check_reports_modes_guards_and_the_method_it_would_use() {
     let out = flicker(&["check", &automaton("impact_oscillator.json")]);
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(
-        text.contains("and the clock t") && text.contains("method taylor"),
+        text.contains("and the clock t")
+            && text.contains("method taylor")
+            && text.contains("[affine flow driven by t]"),
         "{text}"
     );
 }
