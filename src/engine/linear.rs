@@ -39,7 +39,7 @@ use crate::engine::affine_mode::{
 use crate::engine::locate::{Start, StepScan};
 use crate::engine::model::{HybridModel, Mode};
 use crate::numerics::double_double::dot;
-use crate::numerics::polynomial::eval_compensated_plus;
+use crate::numerics::polynomial::eval_compensated_rows_plus;
 
 /// The exact propagator's working state: each mode met so far solved once,
 /// and the current step.
@@ -266,10 +266,13 @@ impl Linear {
             // The start's residual along the step, to its second order
             // (the third is below 1 / 6 of the residual, itself below half
             // an ulp), added before the one rounding.
-            let lo = self.y0_lo.iter().zip(once.iter().zip(twice));
-            for ((xi, c), (l, (a, b))) in x.iter_mut().zip(series.chunks_exact(ORDER + 1)).zip(lo) {
-                *xi = eval_compensated_plus(c, tau, l + tau * (a + 0.5 * tau * b));
-            }
+            let n = x
+                .len()
+                .min(self.y0_lo.len())
+                .min(once.len())
+                .min(twice.len());
+            let extra = |i: usize| self.y0_lo[i] + tau * (once[i] + 0.5 * tau * twice[i]);
+            eval_compensated_rows_plus(&series, ORDER + 1, tau, extra, &mut x[..n]);
             return;
         }
         let m = self.y0.len();

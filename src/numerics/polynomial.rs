@@ -60,31 +60,55 @@ pub fn eval_compensated_plus(c: &[f64], s: f64, extra: f64) -> f64 {
 /// last one to three together: each row's Horner chain waits on its last
 /// step, and independent chains fill the time one would leave idle.
 pub fn eval_compensated_rows(rows: &[f64], width: usize, s: f64, out: &mut [f64]) {
+    eval_compensated_rows_plus(rows, width, s, |_| -0.0, out);
+}
+
+/// Row `i` of `rows` at `s`, plus `extra(i)`, into `out[i]`:
+/// [`eval_compensated_plus`] of each row, bit for bit, in lockstep as
+/// [`eval_compensated_rows`].
+pub fn eval_compensated_rows_plus(
+    rows: &[f64],
+    width: usize,
+    s: f64,
+    extra: impl Fn(usize) -> f64,
+    out: &mut [f64],
+) {
     if width == 0 {
-        out.fill(-0.0);
+        for (i, o) in out.iter_mut().enumerate() {
+            *o = extra(i);
+        }
         return;
     }
     let count = out.len().min(rows.len() / width);
     let whole = count / 4 * 4;
     let (fours, rest) = rows[..count * width].split_at(whole * width);
     let (four_out, rest_out) = out[..count].split_at_mut(whole);
-    for (group, out) in fours
+    for (g, (group, out)) in fours
         .chunks_exact(4 * width)
         .zip(four_out.chunks_exact_mut(4))
+        .enumerate()
     {
-        lockstep::<4>(group, width, s, out);
+        lockstep::<4>(group, width, s, |l| extra(4 * g + l), out);
     }
+    let last = |l| extra(whole + l);
     match rest_out.len() {
-        1 => lockstep::<1>(rest, width, s, rest_out),
-        2 => lockstep::<2>(rest, width, s, rest_out),
-        3 => lockstep::<3>(rest, width, s, rest_out),
+        1 => lockstep::<1>(rest, width, s, last, rest_out),
+        2 => lockstep::<2>(rest, width, s, last, rest_out),
+        3 => lockstep::<3>(rest, width, s, last, rest_out),
         _ => {}
     }
 }
 
-/// [`eval_compensated`] of `L` rows of `width >= 1` coefficients at once.
+/// [`eval_compensated_plus`] of `L` rows of `width >= 1` coefficients at
+/// once, row `l` plus `extra(l)`.
 #[inline(always)]
-fn lockstep<const L: usize>(group: &[f64], width: usize, s: f64, out: &mut [f64]) {
+fn lockstep<const L: usize>(
+    group: &[f64],
+    width: usize,
+    s: f64,
+    extra: impl Fn(usize) -> f64,
+    out: &mut [f64],
+) {
     let mut sum: [f64; L] = std::array::from_fn(|l| group[l * width + width - 1]);
     let mut error = [0.0; L];
     for k in (0..width - 1).rev() {
@@ -100,7 +124,7 @@ fn lockstep<const L: usize>(group: &[f64], width: usize, s: f64, out: &mut [f64]
         }
     }
     for l in 0..L {
-        out[l] = sum[l] + (error[l] + -0.0);
+        out[l] = sum[l] + (error[l] + extra(l));
     }
 }
 
@@ -144,6 +168,16 @@ mod tests {
         let mut out = [1.0; 3];
         eval_compensated_rows(&[], 0, 0.5, &mut out);
         assert!(out.iter().all(|o| *o == 0.0));
+        // With an extra term per row: each row's own `plus`.
+        let extra = |i: usize| 1e-17 * (i as f64 - 3.0);
+        for count in 1..=9 {
+            let mut out = vec![f64::NAN; count];
+            eval_compensated_rows_plus(&rows[..count * width], width, 0.37, extra, &mut out);
+            for (i, (o, c)) in out.iter().zip(rows.chunks_exact(width)).enumerate() {
+                let alone = eval_compensated_plus(c, 0.37, extra(i));
+                assert_eq!(o.to_bits(), alone.to_bits(), "{count}, row {i}");
+            }
+        }
     }
 
     #[test]
