@@ -300,11 +300,11 @@ fn impact_oscillator_follows_the_piecewise_closed_form() {
 
 /// A driven linear oscillator (its Jacobian constant, so its tangent is
 /// `exp(tau A)` at every step) ends within its stated bound of the closed
-/// form, by Taylor's method and by DOP853, every rising passage within its
-/// event-time bound of a root of the closed form; the bound is no looser
-/// than a few hundred times the error it covers, and it is the bound the
-/// same flow gets, to round-off, written so that its Jacobian is taken at
-/// every step (`+ 0 * x * v`).
+/// form, by Taylor's method, DOP853 and DOPRI5, every rising passage
+/// within its event-time bound of a root of the closed form; the bound is
+/// no looser than 1e3 times the error it covers (1e4 by DOPRI5), and it is
+/// the bound the same flow gets, to round-off, written so that its
+/// Jacobian is taken at every step (`+ 0 * x * v`).
 #[test]
 fn a_driven_oscillator_ends_within_its_stated_bound() {
     let (zeta, w, t_end) = (0.05, 0.8, 1000.0);
@@ -319,7 +319,14 @@ fn a_driven_oscillator_ends_within_its_stated_bound() {
         }},
         "t_end": t_end
     });
-    for (args, largest) in [(&[][..], 1e-9), (&["--method", "dop853"][..], 1e-8)] {
+    // Dormand-Prince 5(4) steps with its fifth-order solution and states
+    // its fourth-order estimate, which overstates the error it leaves more
+    // than the others' do.
+    for (args, largest, looseness) in [
+        (&[][..], 1e-9, 1e3),
+        (&["--method", "dop853"][..], 1e-8, 1e3),
+        (&["--method", "dopri5"][..], 1e-7, 1e4),
+    ] {
         let (summary, events) = run_value(&scene, args);
         assert_eq!(summary["status"], "completed", "{args:?}: {summary}");
         let (x, v) = forced_oscillator(zeta, w, 0.0, 0.5, 0.0, t_end);
@@ -333,7 +340,7 @@ fn a_driven_oscillator_ends_within_its_stated_bound() {
         );
         assert!(bound < largest, "{args:?}: bound {bound:e}");
         assert!(
-            bound < 1e3 * error.max(1e-15),
+            bound < looseness * error.max(1e-15),
             "{args:?}: bound {bound:e}, error {error:e}"
         );
         let mut stepwise = scene.clone();
