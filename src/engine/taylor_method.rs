@@ -47,6 +47,9 @@ pub struct Taylor {
     /// A guard's series, scratch for its search.
     guard: Vec<f64>,
     h: f64,
+    /// `e^2` and `exp(-0.7 / (p - 1))`, the step rule's `h = rho / e^2 *
+    /// exp(-0.7 / (p - 1))` (one `exp` per run, not per step).
+    shrink: (f64, f64),
     local_error: f64,
     /// The state at a step's end (scratch for the step's check), and the
     /// flow there.
@@ -69,6 +72,10 @@ impl Taylor {
             guards: Vec::new(),
             guard: vec![0.0; order + 1],
             h: 0.0,
+            shrink: (
+                std::f64::consts::E.powi(2),
+                (-0.7 / (order - 1) as f64).exp(),
+            ),
             local_error: 0.0,
             end: vec![0.0; dimension],
             end_known: false,
@@ -117,15 +124,16 @@ impl Taylor {
         let Tolerances { rtol, atol } = self.tolerances;
         // Relative where the state is large enough for rtol to govern.
         let scale = if rtol * size > atol { size } else { 1.0 };
-        let radius = |k: usize| {
-            let n = norm(k);
+        // The last two coefficients' sizes, each read once.
+        let flow_norms = [norm(p - 1), norm(p)];
+        let radius = |n: f64, k: usize| {
             if n == 0.0 {
                 f64::INFINITY
             } else {
                 (scale / n).powf(1.0 / k as f64)
             }
         };
-        let mut rho = radius(p - 1).min(radius(p));
+        let mut rho = radius(flow_norms[0], p - 1).min(radius(flow_norms[1], p));
         let mut limited_by = None;
         // A guard's series must converge over the step too: a flow whose
         // series ends (a polynomial, a clock) says nothing of a guard that
@@ -133,7 +141,6 @@ impl Taylor {
         // alike, may shorten the step.
         let guards = model.guards(mode).len();
         self.guards.resize(guards * w, 0.0);
-        let flow_norms = [norm(p - 1), norm(p)];
         for g in 0..guards {
             let c = &mut self.guards[g * w..(g + 1) * w];
             model.guard_series(mode, g, &self.series, p, c);
@@ -150,22 +157,14 @@ impl Taylor {
             if within(p - 1, flow_norms[0]) && within(p, flow_norms[1]) {
                 continue;
             }
-            let guard_radius = |k: usize| {
-                let n = c[k].abs();
-                if n == 0.0 {
-                    f64::INFINITY
-                } else {
-                    (scale / n).powf(1.0 / k as f64)
-                }
-            };
-            let guard_rho = guard_radius(p - 1).min(guard_radius(p));
+            let guard_rho = radius(c[p - 1].abs(), p - 1).min(radius(c[p].abs(), p));
             if guard_rho < rho {
                 (rho, limited_by) = (guard_rho, Some(g));
             }
         }
-        let mut h = (rho / std::f64::consts::E.powi(2) * (-0.7 / (p - 1) as f64).exp()).min(h_max);
+        let mut h = (rho / self.shrink.0 * self.shrink.1).min(h_max);
         let allowed = (rtol * size).max(atol);
-        let last = norm(p);
+        let last = flow_norms[1];
         loop {
             if !(h >= h_min) {
                 return Err(match limited_by {
