@@ -5,8 +5,9 @@
 //! the linearisation makes of it. Derivatives the model does not state are
 //! differences (central, step `cbrt(eps)` of the component's size, errors
 //! of about 1e-10 relative; forward for the right-hand side's Jacobian at
-//! every step, about 1e-8), far below what a bound needs; a model's linear
-//! flow `x' = A x + b` gives its Jacobian exactly.
+//! every step, about 1e-8), far below what a bound needs; a flow whose
+//! Jacobian is constant (`x' = A x + b`, or `x' = A x + f(t)` driven by
+//! the clock) gives it exactly, and its tangent is `exp(tau A)`.
 //!
 //! [`ErrorSet`]: crate::engine::error_set::ErrorSet
 
@@ -22,10 +23,10 @@ pub struct Tangents {
     n: usize,
     /// The Jacobian of the last mode asked about, if it is constant (a
     /// linear flow, or one driven by a function of time).
-    linear: Option<(Mode, Option<Vec<f64>>)>,
+    constant: Option<(Mode, Option<Vec<f64>>)>,
     /// The last tangent of such a flow and its `tau`: a fixed-step method
     /// asks for the same one at every step.
-    linear_tangent: Option<(f64, Vec<f64>)>,
+    constant_tangent: Option<(f64, Vec<f64>)>,
     x: Vec<f64>,
     up: Vec<f64>,
     down: Vec<f64>,
@@ -59,8 +60,8 @@ impl Tangents {
     pub fn new(n: usize) -> Self {
         Tangents {
             n,
-            linear: None,
-            linear_tangent: None,
+            constant: None,
+            constant_tangent: None,
             x: vec![0.0; n],
             up: vec![0.0; n],
             down: vec![0.0; n],
@@ -76,16 +77,16 @@ impl Tangents {
 
     /// `A` if `mode`'s flow is `x' = A x + f(t)` (asked of the model once
     /// per change of mode).
-    fn linear_part<M: HybridModel + ?Sized>(&mut self, model: &M, mode: Mode) -> Option<&[f64]> {
+    fn constant_part<M: HybridModel + ?Sized>(&mut self, model: &M, mode: Mode) -> Option<&[f64]> {
         let n = self.n;
-        if self.linear.as_ref().is_none_or(|(m, _)| *m != mode) {
+        if self.constant.as_ref().is_none_or(|(m, _)| *m != mode) {
             let exact = model
                 .constant_jacobian(mode)
                 .map(|a| (0..n * n).map(|k| a[(k / n, k % n)]).collect());
-            self.linear = Some((mode, exact));
-            self.linear_tangent = None;
+            self.constant = Some((mode, exact));
+            self.constant_tangent = None;
         }
-        self.linear.as_ref().and_then(|(_, a)| a.as_deref())
+        self.constant.as_ref().and_then(|(_, a)| a.as_deref())
     }
 
     /// The Jacobian of `mode`'s (nonlinear) right-hand side at `x`, into
@@ -119,8 +120,8 @@ impl Tangents {
 
     /// The tangent map of `tau` of an ODE flow in `mode` along the states
     /// `at(s)` of a step (its dense output, `s` in `[0, tau]`):
-    /// `exp(tau J(at(tau / 2)))`, second order in `tau`. Exact for a linear
-    /// flow.
+    /// `exp(tau J(at(tau / 2)))`, second order in `tau`. Exact where the
+    /// Jacobian is constant.
     pub fn ode<M: HybridModel + ?Sized>(
         &mut self,
         model: &M,
@@ -132,28 +133,29 @@ impl Tangents {
         let n = self.n;
         let mut first = std::mem::take(&mut self.a);
         let mut x = std::mem::take(&mut self.c);
-        if self.linear_part(model, mode).is_some() {
-            // A linear flow: the tangent is exp(tau A), no states needed.
-            if let Some((known, tangent)) = &self.linear_tangent
+        if self.constant_part(model, mode).is_some() {
+            // A constant Jacobian (a linear flow, or one driven by t): the
+            // tangent is exp(tau A), no states needed.
+            if let Some((known, tangent)) = &self.constant_tangent
                 && *known == tau
             {
                 out.copy_from_slice(tangent);
                 (self.a, self.c) = (first, x);
                 return;
             }
-            if let Some((_, Some(a))) = &self.linear {
+            if let Some((_, Some(a))) = &self.constant {
                 for (o, a) in x.iter_mut().zip(a) {
                     *o = tau * a;
                 }
             }
             without_clock(n, model.clock(), &mut x);
             exp(n, &x, out);
-            match &mut self.linear_tangent {
+            match &mut self.constant_tangent {
                 Some((known, tangent)) => {
                     *known = tau;
                     tangent.copy_from_slice(out);
                 }
-                None => self.linear_tangent = Some((tau, out.to_vec())),
+                None => self.constant_tangent = Some((tau, out.to_vec())),
             }
         } else {
             // The midpoint's Jacobian: a second-order tangent (exp of the
