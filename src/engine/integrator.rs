@@ -279,6 +279,26 @@ impl Integrator {
         }
     }
 
+    /// [`Integrator::locate`] on the rest of the last step from `offset`
+    /// into it, where the method can (Taylor's: its guard series shifted);
+    /// `None` for the others, which start a new step instead.
+    pub fn locate_from<M: HybridModel + ?Sized>(
+        &mut self,
+        model: &M,
+        mode: Mode,
+        guard: usize,
+        start: Start,
+        uncertainty: f64,
+        offset: f64,
+    ) -> Option<Result<StepScan, String>> {
+        match self {
+            Integrator::Taylor(m) => {
+                Some(m.locate_from(model, mode, guard, start, uncertainty, offset))
+            }
+            _ => None,
+        }
+    }
+
     /// The correction to a crossing at `tau` into the last step where the
     /// method's dense output is less accurate than its steps (DOP853, see
     /// [`Dop853::sharpen`]); `None` for the others and where sharpening

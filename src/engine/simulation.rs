@@ -22,7 +22,7 @@ use crate::engine::labels::Labels;
 use crate::engine::ledger::{Final, Ledger};
 use crate::engine::locate::{Start, scan_step};
 use crate::engine::method::Method;
-use crate::engine::model::{Affects, Direction, HybridModel, Mode};
+use crate::engine::model::{Affects, Direction, HybridModel, Jump, Mode};
 use crate::engine::observer::{EventRecord, Observer, SETTLE};
 use crate::engine::period_record::REPLAYED_AT_ONCE;
 use crate::engine::periodic::Returns;
@@ -126,6 +126,10 @@ struct Run<'m, 's, M: HybridModel + ?Sized> {
     bound: Bound,
     /// When the integrator's current step ends, for stepped modes.
     step_end: Option<Time>,
+    /// How far into the current step the origin is: zero where a step
+    /// starts, more after a marker that let the step go on (see
+    /// [`Run::go_on`]).
+    step_offset: f64,
     /// Whether the integrator's last step starts at the current origin.
     stepped: bool,
     /// How each guard of the current mode starts the first step from the
@@ -204,6 +208,8 @@ impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
         self.state_at(t.since(self.origin), &mut before);
         let t = self.sharpen(slot, t, &mut before);
         self.set_clock(t, &mut before);
+        // How far into the current step the event is.
+        let into_step = self.step_offset + t.since(self.origin);
         self.close_segment(t.since(self.origin));
         self.after.copy_from_slice(&before);
         let jump = model.reset(mode, slot, &mut self.after);
@@ -313,6 +319,14 @@ impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
                         }
                     })
             }
+            // Only where no period is looked for (a run that logs its
+            // events, or a forced one): a step that goes on past a marker
+            // is not the same from the same state.
+            _ if (observer.wants_details() || self.clock.is_some())
+                && self.go_on(mode, slot, &jump, t, into_step)? =>
+            {
+                Ok(())
+            }
             _ => {
                 self.integrator.restart();
                 // An exact flow's guards start as its model predicts them:
@@ -344,7 +358,9 @@ impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
         // run keeps the state.
         let repeats = match self.motion {
             Motion::Exact => self.bound.idle(),
-            Motion::Stepped => self.integrator.memoryless(),
+            // A step that went on past a marker depends on where it
+            // started, not on the state the marker left.
+            Motion::Stepped => self.integrator.memoryless() && self.step_offset == 0.0,
             Motion::Frozen => false,
         };
         if !observer.wants_details() && !guard.internal && repeats && self.clock.is_none() {
@@ -504,6 +520,7 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
             ),
             stepped: false,
             step_end: None,
+            step_offset: 0.0,
             starts: Vec::new(),
             fresh: false,
             simultaneous: Vec::new(),
@@ -549,7 +566,7 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
         let next = self
             .queue
             .peek()
-            .map_or(h, |(_, later)| later.since(self.origin));
+            .map_or(h - self.step_offset, |(_, later)| later.since(self.origin));
         let reach = (1e-3 * h).min(next - tau);
         let guard = |y: &[f64]| model.guard(mode, slot, y);
         let direction = model.guards(mode)[slot].direction;
@@ -557,7 +574,8 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
         // before the crossing on the dense output.
         let before = if direction == Direction::Either {
             let mut y = std::mem::take(&mut self.after);
-            self.integrator.eval((tau - 1e-4 * h).max(0.0), &mut y);
+            self.integrator
+                .eval(self.step_offset + (tau - 1e-4 * h).max(0.0), &mut y);
             let g = guard(&y);
             self.after = y;
             if g == 0.0 {
@@ -726,6 +744,76 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
         }
     }
 
+    /// After marker `slot` fired at `t`, `into_step` into the current step,
+    /// let the step go on instead of starting a new one, where that changes
+    /// nothing but the cost: a marker of a stepped flow that left the state
+    /// and mode as they were, with no other guard due at its instant, well
+    /// inside the step, on a method that can search the rest of the step
+    /// (Taylor's: the guard's series re-expanded there). The other guards'
+    /// predictions on the step stand; the marker's own is searched anew
+    /// from where it fired. Whether it went on; where its search comes
+    /// within the errors of a graze, it does not (a new step decides).
+    fn go_on(
+        &mut self,
+        mode: Mode,
+        slot: usize,
+        jump: &Jump,
+        t: Time,
+        into_step: f64,
+    ) -> Result<bool, End> {
+        let model = self.model;
+        let guard = &model.guards(mode)[slot];
+        let h = self.integrator.h();
+        let unchanged = self.state.len() == self.before.len()
+            && self
+                .state
+                .iter()
+                .zip(&self.before)
+                .all(|(a, b)| a.to_bits() == b.to_bits());
+        let inside = self.step_end.is_some_and(|end| t < end)
+            && h - into_step > 64.0 * f64::EPSILON * t.value().abs().max(h)
+            && t.value() < self.options.t_end;
+        if !(self.motion == Motion::Stepped
+            && self.stepped
+            && jump.mode == mode
+            && jump.leaves.is_none()
+            && !guard.barrier
+            && !guard.internal
+            && unchanged
+            && inside)
+        {
+            return Ok(false);
+        }
+        let instant = t.after(end_window(t.value()));
+        self.queue.due_by(instant, &mut self.simultaneous);
+        if !self.simultaneous.is_empty() {
+            return Ok(false);
+        }
+        let local = self.local_error();
+        let uncertainty = self
+            .bound
+            .guard_uncertainty(model, mode, slot, &self.state, local);
+        let scan = match self.integrator.locate_from(
+            model,
+            mode,
+            slot,
+            Start::Spent,
+            uncertainty,
+            into_step,
+        ) {
+            Some(Ok(scan)) if scan.margin > uncertainty => scan,
+            _ => return Ok(false),
+        };
+        self.step_offset = into_step;
+        if let Some(s) = scan.crossing {
+            self.queue.schedule(slot, t.after(s * (h - into_step)));
+            if let Some(depth) = self.depths.get_mut(slot) {
+                *depth = scan.margin;
+            }
+        }
+        Ok(true)
+    }
+
     /// Decide how every guard of the current mode starts from the origin
     /// (see [`Start`]), after the event of guard `slot` of mode `from`
     /// (`fired`; `None` at `t = 0` and after settling). A crossing fires
@@ -865,6 +953,7 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
         self.check_guards()?;
         self.queue.clear();
         self.step_end = None;
+        self.step_offset = 0.0;
         let (model, mode) = (self.model, self.mode);
         let guards = model.guards(mode);
         self.motion = self.motion_of(mode)?;
@@ -1011,9 +1100,9 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
                 // error (none for an event at the step's start).
                 let h = self.integrator.h();
                 let local = self.local_error() * (tau / h).min(1.0);
-                let step = &self.integrator;
+                let (step, offset) = (&self.integrator, self.step_offset);
                 self.bound
-                    .after_step(model, mode, tau, local, |s, x| step.sample(s, x));
+                    .after_step(model, mode, tau, local, |s, x| step.sample(offset + s, x));
             }
             Motion::Exact => self.bound.after_exact(model, mode, &self.state, tau),
             _ => {}
@@ -1290,7 +1379,7 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
                 self.exact_evaluations += 1;
                 self.model.advance(self.mode, &self.state, tau, x)
             }
-            Motion::Stepped if self.stepped => self.integrator.eval(tau, x),
+            Motion::Stepped if self.stepped => self.integrator.eval(self.step_offset + tau, x),
             Motion::Stepped | Motion::Frozen => x.copy_from_slice(&self.state),
         }
     }

@@ -297,6 +297,32 @@ impl Taylor {
     }
 }
 
+impl Taylor {
+    /// [`Taylor::locate`] on what is left of the step from `offset` into
+    /// it: the guard's series re-expanded there (a Taylor shift), the
+    /// crossing a fraction of the rest, `h - offset`. What a marker that
+    /// fired inside the step asks of its own guard, the step going on.
+    pub fn locate_from<M: HybridModel + ?Sized>(
+        &mut self,
+        model: &M,
+        mode: Mode,
+        guard: usize,
+        start: Start,
+        uncertainty: f64,
+        offset: f64,
+    ) -> Result<StepScan, String> {
+        let w = self.order + 1;
+        let c = &mut self.guard;
+        c.copy_from_slice(&self.guards[guard * w..(guard + 1) * w]);
+        for k in 0..w {
+            for j in (k..w - 1).rev() {
+                c[j] += offset * c[j + 1];
+            }
+        }
+        locate_on_series(model, mode, guard, c, self.h - offset, start, uncertainty)
+    }
+}
+
 /// The first crossing of `guard` in its direction on a step of length `h`
 /// along which the guard's series is `series` (negated in place where the
 /// guard rises), as a fraction of the step, and how clearly the step

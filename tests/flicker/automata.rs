@@ -364,6 +364,56 @@ fn a_driven_oscillator_ends_within_its_stated_bound() {
     }
 }
 
+/// A marker that a Taylor step crosses twice: `theta = 0.99999` on either
+/// side of a pendulum's every peak (amplitude 1, 0.009 apart, against
+/// steps of about 0.35), so the step goes on past the first crossing and
+/// finds the second on the rest of its series. Every crossing once, each on the
+/// surface, each pair symmetric about its peak `k T`, `T = 2 pi / AGM(1,
+/// cos 1/2)`.
+#[test]
+fn a_marker_crossed_twice_in_a_step_fires_twice_on_its_surface() {
+    let scene = serde_json::json!({
+        "model": "automaton",
+        "states": ["theta", "omega"],
+        "initial": {"theta": 1.0, "omega": 0.0},
+        "modes": {"swing": {
+            "flow": {"theta": "omega", "omega": "-sin(theta)"},
+            "transitions": [{"name": "top", "guard": "theta - 0.99999", "direction": "either"}]
+        }},
+        "t_end": 50.0
+    });
+    let (summary, events) = run_value(&scene, &[]);
+    assert_eq!(summary["status"], "completed", "{summary}");
+    let (mut a, mut g) = (1.0f64, 0.5f64.cos());
+    for _ in 0..10 {
+        (a, g) = (0.5 * (a + g), (a * g).sqrt());
+    }
+    let period = std::f64::consts::TAU / a;
+    // Peaks at k T, k = 0..7 within 50; a fall after each, a rise before
+    // each from the second on.
+    assert_eq!(events.len(), 15, "{} crossings", events.len());
+    for (i, ev) in events.iter().enumerate() {
+        let theta = f(&ev["before"]["theta"]);
+        assert!(
+            (theta - 0.99999).abs() < 1e-12,
+            "crossing {i}: theta {theta}"
+        );
+    }
+    for k in 1..=7 {
+        let (rise, fall) = (f(&events[2 * k - 1]["t"]), f(&events[2 * k]["t"]));
+        let peak = k as f64 * period;
+        assert!(
+            rise < peak && peak < fall,
+            "peak {k} at {peak}: {rise}, {fall}"
+        );
+        assert!(
+            (rise + fall - 2.0 * peak).abs() < 1e-9,
+            "peak {k}: {rise} + {fall} against {}",
+            2.0 * peak
+        );
+    }
+}
+
 /// `check` says what the compiled form found: the affine flight, the
 /// second-order shape, the method and why.
 #[test]
