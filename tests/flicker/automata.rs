@@ -414,6 +414,43 @@ fn a_marker_crossed_twice_in_a_step_fires_twice_on_its_surface() {
     }
 }
 
+/// A section marker observes a run without changing it: Henon-Heiles by
+/// Taylor's method with the section `x = 0` (rising) ends in the same
+/// state, bit for bit, as without it, each step going on past each
+/// crossing. (Restarting the step at each crossing had moved the final
+/// state by 1e-13.)
+#[test]
+fn a_section_leaves_the_run_it_observes_as_it_was() {
+    let scene = |transitions: serde_json::Value| {
+        serde_json::json!({
+            "model": "automaton",
+            "states": ["x", "y", "px", "py"],
+            "initial": {"x": 0.05, "y": 0.3, "px": 0.3521363372331802, "py": 0.0},
+            "modes": {"m": {
+                "flow": {"x": "px", "y": "py", "px": "-x - 2 * x * y", "py": "-y - x^2 + y^2"},
+                "transitions": transitions
+            }},
+            "t_end": 300.0
+        })
+    };
+    let (bare, _) = run_value(&scene(serde_json::json!([])), &[]);
+    let section = serde_json::json!([{"name": "x0", "guard": "x", "direction": "rising"}]);
+    let (with, events) = run_value(&scene(section), &[]);
+    assert_eq!(with["status"], "completed", "{with}");
+    assert!(events.len() > 30, "{} crossings", events.len());
+    for key in ["x", "y", "px", "py"] {
+        let (a, b) = (f(&bare["final_state"][key]), f(&with["final_state"][key]));
+        assert_eq!(
+            a.to_bits(),
+            b.to_bits(),
+            "{key}: {a} without the section, {b} with it"
+        );
+    }
+    for ev in &events {
+        assert!(f(&ev["before"]["x"]).abs() < 1e-15, "{ev}");
+    }
+}
+
 /// `check` says what the compiled form found: the affine flight, the
 /// second-order shape, the method and why.
 #[test]
