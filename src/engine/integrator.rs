@@ -262,27 +262,10 @@ impl Integrator {
     /// Where the method locates a guard's crossing itself, on its own
     /// series (Taylor's method, see [`Taylor::locate`]; the linear
     /// propagator where the model gives its guards' series): the scan of
-    /// the last step for `guard`; `None` where the dense output is to be
-    /// scanned.
+    /// the last step for `guard`, from `offset` into it (a marker that let
+    /// the step go on: Taylor's method only); `None` where the dense output
+    /// is to be scanned, or the step cannot be searched from inside.
     pub fn locate<M: HybridModel + ?Sized>(
-        &mut self,
-        model: &M,
-        mode: Mode,
-        guard: usize,
-        start: Start,
-        uncertainty: f64,
-    ) -> Option<Result<StepScan, String>> {
-        match self {
-            Integrator::Taylor(m) => Some(m.locate(model, mode, guard, start, uncertainty)),
-            Integrator::Linear(m) => m.locate(model, mode, guard, start, uncertainty),
-            _ => None,
-        }
-    }
-
-    /// [`Integrator::locate`] on the rest of the last step from `offset`
-    /// into it, where the method can (Taylor's: its guard series shifted);
-    /// `None` for the others, which start a new step instead.
-    pub fn locate_from<M: HybridModel + ?Sized>(
         &mut self,
         model: &M,
         mode: Mode,
@@ -292,8 +275,9 @@ impl Integrator {
         offset: f64,
     ) -> Option<Result<StepScan, String>> {
         match self {
-            Integrator::Taylor(m) => {
-                Some(m.locate_from(model, mode, guard, start, uncertainty, offset))
+            Integrator::Taylor(m) => Some(m.locate(model, mode, guard, start, uncertainty, offset)),
+            Integrator::Linear(m) if offset == 0.0 => {
+                m.locate(model, mode, guard, start, uncertainty)
             }
             _ => None,
         }

@@ -793,17 +793,14 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
         let uncertainty = self
             .bound
             .guard_uncertainty(model, mode, slot, &self.state, local);
-        let scan = match self.integrator.locate_from(
-            model,
-            mode,
-            slot,
-            Start::Spent,
-            uncertainty,
-            into_step,
-        ) {
-            Some(Ok(scan)) if scan.margin > uncertainty => scan,
-            _ => return Ok(false),
-        };
+        let scan =
+            match self
+                .integrator
+                .locate(model, mode, slot, Start::Spent, uncertainty, into_step)
+            {
+                Some(Ok(scan)) if scan.margin > uncertainty => scan,
+                _ => return Ok(false),
+            };
         self.step_offset = into_step;
         if let Some(s) = scan.crossing {
             self.queue.schedule(slot, t.after(s * (h - into_step)));
@@ -1012,7 +1009,7 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
                     // A recording run proves guards clear of more (see
                     // `period_record`).
                     let searched = self.bound.scan_uncertainty(uncertainty);
-                    let scan = match self.integrator.locate(model, mode, g, start, searched) {
+                    let scan = match self.integrator.locate(model, mode, g, start, searched, 0.0) {
                         Some(Ok(scan)) => {
                             if !guard.internal {
                                 let proven = scan.margin.is_finite() || searched > uncertainty;

@@ -269,40 +269,15 @@ impl Taylor {
         self.evaluations
     }
 
-    /// The first crossing of `guard` on the step in its direction, as a
-    /// fraction of the step, and how clearly the step decides (see
-    /// [`StepScan`]; turning points are looked for only where the guard
-    /// may come within `uncertainty` of zero). How the guard counts at the
-    /// step's start is `start`'s (see [`Start`]).
+    /// The first crossing of `guard` in its direction on the rest of the
+    /// step from `offset` into it (zero: the whole step), as a fraction of
+    /// that rest, and how clearly it decides (see [`StepScan`]; turning
+    /// points are looked for only where the guard may come within
+    /// `uncertainty` of zero). How the guard counts at `offset` is
+    /// `start`'s (see [`Start`]). From inside the step (a marker that fired
+    /// there, the step going on) the guard's series is re-expanded at
+    /// `offset` by a Taylor shift.
     pub fn locate<M: HybridModel + ?Sized>(
-        &mut self,
-        model: &M,
-        mode: Mode,
-        guard: usize,
-        start: Start,
-        uncertainty: f64,
-    ) -> Result<StepScan, String> {
-        let w = self.order + 1;
-        self.guard
-            .copy_from_slice(&self.guards[guard * w..(guard + 1) * w]);
-        locate_on_series(
-            model,
-            mode,
-            guard,
-            &mut self.guard,
-            self.h,
-            start,
-            uncertainty,
-        )
-    }
-}
-
-impl Taylor {
-    /// [`Taylor::locate`] on what is left of the step from `offset` into
-    /// it: the guard's series re-expanded there (a Taylor shift), the
-    /// crossing a fraction of the rest, `h - offset`. What a marker that
-    /// fired inside the step asks of its own guard, the step going on.
-    pub fn locate_from<M: HybridModel + ?Sized>(
         &mut self,
         model: &M,
         mode: Mode,
@@ -314,7 +289,7 @@ impl Taylor {
         let w = self.order + 1;
         let c = &mut self.guard;
         c.copy_from_slice(&self.guards[guard * w..(guard + 1) * w]);
-        for k in 0..w {
+        for k in (0..w).filter(|_| offset != 0.0) {
             for j in (k..w - 1).rev() {
                 c[j] += offset * c[j + 1];
             }
