@@ -764,12 +764,8 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
         let model = self.model;
         let guard = &model.guards(mode)[slot];
         let h = self.integrator.h();
-        let unchanged = self.state.len() == self.before.len()
-            && self
-                .state
-                .iter()
-                .zip(&self.before)
-                .all(|(a, b)| a.to_bits() == b.to_bits());
+        let unchanged =
+            (self.state.iter().zip(&self.before)).all(|(a, b)| a.to_bits() == b.to_bits());
         let inside = self.step_end.is_some_and(|end| t < end)
             && h - into_step > 64.0 * f64::EPSILON * t.value().abs().max(h)
             && t.value() < self.options.t_end;

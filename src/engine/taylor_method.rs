@@ -29,7 +29,7 @@ use crate::engine::adaptive::{StepFailure, Tolerances};
 use crate::engine::locate::{Start, StepScan};
 use crate::engine::model::{Direction, HybridModel, Mode};
 use crate::numerics::first_crossing::{eval2, first_fall};
-use crate::numerics::polynomial::{eval, eval_compensated_rows};
+use crate::numerics::polynomial::{eval, eval_compensated_rows, shift};
 
 /// The tolerance `taylor` takes unless told: machine epsilon, as heyoka.
 pub const DEFAULT_TOLERANCE: f64 = f64::EPSILON;
@@ -289,11 +289,7 @@ impl Taylor {
         let w = self.order + 1;
         let c = &mut self.guard;
         c.copy_from_slice(&self.guards[guard * w..(guard + 1) * w]);
-        for k in (0..w).filter(|_| offset != 0.0) {
-            for j in (k..w - 1).rev() {
-                c[j] += offset * c[j + 1];
-            }
-        }
+        shift(c, offset);
         locate_on_series(model, mode, guard, c, self.h - offset, start, uncertainty)
     }
 }

@@ -13,7 +13,7 @@
 //! first root found is the earliest; none can be missed.
 
 use crate::numerics::fused::mul_add;
-use crate::numerics::polynomial::eval;
+use crate::numerics::polynomial::{eval, shift};
 
 /// `(p(s), p'(s), p''(s))` of `p = sum c[k] s^k`.
 pub fn eval2(c: &[f64], s: f64) -> (f64, f64, f64) {
@@ -171,15 +171,9 @@ pub fn search_fall(c: &[f64], a: f64, b: f64) -> Result<Option<f64>, String> {
 /// division), which only a zero of `p` at `a` needs.
 fn shifted_to(c: &[f64], a: f64, (p, d1, d2): (f64, f64, f64)) -> Vec<f64> {
     let mut shifted = c.to_vec();
-    // At `a = 0` (a series that starts at the event just past) there is
-    // nothing to shift.
-    if a != 0.0 {
-        for k in 0..shifted.len() {
-            for j in (k..shifted.len() - 1).rev() {
-                shifted[j] += a * shifted[j + 1];
-            }
-        }
-    }
+    // At `a = 0` (a series that starts at the event just past) nothing
+    // moves.
+    shift(&mut shifted, a);
     for (k, x) in [p, d1, 0.5 * d2].into_iter().enumerate() {
         if let Some(s) = shifted.get_mut(k) {
             *s = x;
@@ -322,13 +316,8 @@ impl Piece<'_> {
                 // that one piece settles as much as the shift.
                 let c = shifted.insert([0.0; MAX_SHIFTED]);
                 c[..len].copy_from_slice(self.c);
-                // From the series' own origin (most searches) there is
-                // nothing to shift: the sums would only add zeros.
-                for k in (0..len).filter(|_| x0 != 0.0) {
-                    for j in (k..len - 1).rev() {
-                        c[j] += x0 * c[j + 1];
-                    }
-                }
+                // From the series' own origin (most searches) nothing moves.
+                shift(&mut c[..len], x0);
                 c
             }
         };

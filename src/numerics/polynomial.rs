@@ -54,6 +54,19 @@ pub fn eval_compensated_plus(c: &[f64], s: f64, extra: f64) -> f64 {
     sum + (error + extra)
 }
 
+/// Re-expand `c` about `a`, in place: the coefficients of `p(a + s)` in
+/// `s` (a Taylor shift by synthetic division, O(len^2)). At `a = 0` there
+/// is nothing to shift, and nothing is done (the sums would only add
+/// zeros).
+pub fn shift(c: &mut [f64], a: f64) {
+    let len = c.len();
+    for k in (0..len).filter(|_| a != 0.0) {
+        for j in (k..len - 1).rev() {
+            c[j] += a * c[j + 1];
+        }
+    }
+}
+
 /// Each row of `rows` (coefficients `width` apiece, one polynomial after
 /// another) at `s` into `out`, by compensated Horner
 /// ([`eval_compensated`], bit for bit). Rows run four in lockstep, and the
@@ -178,6 +191,20 @@ mod tests {
                 assert_eq!(o.to_bits(), alone.to_bits(), "{count}, row {i}");
             }
         }
+    }
+
+    #[test]
+    fn a_shifted_polynomial_is_the_same_polynomial_about_its_new_origin() {
+        // 2 - 3 s + s^3 about s = 1.5: p(1.5 + u) = 0.875 + 3.75 u + 4.5 u^2
+        // + u^3, exact in binary.
+        let mut c = [2.0, -3.0, 0.0, 1.0];
+        shift(&mut c, 1.5);
+        assert_eq!(c, [0.875, 3.75, 4.5, 1.0]);
+        shift(&mut c, 0.0);
+        assert_eq!(c, [0.875, 3.75, 4.5, 1.0]);
+        shift(&mut c, -1.5);
+        assert_eq!(c, [2.0, -3.0, 0.0, 1.0]);
+        shift(&mut [], 2.0);
     }
 
     #[test]
