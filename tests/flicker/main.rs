@@ -34,6 +34,7 @@ mod oscillator;
 mod phase;
 mod random_impacts;
 mod registry;
+mod regular_orbits;
 mod reproducible;
 mod rough_edges;
 mod samples;
