@@ -452,7 +452,11 @@ fn magnus(n: usize, h: f64, nodes: &[Vec<f64>; 3], out: &mut [f64]) {
 }
 
 fn magnus_sized<const N: usize>(h: f64, nodes: &[Vec<f64>; 3], out: &mut [f64]) {
-    let [a1, a2, a3] = [0, 1, 2].map(|i| square::<N>(&nodes[i], h));
+    let (a1, a2, a3) = (
+        square::<N>(&nodes[0], h),
+        square::<N>(&nodes[1], h),
+        square::<N>(&nodes[2], h),
+    );
     let root = 15f64.sqrt() / 3.0;
     let alpha1 = a2;
     let alpha2 = combine(&a3, &a1, |x, y| root * (x - y));
@@ -485,6 +489,7 @@ fn combine<const N: usize>(a: &Square<N>, b: &Square<N>, f: impl Fn(f64, f64) ->
 }
 
 /// `[a, b] = a b - b a`.
+#[inline(always)]
 fn commutator<const N: usize>(a: &Square<N>, b: &Square<N>) -> Square<N> {
     combine(&product(a, b), &product(b, a), |x, y| x - y)
 }
@@ -561,6 +566,7 @@ type Square<const N: usize> = [[f64; N]; N];
 ///
 /// The squares here are filled by loops, not `array::from_fn` or
 /// `array::map`, whose closures the compiler leaves as calls.
+#[inline(always)]
 fn square<const N: usize>(a: &[f64], scale: f64) -> Square<N> {
     let mut out = [[0.0; N]; N];
     for (row, a) in out.iter_mut().zip(a.chunks_exact(N)) {
