@@ -51,6 +51,8 @@ enum Step {
     /// `a * b`, `b` constant.
     ScaledLeft(At),
     Mul(At),
+    /// `a * a`.
+    Square(At),
     /// `a / b`, `b` constant.
     DivConst(At),
     Div(At),
@@ -108,6 +110,7 @@ impl Series {
                 Op::Neg(a) => Step::Neg(at(a, a)),
                 Op::Mul(a, b) if constant(tape, a) => Step::ScaledRight(at(a, b)),
                 Op::Mul(a, b) if constant(tape, b) => Step::ScaledLeft(at(a, b)),
+                Op::Mul(a, b) if a == b => Step::Square(at(a, a)),
                 Op::Mul(a, b) => Step::Mul(at(a, b)),
                 Op::Div(a, b) if constant(tape, b) => Step::DivConst(at(a, b)),
                 Op::Div(a, b) => Step::Div(at(a, b)),
@@ -132,6 +135,7 @@ impl Series {
                 Step::ScaledRight(At { a, b, out }) => m[out + k] = m[a] * m[b + k],
                 Step::ScaledLeft(At { a, b, out }) => m[out + k] = m[a + k] * m[b],
                 Step::Mul(At { a, b, out }) => m[out + k] = product(m, a, m, b, k, 0),
+                Step::Square(At { a, out, .. }) => m[out + k] = square(m, a, k),
                 Step::DivConst(At { a, b, out }) => m[out + k] = m[a + k] / m[b],
                 Step::Div(At { a, b, out }) => {
                     let sum = if k == 0 {
@@ -411,6 +415,27 @@ fn product(x: &[f64], xs: usize, y: &[f64], ys: usize, k: usize, lo: usize) -> f
     sum
 }
 
+/// Coefficient `k` of `x^2` from `x`'s orders `0..=k` (at `xs`): each
+/// pair `x_j x_(k-j)`, `j < k - j`, once, in increasing `j` from `+0`, the
+/// sum doubled (exactly), then the middle term `x_(k/2)^2` of an even `k`.
+/// Half the terms of [`product`], and fewer roundings: heyoka sums a
+/// square so too. Order 0 is the product's, `0 + x_0^2`.
+#[inline(always)]
+fn square(x: &[f64], xs: usize, k: usize) -> f64 {
+    if k == 0 {
+        return product(x, xs, x, xs, 0, 0);
+    }
+    let mut sum = 0.0;
+    for j in 0..=(k - 1) / 2 {
+        sum += x[xs + j] * x[xs + k - j];
+    }
+    sum += sum;
+    if k % 2 == 0 {
+        sum += x[xs + k / 2] * x[xs + k / 2];
+    }
+    sum
+}
+
 /// `sum_{j=1}^{k} j a_j y_{k-j}` and the same with `z` (if given: empty
 /// for none), `k + 1 = a.len()`, `y` and `z` holding orders `0..k`: the
 /// coefficient `k - 1` of `a' y` and `a' z`, in one pass.
@@ -492,6 +517,24 @@ pub(crate) mod tests {
     }
 
     /// x' = v, v' = -x from (1, 0): x = cos t, v = -sin t.
+    #[test]
+    fn a_square_sums_each_pair_once_and_doubles_it() {
+        // (1 + 2 s + 3 s^2 + 4 s^3 + 5 s^4)^2: 1, 4, 10, 20, 35, in integers
+        // (exact either way), and the product's value where they round.
+        let x = [1.0, 2.0, 3.0, 4.0, 5.0];
+        for (k, want) in [1.0, 4.0, 10.0, 20.0, 35.0].into_iter().enumerate() {
+            assert_eq!(square(&x, 0, k), want, "order {k}");
+        }
+        let x = [0.7, -0.31, 0.123, 1.0 / 3.0, -0.2718, 0.05];
+        for k in 0..x.len() {
+            let (s, p) = (square(&x, 0, k), product(&x, 0, &x, 0, k, 0));
+            assert!(
+                (s - p).abs() <= 4.0 * f64::EPSILON * p.abs().max(0.1),
+                "order {k}: {s} against {p}"
+            );
+        }
+    }
+
     #[test]
     fn the_harmonic_oscillator_expands_to_cosine_and_sine() {
         let t = tape(&["v", "-x"], &["x", "v"]);

@@ -259,6 +259,20 @@ fn lower(tape: &Tape, layout: &Layout, order: usize) -> Option<Code> {
                     e.load(0, layout.at(a, k));
                     e.mul(0, layout.at(b, 0));
                 }
+                // A square as the interpreter's (`recurrences::square`):
+                // each pair once, doubled, then the middle term; the terms
+                // past its degree are exact zeros and left out.
+                Op::Mul(a, b) if a == b && k >= 1 => {
+                    let terms = terms(a, a, k, 0);
+                    let pairs = *terms.start()..=(*terms.end()).min((k - 1) / 2);
+                    e.product(0, |j| layout.at(a, j), |j| layout.at(a, j), k, pairs);
+                    e.add_registers(0, 0);
+                    if k % 2 == 0 && terms.contains(&(k / 2)) {
+                        e.load(1, layout.at(a, k / 2));
+                        e.mul(1, layout.at(a, k / 2));
+                        e.add_registers(0, 1);
+                    }
+                }
                 Op::Mul(a, b) => e.product(
                     0,
                     |j| layout.at(a, j),

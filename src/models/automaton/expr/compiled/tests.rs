@@ -73,6 +73,8 @@ fn every_compiled_instruction_gives_the_interpreters_bits() {
     same_as_interpreted(&["x * c + y", "c * y - x / 3"], &xy, &state);
     same_as_interpreted(&["x / (1 + y^2)", "(x - y) / (2 + x)"], &xy, &state);
     same_as_interpreted(&["1 / (3 + x)", "-y"], &xy, &state);
+    // Squares (each pair once, doubled), and a fourth power by squaring.
+    same_as_interpreted(&["y^2 - x", "x^2 * y + y^4"], &xy, &state);
     // Functions, with their helper series.
     same_as_interpreted(&["y", "-sin(x)"], &xy, &state);
     same_as_interpreted(&["cos(x + y)", "sin(2 * x) * cos(y)"], &xy, &state);
@@ -103,6 +105,13 @@ fn every_compiled_instruction_gives_the_interpreters_bits() {
         ],
         &["t", "p", "q", "x", "y"],
         &[1.5, -0.25, 0.125, 0.4, -0.3],
+    );
+    // Squares of polynomials: their pairs and middle terms past the
+    // degree left out.
+    same_as_interpreted(
+        &["1", "t", "-x + t^2 + p^2 * x + (p * t)^2"],
+        &["t", "p", "x"],
+        &[1.5, -0.25, 0.4],
     );
 }
 
