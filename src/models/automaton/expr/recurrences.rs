@@ -430,7 +430,7 @@ fn square(x: &[f64], xs: usize, k: usize) -> f64 {
         sum += x[xs + j] * x[xs + k - j];
     }
     sum += sum;
-    if k % 2 == 0 {
+    if k.is_multiple_of(2) {
         sum += x[xs + k / 2] * x[xs + k / 2];
     }
     sum

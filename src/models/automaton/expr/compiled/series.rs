@@ -267,7 +267,7 @@ fn lower(tape: &Tape, layout: &Layout, order: usize) -> Option<Code> {
                     let pairs = *terms.start()..=(*terms.end()).min((k - 1) / 2);
                     e.product(0, |j| layout.at(a, j), |j| layout.at(a, j), k, pairs);
                     e.add_registers(0, 0);
-                    if k % 2 == 0 && terms.contains(&(k / 2)) {
+                    if k.is_multiple_of(2) && terms.contains(&(k / 2)) {
                         e.load(1, layout.at(a, k / 2));
                         e.mul(1, layout.at(a, k / 2));
                         e.add_registers(0, 1);
