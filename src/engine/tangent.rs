@@ -808,6 +808,18 @@ mod tests {
     }
 
     #[test]
+    fn a_long_step_is_cut_into_pieces_each_of_the_generators_error() {
+        // tau |J| = 2.5: three pieces of 0.83, the middle one's middle node
+        // the step's midpoint (taken once), each piece about 3e-5 off.
+        let mut tangents = Tangents::new(2);
+        let mut out = [0.0; 4];
+        let at = |s: f64, x: &mut [f64]| x.copy_from_slice(&pendulum_at(s).0);
+        tangents.ode(&Pendulum, 0, 2.5, at, &mut out);
+        let exact = pendulum_at(2.5).1;
+        assert!(farthest(&out, &exact) < 2e-4, "{out:?} against {exact:?}");
+    }
+
+    #[test]
     fn the_magnus_generator_is_of_sixth_order() {
         // One piece of `tau`, its Jacobians at its Gauss points: the local
         // error falls as tau^7 (the midpoint's exponential: tau^3).
