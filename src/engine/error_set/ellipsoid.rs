@@ -29,12 +29,11 @@ impl Ellipsoid {
         }
     }
 
-    /// Carry the set of `n` components through `m` (row-major), clearing
-    /// component `exact`, and add a local error box of half-width `local`
-    /// in the others. Inlined where `n` is known (see
-    /// [`unrolled`](super::unrolled)).
+    /// Carry the set of `n` components through `m` (row-major), and add a
+    /// local error box of half-width `local`. Inlined where `n` is known
+    /// (see [`unrolled`](super::unrolled)).
     #[inline(always)]
-    pub(super) fn map(&mut self, n: usize, m: &[f64], local: f64, exact: Option<usize>) {
+    pub(super) fn map(&mut self, n: usize, m: &[f64], local: f64) {
         let mut mp = [0.0; TRACKED * TRACKED];
         for i in 0..n {
             for j in 0..n {
@@ -48,20 +47,13 @@ impl Ellipsoid {
                 self.p[j * n + i] = v;
             }
         }
-        if let Some(c) = exact {
-            for k in 0..n {
-                self.p[c * n + k] = 0.0;
-                self.p[k * n + c] = 0.0;
-            }
-        }
         if local <= 0.0 {
             return;
         }
-        let free = n - usize::from(exact.is_some());
-        let q = free as f64 * local * local;
+        let q = n as f64 * local * local;
         let trace_p: f64 = (0..n).map(|i| self.p[i * n + i]).sum();
         let (keep, add) = if trace_p > 0.0 {
-            let ratio = (trace_p / (q * free as f64)).sqrt();
+            let ratio = (trace_p / (q * n as f64)).sqrt();
             (1.0 + 1.0 / ratio, 1.0 + ratio)
         } else {
             (0.0, 1.0)
@@ -69,7 +61,7 @@ impl Ellipsoid {
         for v in self.p[..n * n].iter_mut() {
             *v *= keep;
         }
-        for i in (0..n).filter(|&i| Some(i) != exact) {
+        for i in 0..n {
             self.p[i * n + i] += add * q;
         }
     }
@@ -102,14 +94,14 @@ mod tests {
     fn a_map_is_carried_exactly_and_balls_add_their_radii() {
         // A unit ball stretched by 3 along x: its half-widths are 3 and 1.
         let mut e = Ellipsoid::new(2);
-        e.map(2, &[1.0, 0.0, 0.0, 1.0], 1.0 / 2f64.sqrt(), None);
-        e.map(2, &[3.0, 0.0, 0.0, 1.0], 0.0, None);
+        e.map(2, &[1.0, 0.0, 0.0, 1.0], 1.0 / 2f64.sqrt());
+        e.map(2, &[3.0, 0.0, 0.0, 1.0], 0.0);
         assert!((e.along(&[1.0, 0.0]) - 3.0).abs() < 1e-12);
         assert!((e.along(&[0.0, 1.0]) - 1.0).abs() < 1e-12);
         // Two balls of radii 1 and 2: one of radius 3.
         let mut e = Ellipsoid::new(2);
-        e.map(2, &[1.0, 0.0, 0.0, 1.0], 1.0 / 2f64.sqrt(), None);
-        e.map(2, &[1.0, 0.0, 0.0, 1.0], 2.0 / 2f64.sqrt(), None);
+        e.map(2, &[1.0, 0.0, 0.0, 1.0], 1.0 / 2f64.sqrt());
+        e.map(2, &[1.0, 0.0, 0.0, 1.0], 2.0 / 2f64.sqrt());
         assert!((e.state_bound() - 3.0).abs() < 1e-12, "{}", e.state_bound());
     }
 }

@@ -68,8 +68,9 @@ pub struct ErrorSet {
     /// Set once a non-finite error entered: every bound is then infinite.
     poisoned: bool,
     /// A component that carries no error (the clock, which the engine
-    /// keeps equal to the run's time): every map clears it, and no local
-    /// error is added to it.
+    /// keeps equal to the run's time): the enclosures hold the others
+    /// alone, and every map and gradient is read without its row and
+    /// column.
     exact: Option<usize>,
 }
 
@@ -90,7 +91,16 @@ impl ErrorSet {
     /// the engine keeps equal to the run's time.
     pub fn with_exact(mut self, exact: Option<usize>) -> Self {
         self.exact = exact.filter(|&c| c < self.n);
+        if let (Some(_), Some(enclosures)) = (self.exact, &mut self.enclosures) {
+            let free = self.n - 1;
+            *enclosures = (Parallelepiped::new(free), Ellipsoid::new(free));
+        }
         self
+    }
+
+    /// The components the enclosures hold, in order: all but `exact`.
+    fn free(&self) -> impl Iterator<Item = usize> + '_ {
+        (0..self.n).filter(|&i| Some(i) != self.exact)
     }
 
     /// Whether errors are carried through flows and events in this
@@ -116,16 +126,33 @@ impl ErrorSet {
         if self.poisoned {
             return;
         }
+        if self.enclosures.is_none() {
+            return;
+        }
+        // The exact component's column multiplies no error, and its row
+        // is no error: the map of the others is `m` without them.
+        let mut reduced = [0.0; TRACKED * TRACKED];
+        let (m, k) = match self.exact {
+            None => (m, self.n),
+            Some(_) => {
+                let k = self.n - 1;
+                for (r, i) in self.free().enumerate() {
+                    for (c, j) in self.free().enumerate() {
+                        reduced[r * k + c] = m[i * self.n + j];
+                    }
+                }
+                (&reduced[..k * k], k)
+            }
+        };
         if let Some((box_, ellipsoid)) = &mut self.enclosures {
-            let exact = self.exact;
             // At every step: both maps copied for each size, their loops
             // unrolled.
             unrolled(
-                self.n,
+                k,
                 #[inline(always)]
-                |n| {
-                    box_.map(n, m, local, exact);
-                    ellipsoid.map(n, m, local, exact);
+                |k| {
+                    box_.map(k, m, local);
+                    ellipsoid.map(k, m, local);
                 },
             );
         }
@@ -159,7 +186,7 @@ impl ErrorSet {
     /// where it settles the question the ellipsoid need not be asked.
     pub fn within(&self, gradient: &[f64], spread: f64, limit: f64) -> bool {
         if let (Some((box_, _)), false) = (&self.enclosures, self.poisoned)
-            && limit > box_.along(gradient) + spread
+            && limit > box_.along(&self.reduced(gradient)) + spread
         {
             return true;
         }
@@ -174,9 +201,22 @@ impl ErrorSet {
             return f64::INFINITY;
         }
         match &self.enclosures {
-            Some((box_, ellipsoid)) => box_.along(gradient).min(ellipsoid.along(gradient)),
+            Some((box_, ellipsoid)) => {
+                let gradient = self.reduced(gradient);
+                box_.along(&gradient).min(ellipsoid.along(&gradient))
+            }
             None => gradient.iter().map(|g| g.abs()).sum::<f64>() * self.squares.sqrt(),
         }
+    }
+
+    /// `gradient`'s components along the enclosures' (the exact one
+    /// dropped), the rest zero.
+    fn reduced(&self, gradient: &[f64]) -> [f64; TRACKED] {
+        let mut out = [0.0; TRACKED];
+        for (o, i) in out.iter_mut().zip(self.free()) {
+            *o = gradient[i];
+        }
+        out
     }
 }
 
@@ -277,7 +317,7 @@ mod tests {
         let mut columns: Vec<[f64; 4]> = Vec::new();
         for _ in 0..k {
             set.map(&m, l);
-            boxed.map(4, &m, l, None);
+            boxed.map(4, &m, l);
             for c in &mut columns {
                 *c = std::array::from_fn(|i| (0..4).map(|j| m[i * 4 + j] * c[j]).sum());
             }

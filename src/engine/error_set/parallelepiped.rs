@@ -43,20 +43,16 @@ impl Parallelepiped {
         }
     }
 
-    /// Carry the set of `n` components through `m` (row-major), clearing
-    /// component `exact`, and add a local error box of half-width `local`
-    /// in the others. Inlined where `n` is known (see
-    /// [`unrolled`](super::unrolled)).
+    /// Carry the set of `n` components through `m` (row-major), and add a
+    /// local error box of half-width `local`. Inlined where `n` is known
+    /// (see [`unrolled`](super::unrolled)).
     #[inline(always)]
-    pub(super) fn map(&mut self, n: usize, m: &[f64], local: f64, exact: Option<usize>) {
+    pub(super) fn map(&mut self, n: usize, m: &[f64], local: f64) {
         let mut product = [0.0; TRACKED * TRACKED];
         // product = m * basis, column-major.
         for j in 0..n {
             for i in 0..n {
                 product[j * n + i] = (0..n).map(|k| m[i * n + k] * self.basis[j * n + k]).sum();
-            }
-            if let Some(c) = exact {
-                product[j * n + c] = 0.0;
             }
         }
         // Longest error columns first: Q's first direction follows the
@@ -95,11 +91,8 @@ impl Parallelepiped {
                 }
                 carried += dot.abs() * self.radii[j];
             }
-            let mut spread: f64 = qa.iter().map(|x| x.abs()).sum();
-            if let Some(c) = exact {
-                spread -= qa[c].abs();
-            }
-            *r = carried + spread.max(0.0) * local;
+            let spread: f64 = qa.iter().map(|x| x.abs()).sum();
+            *r = carried + spread * local;
         }
         self.radii = radii;
     }
