@@ -171,17 +171,19 @@ impl Bound {
     }
 
     /// Carry the errors over a stretch `tau` of an ODE flow in `mode` whose
-    /// states `at(s)` the step's dense output gives, adding `local`.
+    /// states `at(s)` the step's dense output gives, adding `local`; the
+    /// flow at the stretch's two ends where the step knows it.
     pub fn after_step<M: HybridModel + ?Sized>(
         &mut self,
         model: &M,
         mode: Mode,
-        tau: f64,
-        local: f64,
+        (tau, local): (f64, f64),
         at: impl FnMut(f64, &mut [f64]),
+        rates: Option<(&[f64], &[f64])>,
     ) {
         if self.errors.tracked() {
-            self.tangents.ode(model, mode, tau, at, &mut self.matrix);
+            self.tangents
+                .ode(model, mode, (tau, rates), at, &mut self.matrix);
             self.record.step(&self.matrix, local);
         } else {
             self.record.broken();

@@ -238,6 +238,16 @@ impl Integrator {
         }
     }
 
+    /// The flow at the start and at the end of a stretch `tau` from
+    /// `offset` into the step, where the method knows both without
+    /// evaluating it (Taylor's whole step).
+    pub fn rates(&self, offset: f64, tau: f64) -> Option<(&[f64], &[f64])> {
+        match self {
+            Integrator::Taylor(m) => m.rates(offset, tau),
+            _ => None,
+        }
+    }
+
     /// The state at the end of the last step.
     pub fn end(&self, x: &mut [f64]) {
         match self {

@@ -1094,8 +1094,14 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
                 let h = self.integrator.h();
                 let local = self.local_error() * (tau / h).min(1.0);
                 let (step, offset) = (&self.integrator, self.step_offset);
-                self.bound
-                    .after_step(model, mode, tau, local, |s, x| step.sample(offset + s, x));
+                let rates = step.rates(offset, tau);
+                self.bound.after_step(
+                    model,
+                    mode,
+                    (tau, local),
+                    |s, x| step.sample(offset + s, x),
+                    rates,
+                );
             }
             Motion::Exact => self.bound.after_exact(model, mode, &self.state, tau),
             _ => {}

@@ -126,13 +126,14 @@ impl Tangents {
     /// The tangent map of `tau` of an ODE flow in `mode` along the states
     /// `at(s)` of a step (its dense output, `s` in `[0, tau]`): the
     /// exponential of Magnus' sixth-order generator (`magnus`) of each
-    /// piece, the flow's direction then carried exactly (`carry_the_flow`).
+    /// piece, the flow's direction then carried exactly (`carry_the_flow`,
+    /// with the flow at the two ends, `rates`, where the step knows it).
     /// Exact where the Jacobian is constant.
     pub fn ode<M: HybridModel + ?Sized>(
         &mut self,
         model: &M,
         mode: Mode,
-        tau: f64,
+        (tau, rates): (f64, Option<(&[f64], &[f64])>),
         mut at: impl FnMut(f64, &mut [f64]),
         out: &mut [f64],
     ) {
@@ -218,7 +219,7 @@ impl Tangents {
             self.d = piece;
             self.e = product;
             self.nodes = nodes;
-            self.carry_the_flow(model, mode, tau, at, out);
+            self.carry_the_flow(model, mode, (tau, rates), at, out);
         }
         self.a = first;
         self.c = x;
@@ -235,12 +236,15 @@ impl Tangents {
     /// rank-one change `(f1 - out f0) f0^T / |f0|^2` moves no direction
     /// across `f0`, and along `f0` gives the exact answer, so it leaves no
     /// direction less accurate. Only a correction already small (1e-6 of
-    /// the rate) is made: near a rest point the rates say little.
+    /// the rate) is made: near a rest point the rates say little. The
+    /// rates are `known` where the step has them (Taylor's whole step: its
+    /// series' first coefficients, and the flow its check took at the
+    /// end), else taken at `at(0)` and `at(tau)`.
     fn carry_the_flow<M: HybridModel + ?Sized>(
         &mut self,
         model: &M,
         mode: Mode,
-        tau: f64,
+        (tau, known): (f64, Option<(&[f64], &[f64])>),
         mut at: impl FnMut(f64, &mut [f64]),
         out: &mut [f64],
     ) {
@@ -249,11 +253,17 @@ impl Tangents {
             return;
         }
         let n = self.n;
-        let (before, after, miss) = (&mut self.up, &mut self.down, &mut self.x);
-        at(0.0, miss);
-        model.rhs(mode, miss, before);
-        at(tau, miss);
-        model.rhs(mode, miss, after);
+        let (before, after): (&[f64], &[f64]) = match known {
+            Some(rates) => rates,
+            None => {
+                at(0.0, &mut self.x);
+                model.rhs(mode, &self.x, &mut self.up);
+                at(tau, &mut self.x);
+                model.rhs(mode, &self.x, &mut self.down);
+                (&self.up, &self.down)
+            }
+        };
+        let miss = &mut self.x;
         let norm = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>();
         for (i, (m, row)) in miss.iter_mut().zip(out.chunks_exact(n)).enumerate() {
             *m = after[i]
@@ -814,7 +824,7 @@ mod tests {
         let mut tangents = Tangents::new(2);
         let mut out = [0.0; 4];
         let at = |s: f64, x: &mut [f64]| x.copy_from_slice(&pendulum_at(s).0);
-        tangents.ode(&Pendulum, 0, 2.5, at, &mut out);
+        tangents.ode(&Pendulum, 0, (2.5, None), at, &mut out);
         let exact = pendulum_at(2.5).1;
         assert!(farthest(&out, &exact) < 2e-4, "{out:?} against {exact:?}");
     }
@@ -849,7 +859,7 @@ mod tests {
         let tau = 0.5;
         let mut out = [0.0; 4];
         let at = |s: f64, x: &mut [f64]| x.copy_from_slice(&pendulum_at(s).0);
-        tangents.ode(&Pendulum, 0, tau, at, &mut out);
+        tangents.ode(&Pendulum, 0, (tau, None), at, &mut out);
         let (end, exact) = pendulum_at(tau);
         // One piece (tau |J| = 0.5), of Magnus' error (about 5e-7 here:
         // see above).

@@ -57,6 +57,8 @@ pub struct Taylor {
     /// Whether `end` holds the accepted step's end.
     end_known: bool,
     rate: Vec<f64>,
+    /// The flow at the step's start: the series' first coefficients.
+    start_rate: Vec<f64>,
     /// Series asked of the model (flows and guards).
     evaluations: u64,
 }
@@ -80,6 +82,7 @@ impl Taylor {
             end: vec![0.0; dimension],
             end_known: false,
             rate: vec![0.0; dimension],
+            start_rate: vec![0.0; dimension],
             evaluations: 0,
         }
     }
@@ -108,6 +111,9 @@ impl Taylor {
         self.evaluations += 1;
         if !self.series.iter().all(|c| c.is_finite()) {
             return Err(StepFailure::NonFinite);
+        }
+        for (f, c) in self.start_rate.iter_mut().zip(self.series.chunks_exact(w)) {
+            *f = c[1];
         }
         let norm = |k: usize| {
             self.series
@@ -230,6 +236,13 @@ impl Taylor {
     /// Length of the last step.
     pub fn h(&self) -> f64 {
         self.h
+    }
+
+    /// The flow at the start and at the end of a stretch `tau` from
+    /// `offset` into the step, where the step knows both: the whole step,
+    /// checked against the flow at its end.
+    pub fn rates(&self, offset: f64, tau: f64) -> Option<(&[f64], &[f64])> {
+        (offset == 0.0 && tau == self.h && self.end_known).then_some((&self.start_rate, &self.rate))
     }
 
     /// The state `tau` into the step: each component's series summed, by
