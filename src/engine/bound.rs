@@ -25,7 +25,7 @@
 use crate::engine::error_set::{ErrorSet, TRACKED};
 use crate::engine::model::{HybridModel, Mode};
 use crate::engine::period_record::{EventFacts, HEADROOM, Op, PeriodRecord};
-use crate::engine::tangent::Tangents;
+use crate::engine::tangent::{Rates, Tangents};
 use crate::engine::zeno;
 use crate::time::Time;
 
@@ -179,7 +179,7 @@ impl Bound {
         mode: Mode,
         (tau, local): (f64, f64),
         at: impl FnMut(f64, &mut [f64]),
-        rates: Option<(&[f64], &[f64])>,
+        rates: Rates<'_>,
     ) {
         if self.errors.tracked() {
             self.tangents

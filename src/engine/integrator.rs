@@ -12,6 +12,7 @@ use crate::engine::linear::Linear;
 use crate::engine::locate::{Interpolant, Start, StepScan};
 use crate::engine::method::Method;
 use crate::engine::model::{Flow, HybridModel, Mode};
+use crate::engine::tangent::Rates;
 use crate::engine::taylor_method::Taylor;
 use crate::engine::verlet::Verlet;
 
@@ -241,7 +242,7 @@ impl Integrator {
     /// The flow at the start and at the end of a stretch `tau` from
     /// `offset` into the step, where the method knows both without
     /// evaluating it (Taylor's whole step).
-    pub fn rates(&self, offset: f64, tau: f64) -> Option<(&[f64], &[f64])> {
+    pub fn rates(&self, offset: f64, tau: f64) -> Rates<'_> {
         match self {
             Integrator::Taylor(m) => m.rates(offset, tau),
             _ => None,

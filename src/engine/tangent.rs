@@ -38,6 +38,10 @@ pub struct Tangents {
     nodes: [Vec<f64>; 3],
 }
 
+/// The flow at a stretch's start and at its end, where the step already
+/// knows them (see `carry_the_flow`).
+pub type Rates<'a> = Option<(&'a [f64], &'a [f64])>;
+
 /// The largest `||tau J||` (row sums) of one piece of a nonlinear step's
 /// tangent. The sixth-order Magnus generator's error falls as its seventh
 /// power (a pendulum swinging to 1 rad: 2.5e-5 at 0.8, 1.2e-7 at 0.4); at
@@ -133,7 +137,7 @@ impl Tangents {
         &mut self,
         model: &M,
         mode: Mode,
-        (tau, rates): (f64, Option<(&[f64], &[f64])>),
+        (tau, rates): (f64, Rates<'_>),
         mut at: impl FnMut(f64, &mut [f64]),
         out: &mut [f64],
     ) {
@@ -244,7 +248,7 @@ impl Tangents {
         &mut self,
         model: &M,
         mode: Mode,
-        (tau, known): (f64, Option<(&[f64], &[f64])>),
+        (tau, known): (f64, Rates<'_>),
         mut at: impl FnMut(f64, &mut [f64]),
         out: &mut [f64],
     ) {

@@ -28,6 +28,7 @@
 use crate::engine::adaptive::{StepFailure, Tolerances};
 use crate::engine::locate::{Start, StepScan};
 use crate::engine::model::{Direction, HybridModel, Mode};
+use crate::engine::tangent::Rates;
 use crate::numerics::first_crossing::{eval2, first_fall};
 use crate::numerics::polynomial::{eval, eval_compensated_rows, shift};
 
@@ -241,7 +242,7 @@ impl Taylor {
     /// The flow at the start and at the end of a stretch `tau` from
     /// `offset` into the step, where the step knows both: the whole step,
     /// checked against the flow at its end.
-    pub fn rates(&self, offset: f64, tau: f64) -> Option<(&[f64], &[f64])> {
+    pub fn rates(&self, offset: f64, tau: f64) -> Rates<'_> {
         (offset == 0.0 && tau == self.h && self.end_known).then_some((&self.start_rate, &self.rate))
     }
 
