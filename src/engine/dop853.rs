@@ -283,6 +283,13 @@ impl Dop853 {
         &self.dense
     }
 
+    /// The flow at the start and at the end of the last accepted step: its
+    /// first stage and the one it carries over to the next step (first
+    /// same as last), until the next step's trial overwrites them.
+    pub fn rates(&self) -> (&[f64], &[f64]) {
+        (&self.k[END], &self.k[0])
+    }
+
     /// Sharpen a crossing found on the dense output, whose error (one order
     /// below the step's) otherwise sets the accuracy of every event: re-take
     /// the step from `y0` to exactly `tau` (12 evaluations), then follow the

@@ -110,6 +110,13 @@ impl Dopri5 {
         &self.dense
     }
 
+    /// The flow at the start and at the end of the last accepted step: its
+    /// first stage and the one it carries over to the next step (first
+    /// same as last), until the next step's trial overwrites them.
+    pub fn rates(&self) -> (&[f64], &[f64]) {
+        (&self.k[6], &self.k[0])
+    }
+
     fn eval<M: HybridModel + ?Sized>(&mut self, model: &M, mode: Mode, y: &[f64], stage: usize) {
         model.rhs(mode, y, &mut self.k[stage]);
         self.control.evaluations += 1;

@@ -240,11 +240,15 @@ impl Integrator {
     }
 
     /// The flow at the start and at the end of a stretch `tau` from
-    /// `offset` into the step, where the method knows both without
-    /// evaluating it (Taylor's whole step).
+    /// `offset` into the last step, where the method knows both without
+    /// evaluating it: a whole step (Taylor's, checked against the flow at
+    /// its end; a Dormand-Prince pair's first and last stages).
     pub fn rates(&self, offset: f64, tau: f64) -> Rates<'_> {
+        let whole = offset == 0.0 && tau == self.h();
         match self {
             Integrator::Taylor(m) => m.rates(offset, tau),
+            Integrator::Dopri5(m) => whole.then(|| m.rates()),
+            Integrator::Dop853(m) => whole.then(|| m.rates()),
             _ => None,
         }
     }
