@@ -367,19 +367,25 @@ fn defects_within<const L: usize>(c: &[f64], f: &[f64], h: f64, tolerance: f64) 
     let w = c.len() / L;
     // The series' derivatives at h.
     let mut slope = [0.0; L];
+    // `k` as a float counted down (exact), not converted at each term: a
+    // conversion writes part of a register and waits for its last value.
+    let mut weight = (w - 1) as f64;
     for k in (1..w).rev() {
         for l in 0..L {
-            slope[l] = slope[l] * h + k as f64 * c[l * w + k];
+            slope[l] = slope[l] * h + weight * c[l * w + k];
         }
+        weight -= 1.0;
     }
     (0..L).all(|l| {
         let miss = (slope[l] - f[l]).abs() * h;
         miss <= tolerance || {
             // The sizes of the derivative's terms (f's beside them).
             let row = &c[l * w..(l + 1) * w];
-            let size = (1..w)
-                .rev()
-                .fold(f[l].abs(), |size, k| size * h + k as f64 * row[k].abs());
+            let (mut size, mut weight) = (f[l].abs(), (w - 1) as f64);
+            for ck in row[1..].iter().rev() {
+                size = size * h + weight * ck.abs();
+                weight -= 1.0;
+            }
             miss <= tolerance + 16.0 * f64::EPSILON * size * h
         }
     })
