@@ -97,6 +97,11 @@ impl Parallelepiped {
         self.radii = radii;
     }
 
+    /// How many components the set holds.
+    pub(super) fn dimension(&self) -> usize {
+        self.n
+    }
+
     /// The half-width of the set along each component, the largest.
     pub(super) fn state_bound(&self) -> f64 {
         let n = self.n;
