@@ -30,6 +30,11 @@ impl Time {
         self.hi
     }
 
+    /// What [`value`](Time::value) leaves out: `self - self.value()`.
+    pub fn rounding(self) -> f64 {
+        self.lo
+    }
+
     /// `self + tau`, with the rounding error of the sum kept in `lo`.
     pub fn after(self, tau: f64) -> Self {
         let (s, e) = two_sum(self.hi, tau);

@@ -24,6 +24,7 @@
 use nalgebra::DMatrix;
 
 use crate::engine::adaptive::StepFailure;
+use crate::engine::affine_flow::cos_sin;
 use crate::engine::model::{HybridModel, Mode};
 use crate::numerics::double_double::DoubleDouble;
 
@@ -46,6 +47,15 @@ pub struct AffineMode {
     pub rows: Vec<f64>,
     /// The longest step, `1 / |M|_1` (infinite for `M = 0`).
     pub h_bound: f64,
+    /// The clock, where sines of it drive the flow.
+    clock: Option<usize>,
+    /// Each wave's frequency and the scale its components are held at:
+    /// `y = [x, 1, scale cos(w t), scale sin(w t), ...]`.
+    waves: Vec<(f64, f64)>,
+    /// `sum_k max_i (|c_ki| + |s_ki|)`: how strongly the waves drive the
+    /// state, for the error their rounding leaves (see
+    /// [`AffineMode::wave_error`]).
+    drive: f64,
     /// `exp(M h_bound)` row by row in double-double (see
     /// [`crate::numerics::double_double::dot`]), once built.
     propagator: Option<Vec<DoubleDouble>>,
@@ -122,6 +132,9 @@ pub fn guard_series(rows: &[f64], y: &[f64], y_lo: &[f64], out: &mut [f64]) {
         3 => guard_series_of::<3>(rows, y, y_lo, out),
         4 => guard_series_of::<4>(rows, y, y_lo, out),
         5 => guard_series_of::<5>(rows, y, y_lo, out),
+        // A forced oscillator: two states, the clock, one wave.
+        6 => guard_series_of::<6>(rows, y, y_lo, out),
+        7 => guard_series_of::<7>(rows, y, y_lo, out),
         m => {
             let product =
                 |row: &[f64], y: &[f64]| -> f64 { row.iter().zip(y).map(|(a, b)| a * b).sum() };
@@ -164,22 +177,58 @@ impl AffineMode {
         mode: Mode,
         n: usize,
     ) -> Result<Self, StepFailure> {
-        let Some((a, b)) = model.linear(mode) else {
+        let Some(flow) = model.affine_flow(mode) else {
             return Err(StepFailure::NotApplicable(format!(
-                "mode `{}` is not a linear flow x' = A x + b",
+                "mode `{}` is not a linear flow x' = A x + b (plus sines of t)",
                 model.mode_name(mode)
             )));
         };
-        let m = n + 1;
+        let clock = match (flow.waves.is_empty(), model.clock()) {
+            (true, _) => None,
+            (false, Some(clock)) => Some(clock),
+            (false, None) => {
+                return Err(StepFailure::NotApplicable(format!(
+                    "mode `{}` is driven by sines of t but the model has no clock",
+                    model.mode_name(mode)
+                )));
+            }
+        };
+        let m = n + 1 + 2 * flow.waves.len();
         let mut augmented = DMatrix::zeros(m, m);
-        augmented.view_mut((0, 0), (n, n)).copy_from(&a);
-        augmented.view_mut((0, n), (n, 1)).copy_from(&b);
-        if !augmented.iter().all(|x| x.is_finite()) {
+        augmented.view_mut((0, 0), (n, n)).copy_from(&flow.a);
+        augmented.view_mut((0, n), (n, 1)).copy_from(&flow.b);
+        let column_norm = |a: &DMatrix<f64>, j: usize| a.column(j).lp_norm(1);
+        let undriven = (0..=n)
+            .map(|j| column_norm(&augmented, j))
+            .fold(0.0, f64::max);
+        let mut waves = Vec::with_capacity(flow.waves.len());
+        let mut drive = 0.0;
+        for (k, wave) in flow.waves.iter().enumerate() {
+            let (c, s) = (n + 1 + 2 * k, n + 2 + 2 * k);
+            // The wave's components held scaled, `sigma (cos, sin)`, so
+            // that its columns (`|c_k| / sigma + w`) do not shorten the
+            // steps below what `A` and `b` allow where they need not.
+            let size = wave.cos.lp_norm(1).max(wave.sin.lp_norm(1));
+            let room = (undriven - wave.frequency).max(0.25 * wave.frequency);
+            let scale = if size > 0.0 { size / room } else { 1.0 };
+            augmented
+                .view_mut((0, c), (n, 1))
+                .copy_from(&(&wave.cos / scale));
+            augmented
+                .view_mut((0, s), (n, 1))
+                .copy_from(&(&wave.sin / scale));
+            augmented[(c, s)] = -wave.frequency;
+            augmented[(s, c)] = wave.frequency;
+            waves.push((wave.frequency, scale));
+            drive += (0..n)
+                .map(|i| wave.cos[i].abs() + wave.sin[i].abs())
+                .fold(0.0, f64::max);
+        }
+        if !augmented.iter().all(|x| x.is_finite()) || !waves.iter().all(|(_, s)| s.is_finite()) {
             return Err(StepFailure::NonFinite);
         }
-        let norm = augmented
-            .column_iter()
-            .map(|c| c.lp_norm(1))
+        let norm = (0..m)
+            .map(|j| column_norm(&augmented, j))
             .fold(0.0, f64::max);
         let h_bound = if norm > 0.0 {
             1.0 / norm
@@ -195,12 +244,15 @@ impl AffineMode {
         let mut solved = AffineMode {
             rows,
             h_bound,
+            clock,
+            waves,
+            drive,
             propagator: None,
             series_steps: 0,
             guard_rows: vec![None; model.guards(mode).len()],
             state_rows: None,
         };
-        if n <= SOLVED_DIMENSION {
+        if m <= SOLVED_DIMENSION + 1 {
             solved.state_rows = Some(solved.component_rows(n));
             for g in 0..solved.guard_rows.len() {
                 solved.guard_rows[g] = solved.affine_guard_rows(model, mode, g, n);
@@ -227,8 +279,36 @@ impl AffineMode {
         self.propagator.as_deref()
     }
 
-    /// `n + 1`, the augmented state's length.
-    fn augmented_len(&self) -> usize {
+    /// The augmented state at the start of a step from `x` (`n`
+    /// components): `[x, 1, scale cos(w t), scale sin(w t), ...]`, `t` the
+    /// clock's value and what its rounding left out in `x_lo` (a whole
+    /// step's end: the clock then reads the time the state is at, not the
+    /// time rounded, which would shift the forcing against the state by
+    /// half an ulp of `t` at every step).
+    pub fn augment(&self, x: &[f64], x_lo: &[f64], y: &mut [f64]) {
+        let n = x.len();
+        y[..n].copy_from_slice(x);
+        y[n] = 1.0;
+        if let Some(clock) = self.clock {
+            for (k, &(w, scale)) in self.waves.iter().enumerate() {
+                let (c, s) = cos_sin(w, x[clock], x_lo[clock]);
+                y[n + 1 + 2 * k] = scale * c;
+                y[n + 2 + 2 * k] = scale * s;
+            }
+        }
+    }
+
+    /// What the waves' rounding may leave in the state over a step of
+    /// `h`: each wave starts within an ulp or two of its value
+    /// ([`cos_sin`]; `2 eps`), and drives the state by at most `drive`
+    /// through a propagator of norm at most `e` (`|M| h <= 1`). Zero where
+    /// no wave drives the flow.
+    pub fn wave_error(&self, h: f64) -> f64 {
+        std::f64::consts::E * 2.0 * f64::EPSILON * self.drive * h
+    }
+
+    /// `n + 1` (and two per wave), the augmented state's length.
+    pub fn augmented_len(&self) -> usize {
         (self.rows.len() as f64).sqrt().round() as usize
     }
 
@@ -272,7 +352,7 @@ impl AffineMode {
         if !model.guards(mode)[g].affine {
             return None;
         }
-        let m = n + 1;
+        let m = self.augmented_len();
         let zero = vec![0.0; n];
         let mut row = vec![0.0; m];
         if !model.guard_gradient(mode, g, &zero, &mut row[..n]) {
@@ -289,7 +369,7 @@ impl AffineMode {
     /// component after another: its Taylor coefficients along any step are
     /// their products with `y`, each rounded once.
     fn component_rows(&self, n: usize) -> Vec<f64> {
-        let m = n + 1;
+        let m = self.augmented_len();
         let mut all = Vec::with_capacity(n * (ORDER + 1) * m);
         for i in 0..n {
             let mut unit = vec![0.0; m];
@@ -333,6 +413,9 @@ mod tests {
         let mode = AffineMode {
             rows,
             h_bound: 1.0,
+            clock: None,
+            waves: Vec::new(),
+            drive: 0.0,
             propagator: None,
             series_steps: 0,
             guard_rows: Vec::new(),
@@ -365,6 +448,9 @@ mod tests {
         let mode = AffineMode {
             rows,
             h_bound: 1.0 / 2.0,
+            clock: None,
+            waves: Vec::new(),
+            drive: 0.0,
             propagator: None,
             series_steps: 0,
             guard_rows: Vec::new(),

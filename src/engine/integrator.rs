@@ -45,8 +45,8 @@ pub fn motion<M: HybridModel + ?Sized>(
         (Flow::Ode, Method::Exact) => Err(format!(
             "mode `{name}` has no exact flow; choose a numerical method"
         )),
-        (_, Method::Linear) if !model.is_linear(mode) => Err(format!(
-            "mode `{name}` is not a linear flow x' = A x + b, so the linear propagator cannot run it"
+        (_, Method::Linear) if !model.has_affine_flow(mode) => Err(format!(
+            "mode `{name}` is not a linear flow x' = A x + b (plus sines of t), so the linear propagator cannot run it"
         )),
         (_, Method::Dopri5(_) | Method::Dop853(_) | Method::Verlet { .. })
             if !model.has_rhs(mode) =>
@@ -207,6 +207,16 @@ impl Integrator {
         }
     }
 
+    /// The next step starts where the clock (component `clock`) reads the
+    /// run's time less `rounding`: the linear propagator starts from the
+    /// exact time (see [`Linear::clock_at`]); the others read the clock as
+    /// it is.
+    pub fn clock_at(&mut self, clock: usize, rounding: f64) {
+        if let Integrator::Linear(m) = self {
+            m.clock_at(clock, rounding);
+        }
+    }
+
     /// Length of the last step.
     pub fn h(&self) -> f64 {
         match self {
@@ -314,6 +324,13 @@ impl Integrator {
             Integrator::Dop853(m) => m.sharpen(model, mode, y0, crossing, x),
             _ => None,
         }
+    }
+
+    /// Whether a step reads the clock at the run's exact time (the
+    /// linear propagator: see [`Linear::clock_at`]), so that a forcing
+    /// read through it is not shifted by the clock's rounding.
+    pub fn reads_exact_clock(&self) -> bool {
+        matches!(self, Integrator::Linear(_))
     }
 
     /// An estimate of the last step's local error (largest component).

@@ -173,7 +173,7 @@ pub fn cheapest<M: HybridModel + ?Sized>(
         (Method::Exact, "every mode has a closed form")
     } else if !all(&|m| model.flow(m) != Flow::Exact) {
         (Method::Auto, "some modes have a closed form")
-    } else if all(&|m| model.flow(m) == Flow::Frozen || model.is_linear(m)) {
+    } else if all(&|m| model.flow(m) == Flow::Frozen || model.has_affine_flow(m)) {
         (Method::Linear, "every mode's flow is affine")
     } else if all(&|m| model.flow(m) == Flow::Frozen || model.has_series(m)) {
         (Method::Taylor(taylor), "a mode's flow is not affine")

@@ -4,6 +4,7 @@
 //! ([`local`]), and returns the [`Outcome`] of a run ([`run`]).
 
 pub mod adaptive;
+pub mod affine_flow;
 pub mod affine_mode;
 pub mod bound;
 pub mod dop853;

@@ -10,6 +10,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
+use crate::engine::affine_flow::AffineFlow;
 use crate::engine::labels::Labels;
 use crate::engine::names::Name;
 
@@ -268,6 +269,23 @@ pub trait HybridModel {
     /// answers cheaply.
     fn is_linear(&self, mode: Mode) -> bool {
         self.linear(mode).is_some()
+    }
+
+    /// The flow in `mode` as the exact linear propagator runs it: a linear
+    /// flow (what [`linear`](HybridModel::linear) says), or one driven by
+    /// sines of the clock as well ([`AffineFlow`]).
+    fn affine_flow(&self, mode: Mode) -> Option<AffineFlow> {
+        self.linear(mode).map(|(a, b)| AffineFlow {
+            a,
+            b,
+            waves: Vec::new(),
+        })
+    }
+
+    /// Whether [`affine_flow`](HybridModel::affine_flow) is some, without
+    /// building it.
+    fn has_affine_flow(&self, mode: Mode) -> bool {
+        self.is_linear(mode)
     }
 
     /// The exact flow map of a [`Flow::Exact`] mode: `x` is the state

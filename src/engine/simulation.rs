@@ -976,6 +976,10 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
                 let mut graze: Option<(usize, f64, f64, f64)> = None;
                 let mut earliest = f64::INFINITY;
                 self.depths.resize(guards.len(), f64::INFINITY);
+                if let Some((c, c0)) = self.clock {
+                    self.integrator
+                        .clock_at(c, self.origin.after(c0).rounding());
+                }
                 if let Err(failure) =
                     self.integrator
                         .step(model, mode, &self.state, remaining, h_min)
@@ -1187,6 +1191,10 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
         let Some((c, _)) = self.clock.filter(|_| model.has_rhs(mode)) else {
             return 0.0;
         };
+        // The linear propagator steps from the exact time.
+        if self.integrator.reads_exact_clock() {
+            return 0.0;
+        }
         let t = self.state[c];
         // A difference over a small part of the step (which resolves the
         // forcing), and far above the ulps of t.

@@ -477,8 +477,8 @@ fn check_reports_modes_guards_and_the_method_it_would_use() {
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(
         text.contains("and the clock t")
-            && text.contains("method taylor")
-            && text.contains("[affine flow driven by t]"),
+            && text.contains("method linear")
+            && text.contains("[affine flow driven by sines of t]"),
         "{text}"
     );
 }

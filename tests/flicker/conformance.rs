@@ -11,8 +11,9 @@
 //!   expressions the linear propagator, Taylor's method, Dormand-Prince,
 //!   DOP853 and Stormer-Verlet, wherever each applies.
 //! - Flows: an oscillator `x'' = -x` (autonomous), the same forced by
-//!   `cos(2 t)` (whose flow is not affine) and by the ramp `0.2 t` (affine
-//!   in the state and the clock).
+//!   `cos(2 t)` (affine in the state and driven by a sine of the clock,
+//!   which the linear propagator carries as two more components) and by
+//!   the ramp `0.2 t` (affine in the state and the clock).
 //! - Directions: rising, falling, either.
 //! - What the transition does: nothing (a marker: a Poincare section), a
 //!   reset of a counter, a change to a second mode with the same flow and
@@ -129,8 +130,7 @@ impl Way {
     fn runs(self, family: Family) -> bool {
         match self {
             Way::Exact | Way::Verlet => family == Family::Oscillator,
-            Way::Linear => family != Family::Forced,
-            Way::Taylor | Way::Dopri5 | Way::Dop853 => true,
+            Way::Linear | Way::Taylor | Way::Dopri5 | Way::Dop853 => true,
         }
     }
 }

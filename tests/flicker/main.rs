@@ -21,6 +21,7 @@ mod error_bound;
 mod event_location;
 mod fast_forward;
 mod filippov;
+mod forced_linear;
 mod fuzz_regressions;
 mod golden;
 mod homogenized;

@@ -8,7 +8,9 @@
 //! so that the flows stay autonomous as the engine wants them (the log and
 //! the summary show it as a state). What the compiled form reveals is
 //! offered to the methods: a mode whose rates are affine is linear (its `A`
-//! and `b` read off exactly by forward differentiation), a mode of the
+//! and `b` read off exactly by forward differentiation), one affine in the
+//! state and driven by sines of the clock is that too, with its waves
+//! (`expr/waves.rs`), a mode of the
 //! shape `[q; v]` with `q' = v` and `v'` free of `v` is second order.
 
 use std::cell::RefCell;
@@ -16,12 +18,13 @@ use std::sync::Arc;
 
 use nalgebra::{DMatrix, DVector};
 
+use crate::engine::affine_flow::AffineFlow;
 use crate::engine::{Flow, Guard, HybridModel, Jump, Mode, Name};
 use crate::models::automaton::definition::{Definition, Source};
 use crate::models::automaton::expr::compiled::{CompiledFlows, CompiledTape};
 use crate::models::automaton::expr::derivative::{jacobian, jacobian_into, jacobian_tape};
 use crate::models::automaton::expr::recurrences::Series;
-use crate::models::automaton::expr::{Ast, Scope, Tape};
+use crate::models::automaton::expr::{Ast, Scope, Tape, waves};
 use crate::models::automaton::filippov::{self, Target};
 use crate::scene::SceneError;
 
@@ -68,6 +71,9 @@ struct CompiledMode {
     rest: Option<Reset>,
     kind: Flow,
     linear: Option<(DMatrix<f64>, DVector<f64>)>,
+    /// The flow as affine in the state and driven by sines of the clock,
+    /// where it is that and not plainly linear.
+    driven: Option<AffineFlow>,
     /// The flow's Jacobian in the state where it is constant (linear, or
     /// linear and driven by the clock), its clock's column zero.
     constant_jacobian: Option<DMatrix<f64>>,
@@ -344,6 +350,10 @@ impl Automaton {
                 }
                 None => None,
             };
+            let driven = match (&linear, clock_input) {
+                (None, Some(t)) => waves::driven(&flow, n, t as usize),
+                _ => None,
+            };
             let half = n / 2;
             let second_order = !clock
                 && n % 2 == 0
@@ -380,6 +390,7 @@ impl Automaton {
                 rest,
                 kind: if still { Flow::Frozen } else { Flow::Ode },
                 linear,
+                driven,
                 constant_jacobian,
                 second_order,
             });
@@ -473,11 +484,12 @@ impl Automaton {
         self.modes.iter().find_map(|m| m.rough.as_deref())
     }
 
-    /// Whether every mode's flow is affine (the linear propagator runs it).
+    /// Whether every mode's flow is affine, or affine and driven by sines
+    /// of the clock (the linear propagator runs it).
     pub fn all_linear(&self) -> bool {
         self.modes
             .iter()
-            .all(|m| m.linear.is_some() || m.kind == Flow::Frozen)
+            .all(|m| m.linear.is_some() || m.driven.is_some() || m.kind == Flow::Frozen)
     }
 
     /// Whether the run ends at the event of `guard` in `mode`.
@@ -615,6 +627,22 @@ impl HybridModel for Automaton {
 
     fn constant_jacobian(&self, mode: Mode) -> Option<DMatrix<f64>> {
         self.modes[mode].constant_jacobian.clone()
+    }
+
+    fn affine_flow(&self, mode: Mode) -> Option<AffineFlow> {
+        let m = &self.modes[mode];
+        m.driven.clone().or_else(|| {
+            m.linear.clone().map(|(a, b)| AffineFlow {
+                a,
+                b,
+                waves: Vec::new(),
+            })
+        })
+    }
+
+    fn has_affine_flow(&self, mode: Mode) -> bool {
+        let m = &self.modes[mode];
+        m.linear.is_some() || m.driven.is_some()
     }
 
     fn reset(&self, mode: Mode, guard: usize, x: &mut [f64]) -> Jump {

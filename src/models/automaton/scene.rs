@@ -264,6 +264,9 @@ impl SceneModel for AutomatonScene {
             let mut traits = Vec::new();
             if model.is_linear(m) {
                 traits.push("affine flow");
+            } else if model.has_affine_flow(m) {
+                // x' = A x + b + sines of t: the linear propagator's too.
+                traits.push("affine flow driven by sines of t");
             } else if model.constant_jacobian(m).is_some() {
                 // x' = A x + f(t): its errors move by exp(tau A).
                 traits.push("affine flow driven by t");

@@ -8,6 +8,7 @@ pub mod parse;
 pub mod recurrences;
 pub mod symbolic;
 pub mod tape;
+pub mod waves;
 
 pub use parse::{Ast, ParseError, parse};
 pub use tape::{CompileError, Op, Scope, Tape};
