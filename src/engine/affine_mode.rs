@@ -20,6 +20,15 @@
 //! - the same rows for each state component, `e_i M^k / k!`: the state's
 //!   own series where a step needs it (an event's state), each coefficient
 //!   one product, independent of the others.
+//!
+//! A mode driven by sines of the clock ([`AffineFlow`]'s waves) adds two
+//! components per frequency, `sigma cos(w t)` and `sigma sin(w t)` (their
+//! rows the rotation `C' = -w S`, `S' = w C`, their columns the forcing
+//! over `sigma`, which keeps them from shortening the steps): `y = [x, 1,
+//! sigma C, sigma S, ...]`, filled at each step's start from its exact
+//! time ([`AffineMode::augment`]).
+//!
+//! [`AffineFlow`]: crate::engine::affine_flow::AffineFlow
 
 use nalgebra::DMatrix;
 

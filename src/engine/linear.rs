@@ -1,4 +1,6 @@
-//! The exact propagator of a linear flow `x' = A x + b`.
+//! The exact propagator of a linear flow `x' = A x + b` (and of one driven
+//! by sines of the clock as well, their values carried as more components
+//! of `y`: see [`AffineMode`]).
 //!
 //! With the augmented matrix `M = [[A, b], [0, 0]]`, the flow from `y` is
 //! `exp(M tau) y = sum_k M^k y tau^k / k!`. Steps are bounded so that
