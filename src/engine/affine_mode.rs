@@ -10,8 +10,9 @@
 //! - the propagator over a whole step, `exp(M h)` in double-double, so that
 //!   a step rounds its result once, as the series it replaces does, and
 //!   applying it many times adds no bias of its own; it is built once the
-//!   mode has taken `n + 1` whole steps by their series (building it takes
-//!   `n + 1` series in double-double: microseconds for a few states, a
+//!   mode has taken `m` whole steps by their series, `m` the augmented
+//!   state's length (`n + 1`, two more per wave below; building it takes
+//!   `m` series in double-double: microseconds for a few states, a
 //!   millisecond at 16), so a run of a handful of steps never pays for it
 //!   and any longer one wins it back;
 //! - for each guard that is affine in the state, `g(x) = c . x + d`, the
@@ -41,9 +42,10 @@ use crate::numerics::double_double::DoubleDouble;
 /// out is below `1 / 25!` (7e-26) of the state.
 pub const ORDER: usize = 24;
 
-/// The largest state whose mode is solved once: its propagator holds
-/// `(n + 1)^2` numbers and costs `(n + 1)` series to build, and each affine
-/// guard `(ORDER + 1) (n + 1)` more, which a long chain (thousands of
+/// The largest state whose mode is solved once (with its waves, an
+/// augmented state of `m <= SOLVED_DIMENSION + 1`): its propagator holds
+/// `m^2` numbers and costs `m` series to build, and each affine guard
+/// `(ORDER + 1) m` more, which a long chain (thousands of
 /// states, one guard per unit) could not afford; larger modes are stepped
 /// by their series.
 pub const SOLVED_DIMENSION: usize = 32;
@@ -52,7 +54,7 @@ pub const SOLVED_DIMENSION: usize = 32;
 /// propagator and its affine guards' rows.
 #[derive(Debug, Clone)]
 pub struct AffineMode {
-    /// `M`, row by row, `(n + 1)^2` numbers.
+    /// `M`, row by row, `m^2` numbers (`m` the augmented state's length).
     pub rows: Vec<f64>,
     /// The longest step, `1 / |M|_1` (infinite for `M = 0`).
     pub h_bound: f64,
@@ -219,7 +221,13 @@ impl AffineMode {
             // steps below what `A` and `b` allow where they need not.
             let size = wave.cos.lp_norm(1).max(wave.sin.lp_norm(1));
             let room = (undriven - wave.frequency).max(0.25 * wave.frequency);
-            let scale = if size > 0.0 { size / room } else { 1.0 };
+            // A power of two: the coefficients over it, and the values
+            // times it, are exact.
+            let scale = if size > 0.0 {
+                (size / room).log2().ceil().exp2()
+            } else {
+                1.0
+            };
             augmented
                 .view_mut((0, c), (n, 1))
                 .copy_from(&(&wave.cos / scale));
@@ -272,7 +280,7 @@ impl AffineMode {
 
     /// The propagator over a whole step (`h_bound`), for one more whole
     /// step: `None` while the mode is too large, its bound infinite, or it
-    /// has taken no more than its augmented size (`n + 1`) by the series.
+    /// has taken no more than its augmented size (`m`) by the series.
     pub fn whole_step(&mut self) -> Option<&[DoubleDouble]> {
         if self.propagator.is_none() {
             let m = self.augmented_len();
@@ -308,12 +316,14 @@ impl AffineMode {
     }
 
     /// What the waves' rounding may leave in the state over a step of
-    /// `h`: each wave starts within an ulp or two of its value
-    /// ([`cos_sin`]; `2 eps`), and drives the state by at most `drive`
-    /// through a propagator of norm at most `e` (`|M| h <= 1`). Zero where
-    /// no wave drives the flow.
+    /// `h`: each wave starts within `3 eps` of its value ([`cos_sin`]: the
+    /// library's sine and cosine within an ulp, the first-order turn's
+    /// product and sum within one each; the scale a power of two, exact),
+    /// and drives the state by at most `drive` through a propagator of
+    /// norm at most `e` (`|M| h <= 1`). Zero where no wave drives the
+    /// flow.
     pub fn wave_error(&self, h: f64) -> f64 {
-        std::f64::consts::E * 2.0 * f64::EPSILON * self.drive * h
+        std::f64::consts::E * 3.0 * f64::EPSILON * self.drive * h
     }
 
     /// `n + 1` (and two per wave), the augmented state's length.

@@ -326,11 +326,16 @@ impl Integrator {
         }
     }
 
-    /// Whether a step reads the clock at the run's exact time (the
+    /// Where a step of `h` reads the clock at the run's exact time (the
     /// linear propagator: see [`Linear::clock_at`]), so that a forcing
-    /// read through it is not shifted by the clock's rounding.
-    pub fn reads_exact_clock(&self) -> bool {
-        matches!(self, Integrator::Linear(_))
+    /// read through it is not shifted by the clock's rounding: what the
+    /// forcing's values' own rounding leaves instead. `None` for the
+    /// others, whose forcing sees the clock's reading.
+    pub fn exact_clock_error(&self, h: f64) -> Option<f64> {
+        match self {
+            Integrator::Linear(m) => Some(m.forcing_error(h)),
+            _ => None,
+        }
     }
 
     /// An estimate of the last step's local error (largest component).

@@ -1192,8 +1192,8 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
             return 0.0;
         };
         // The linear propagator steps from the exact time.
-        if self.integrator.reads_exact_clock() {
-            return 0.0;
+        if let Some(error) = self.integrator.exact_clock_error(h) {
+            return error;
         }
         let t = self.state[c];
         // A difference over a small part of the step (which resolves the

@@ -101,3 +101,23 @@ fn two_frequencies_and_a_phase_agree_with_taylors_method_within_both_bounds() {
         );
     }
 }
+
+/// The same flow where every step is cut short: a guard with a fast sine
+/// of the clock (`40 t`) makes the propagator halve its steps until the
+/// guard's series converges, so no step is a whole one and none carries
+/// its end's rounding to the next. Each still starts from the exact time
+/// (the engine's), and the final state is within 1e-14 of `sin(w t) / w`;
+/// a step that read the clock's rounded value instead would shift the
+/// forcing by up to half an ulp of `t` each time, about 1e-10 by the end.
+#[test]
+fn steps_cut_short_start_from_the_exact_time_too() {
+    let mut scene = integrator_of_a_cosine(1e4);
+    scene["modes"]["m"]["transitions"][0]["guard"] = json!("x - 0.5 / w + 0.001 * sin(40 * t)");
+    let (summary, _) = run_value(&scene, &["--no-events"]);
+    assert_eq!(summary["status"], "completed", "{summary}");
+    assert_eq!(summary["method"], "linear", "{summary}");
+    let x = f(&summary["final_state"]["x"]);
+    let exact = 0.068830468142869827;
+    assert!((x - exact).abs() < 1e-14, "{x} vs {exact}");
+    assert!((x - exact).abs() <= f(&summary["error_bound"]), "{summary}");
+}
