@@ -353,6 +353,7 @@ impl Linear {
             uncertainty,
         ))
     }
+
     /// Propagator evaluations so far: the steps and exponentials taken.
     pub fn evaluations(&self) -> u64 {
         self.evaluations.get()
