@@ -419,6 +419,12 @@ fn falls(
     if stays_above_with(c, h, uncertainty, pull) || (check_start && rises_clear(c, pull)) {
         return Ok((None, CLEAR));
     }
+    // Rising all the way (a marker's opposite passage, half of every
+    // oscillation's crossings): nothing falls, and nothing turns to come
+    // near zero; the searches below would find as much.
+    if rises_throughout(c, h) {
+        return Ok((None, CLEAR));
+    }
     // Series are at most MAX_ORDER + 1 long: scratch on the stack.
     let n = c.len();
     let mut scratch = [0.0; MAX_ORDER + 1];
@@ -545,6 +551,18 @@ fn stays_above_with(c: &[f64], h: f64, level: f64, from_two: f64) -> bool {
     c0 > level && end > level
 }
 
+/// Whether `p(s) = sum c_k s^k` is strictly increasing on `[0, h]`: its
+/// slope's falling terms at their largest, `c_1 + sum_{k >= 2} min(0, k
+/// c_k) h^(k - 1)`, stay above zero (that sum padded for its rounding).
+fn rises_throughout(c: &[f64], h: f64) -> bool {
+    let mut falling = 0.0;
+    for (k, &ck) in c.iter().enumerate().skip(2).rev() {
+        falling = falling * h + (k as f64 * ck).min(0.0);
+    }
+    let rate = c.get(1).copied().unwrap_or(0.0);
+    rate + falling * h * (1.0 + 1e-12) > 0.0
+}
+
 /// Whether `sum c_k s^k`, leaving zero (`c_0 = 0`, just after a reset put
 /// the guard there), stays above zero on `(0, h]`, given `pull =
 /// pull_down(c, h)`: `p(s) >= s (c_1 + pull)`, a rise no term can turn back
@@ -602,6 +620,27 @@ mod tests {
         assert!(end > 0.1 && end < 0.2, "{end}");
         assert!(stays_above(&c, h, 0.1));
         assert!(!stays_above(&c, h, 0.2));
+    }
+
+    #[test]
+    fn a_rise_throughout_is_proven_where_the_slope_stays_positive_and_no_further() {
+        // p = -0.3 + s - 0.2 s^2: p' = 1 - 0.4 s, positive up to s = 2.5.
+        let c = [-0.3, 1.0, -0.2];
+        assert!(rises_throughout(&c, 2.0));
+        assert!(rises_throughout(&c, 2.49));
+        assert!(!rises_throughout(&c, 2.6));
+        // A rising term counts for nothing: p' = -0.1 + 3 s^2 dips below
+        // zero at the start, whatever it reaches later.
+        assert!(!rises_throughout(&[0.0, -0.1, 0.0, 1.0], 1.0));
+        // The cosine arc after an impact, leaving zero at 0.447: its apex
+        // at t = atan2(0.447, 0.2) = 1.15; rising over a step of 1, not
+        // over one of 1.5 that passes it.
+        let (c, _) = arc(0.0, 0.4472135954999579, 1.0);
+        assert!(rises_throughout(&c, 1.0));
+        assert!(!rises_throughout(&c, 1.5));
+        // A falls() on a series that rises throughout finds nothing.
+        let (found, margin) = falls(&[-0.3, 1.0, -0.2], 2.0, false, 1e-9).unwrap();
+        assert_eq!((found, margin.0), (None, f64::INFINITY));
     }
 
     #[test]
