@@ -433,9 +433,10 @@ fn falls(
         let back = &mut scratch[..n];
         back.iter_mut().zip(c).for_each(|(b, x)| *b = -x);
         // Most such steps stay past it (a marker's far side, half of every
-        // oscillation): proven by its falling terms alone, where the
-        // search's own first proof weighs every term.
-        if stays_above_with(back, h, 0.0, pull_down(back, h)) {
+        // oscillation; the step after a marker fired, leaving zero): proven
+        // by its falling terms alone, where the search's own first proof
+        // weighs every term.
+        if stays_above_with(back, h, 0.0, pull_down(back, h)) || rises_throughout(back, h) {
             return Ok((None, CLEAR));
         }
         match first_fall(back, 0.0, h)? {
