@@ -35,6 +35,17 @@ pub struct AffineFlow {
     pub waves: Vec<Wave>,
 }
 
+impl AffineFlow {
+    /// `x' = A x + b`, driven by nothing.
+    pub fn linear((a, b): (DMatrix<f64>, DVector<f64>)) -> Self {
+        AffineFlow {
+            a,
+            b,
+            waves: Vec::new(),
+        }
+    }
+}
+
 /// `(cos(w (t + t_lo)), sin(w (t + t_lo)))` to about an ulp for any `t`
 /// (`t_lo` below an ulp of `t`): the product `w t` is split into its
 /// rounded value and what rounding left out (an FMA gives it exactly),

@@ -298,10 +298,9 @@ impl AffineMode {
 
     /// The augmented state at the start of a step from `x` (`n`
     /// components): `[x, 1, scale cos(w t), scale sin(w t), ...]`, `t` the
-    /// clock's value and what its rounding left out in `x_lo` (a whole
-    /// step's end: the clock then reads the time the state is at, not the
-    /// time rounded, which would shift the forcing against the state by
-    /// half an ulp of `t` at every step).
+    /// clock's value and what its rounding left out in `x_lo` (the run's
+    /// exact time: the time rounded would shift the forcing against the
+    /// state by half an ulp of `t` at every step).
     pub fn augment(&self, x: &[f64], x_lo: &[f64], y: &mut [f64]) {
         let n = x.len();
         y[..n].copy_from_slice(x);

@@ -77,7 +77,7 @@ pub struct Linear {
     y0_lo: Vec<f64>,
     lo_terms: RefCell<(Vec<f64>, Vec<f64>)>,
     /// The clock's component and what rounding the run's time to its
-    /// reading left out, for a step that does not continue the last one.
+    /// reading left out, for the next step (see [`Linear::clock_at`]).
     clock: Option<(usize, f64)>,
     /// Propagator evaluations; a `Cell` because evaluation reads `&self`.
     evaluations: Cell<u64>,

@@ -275,11 +275,7 @@ pub trait HybridModel {
     /// flow (what [`linear`](HybridModel::linear) says), or one driven by
     /// sines of the clock as well ([`AffineFlow`]).
     fn affine_flow(&self, mode: Mode) -> Option<AffineFlow> {
-        self.linear(mode).map(|(a, b)| AffineFlow {
-            a,
-            b,
-            waves: Vec::new(),
-        })
+        self.linear(mode).map(AffineFlow::linear)
     }
 
     /// Whether [`affine_flow`](HybridModel::affine_flow) is some, without

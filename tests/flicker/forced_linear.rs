@@ -62,6 +62,38 @@ fn a_sine_driven_flow_is_propagated_exactly_over_a_long_run() {
     );
 }
 
+/// `scene` by its default method (the linear propagator) and by Taylor's
+/// method at machine precision: both complete, with the same events, each
+/// pair within the sum of the two stated event-time bounds, and final
+/// states (`x` and `v`) within the sum of the two error bounds. Returns
+/// the events.
+fn agrees_with_taylor_within_both_bounds(scene: &Value, case: &str) -> Vec<Value> {
+    let (linear, a) = run_value(scene, &[]);
+    let (taylor, b) = run_value(scene, &["--method", "taylor"]);
+    assert_eq!(linear["method"], "linear", "{case}: {linear}");
+    for s in [&linear, &taylor] {
+        assert_eq!(s["status"], "completed", "{case}: {s}");
+    }
+    assert_eq!(a.len(), b.len(), "{case}");
+    let times = f(&linear["event_time_bound"]) + f(&taylor["event_time_bound"]);
+    for (p, q) in a.iter().zip(&b) {
+        assert_eq!(p["guard"], q["guard"], "{case}");
+        assert!(
+            (f(&p["t"]) - f(&q["t"])).abs() <= times,
+            "{case}: {p} vs {q}"
+        );
+    }
+    let states = f(&linear["error_bound"]) + f(&taylor["error_bound"]);
+    for key in ["x", "v"] {
+        let (p, q) = (
+            f(&linear["final_state"][key]),
+            f(&taylor["final_state"][key]),
+        );
+        assert!((p - q).abs() <= states, "{case} {key}: {p} vs {q}");
+    }
+    a
+}
+
 /// A damped oscillator driven at two frequencies with a phase,
 /// `x'' + 0.1 x' + x = cos(0.8 t + 0.3) - 0.5 sin(2 t)`, by the linear
 /// propagator and by Taylor's method at machine precision: the same
@@ -79,27 +111,8 @@ fn two_frequencies_and_a_phase_agree_with_taylors_method_within_both_bounds() {
         }},
         "t_end": 2000.0
     });
-    let (linear, a) = run_value(&scene, &[]);
-    let (taylor, b) = run_value(&scene, &["--method", "taylor"]);
-    assert_eq!(linear["method"], "linear", "{linear}");
-    assert_eq!(taylor["method"], "taylor", "{taylor}");
-    assert_eq!(a.len(), b.len());
-    assert!(a.len() > 200, "{} passages", a.len());
-    let times = f(&linear["event_time_bound"]) + f(&taylor["event_time_bound"]);
-    for (p, q) in a.iter().zip(&b) {
-        assert!((f(&p["t"]) - f(&q["t"])).abs() <= times, "{p} vs {q}");
-    }
-    let states = f(&linear["error_bound"]) + f(&taylor["error_bound"]);
-    for key in ["x", "v"] {
-        let (p, q) = (
-            f(&linear["final_state"][key]),
-            f(&taylor["final_state"][key]),
-        );
-        assert!(
-            (p - q).abs() <= states,
-            "{key}: {p} vs {q} (bounds {states:e})"
-        );
-    }
+    let passages = agrees_with_taylor_within_both_bounds(&scene, "two frequencies");
+    assert!(passages.len() > 200, "{} passages", passages.len());
 }
 
 /// The same flow where every step is cut short: a guard with a fast sine
@@ -160,29 +173,7 @@ fn random_driven_modes_agree_with_taylors_method_within_both_bounds() {
             },
             "t_end": 50.0
         });
-        let (linear, a) = run_value(&scene, &[]);
-        let (taylor, b) = run_value(&scene, &["--method", "taylor"]);
-        assert_eq!(linear["method"], "linear", "case {case}: {linear}");
-        for s in [&linear, &taylor] {
-            assert_eq!(s["status"], "completed", "case {case}: {s}");
-        }
-        assert_eq!(a.len(), b.len(), "case {case}");
-        assert!(a.len() >= 10, "case {case}: {} events", a.len());
-        let times = f(&linear["event_time_bound"]) + f(&taylor["event_time_bound"]);
-        for (p, q) in a.iter().zip(&b) {
-            assert_eq!(p["guard"], q["guard"], "case {case}");
-            assert!(
-                (f(&p["t"]) - f(&q["t"])).abs() <= times,
-                "case {case}: {p} vs {q}"
-            );
-        }
-        let states = f(&linear["error_bound"]) + f(&taylor["error_bound"]);
-        for key in ["x", "v"] {
-            let (p, q) = (
-                f(&linear["final_state"][key]),
-                f(&taylor["final_state"][key]),
-            );
-            assert!((p - q).abs() <= states, "case {case} {key}: {p} vs {q}");
-        }
+        let events = agrees_with_taylor_within_both_bounds(&scene, &format!("case {case}"));
+        assert!(events.len() >= 10, "case {case}: {} events", events.len());
     }
 }

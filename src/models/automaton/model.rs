@@ -487,9 +487,7 @@ impl Automaton {
     /// Whether every mode's flow is affine, or affine and driven by sines
     /// of the clock (the linear propagator runs it).
     pub fn all_linear(&self) -> bool {
-        self.modes
-            .iter()
-            .all(|m| m.linear.is_some() || m.driven.is_some() || m.kind == Flow::Frozen)
+        (0..self.modes.len()).all(|m| self.has_affine_flow(m) || self.modes[m].kind == Flow::Frozen)
     }
 
     /// Whether the run ends at the event of `guard` in `mode`.
@@ -631,13 +629,9 @@ impl HybridModel for Automaton {
 
     fn affine_flow(&self, mode: Mode) -> Option<AffineFlow> {
         let m = &self.modes[mode];
-        m.driven.clone().or_else(|| {
-            m.linear.clone().map(|(a, b)| AffineFlow {
-                a,
-                b,
-                waves: Vec::new(),
-            })
-        })
+        m.driven
+            .clone()
+            .or_else(|| m.linear.clone().map(AffineFlow::linear))
     }
 
     fn has_affine_flow(&self, mode: Mode) -> bool {

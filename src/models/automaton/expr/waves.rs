@@ -42,11 +42,12 @@ impl Value {
         (self.waves.is_empty() && vars.iter().all(|v| *v == 0.0)).then_some(c[0])
     }
 
-    fn scaled(mut self, by: f64) -> Self {
-        self.linear.iter_mut().for_each(|v| *v *= by);
+    /// Each coefficient through `f` (a product or a quotient by a
+    /// constant, taken as the tape takes it).
+    fn each(mut self, f: impl Fn(f64) -> f64) -> Self {
+        self.linear.iter_mut().for_each(|v| *v = f(*v));
         for (_, c, s) in &mut self.waves {
-            *c *= by;
-            *s *= by;
+            (*c, *s) = (f(*c), f(*s));
         }
         self
     }
@@ -118,23 +119,16 @@ pub fn driven(flow: &Tape, n: usize, clock: usize) -> Option<AffineFlow> {
             }
             Op::Add(a, b) => v(a).clone().plus(v(b), 1.0),
             Op::Sub(a, b) => v(a).clone().plus(v(b), -1.0),
-            Op::Neg(a) => v(a).clone().scaled(-1.0),
+            Op::Neg(a) => v(a).clone().each(|x| -x),
             Op::Mul(a, b) => match (c(a), c(b)) {
-                (Some(x), _) => v(b).clone().scaled(x),
-                (_, Some(y)) => v(a).clone().scaled(y),
+                (Some(x), _) => v(b).clone().each(|y| x * y),
+                (_, Some(y)) => v(a).clone().each(|x| x * y),
                 _ => return None,
             },
-            Op::Div(a, b) if c(b).is_some() => {
-                let mut quotient = v(a).clone();
-                // Divided as the tape divides: each coefficient by b.
-                let by = c(b).expect("checked");
-                quotient.linear.iter_mut().for_each(|x| *x /= by);
-                for (_, cw, sw) in &mut quotient.waves {
-                    *cw /= by;
-                    *sw /= by;
-                }
-                quotient
-            }
+            Op::Div(a, b) => match c(b) {
+                Some(y) => v(a).clone().each(|x| x / y),
+                None => return None,
+            },
             Op::Call(f @ (Fun::Cos | Fun::Sin), a) if c(a).is_none() => v(a).sine(f, clock)?,
             op if op.operands().all(|r| c(r).is_some()) => {
                 Value::constant(n, op.value(&constants, &[]))
