@@ -316,6 +316,7 @@ impl Dop853 {
             reach,
             guard,
             crossed,
+            ..
         } = crossing;
         let h = self.dense.h;
         let (a, b) = ((tau - 1e-4 * h).max(0.0), (tau + 1e-4 * h).min(h));

@@ -78,6 +78,8 @@ pub struct Crossing<'a> {
     pub guard: &'a dyn Fn(&[f64]) -> f64,
     /// Whether a value of the guard counts as having crossed.
     pub crossed: &'a dyn Fn(f64) -> bool,
+    /// The guard's place among its mode's guards.
+    pub slot: usize,
 }
 
 /// Whether `method` can run every one of `modes` of `model`, by [`motion`]'s
@@ -310,8 +312,11 @@ impl Integrator {
 
     /// The correction to a crossing at `tau` into the last step where the
     /// method's dense output is less accurate than its steps (DOP853, see
-    /// [`Dop853::sharpen`]); `None` for the others and where sharpening
-    /// declines, leaving the dense output's crossing as it was.
+    /// [`Dop853::sharpen`]), or where the method knows the state at the
+    /// crossing to well below an ulp (the linear propagator: an affine
+    /// guard's zero to double-double, see [`Linear::sharpen`]); `None` for
+    /// the others and where sharpening declines, leaving the crossing as
+    /// it was.
     pub fn sharpen<M: HybridModel + ?Sized>(
         &mut self,
         model: &M,
@@ -322,6 +327,7 @@ impl Integrator {
     ) -> Option<f64> {
         match self {
             Integrator::Dop853(m) => m.sharpen(model, mode, y0, crossing, x),
+            Integrator::Linear(m) => m.sharpen(model, mode, crossing, x),
             _ => None,
         }
     }

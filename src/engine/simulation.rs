@@ -592,10 +592,11 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
         };
         let mut sharp = std::mem::take(&mut self.after);
         let crossing = Crossing {
-            tau,
+            tau: self.step_offset + tau,
             reach,
             guard: &guard,
             crossed: &crossed,
+            slot,
         };
         let correction = self
             .integrator

@@ -39,7 +39,7 @@ pub fn quick_two_sum(a: f64, b: f64) -> (f64, f64) {
 /// `a * b` exactly, as the rounded product and its error (one fused
 /// multiply-add; a software one where the target has none).
 #[inline(always)]
-fn two_prod(a: f64, b: f64) -> (f64, f64) {
+pub fn two_prod(a: f64, b: f64) -> (f64, f64) {
     let p = a * b;
     (p, a.mul_add(b, -p))
 }

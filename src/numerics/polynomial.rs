@@ -6,6 +6,7 @@
 //! step into one rounding where the target can ([`eval`]). The two differ
 //! in the last bits only, and each keeps the results it was tested with.
 
+use crate::numerics::double_double::two_sum;
 use crate::numerics::fused::mul_add;
 
 /// `p(s)` by Horner's rule, each step `step(acc, s, c[k])`.
@@ -73,22 +74,27 @@ pub fn shift(c: &mut [f64], a: f64) {
 /// last one to three together: each row's Horner chain waits on its last
 /// step, and independent chains fill the time one would leave idle.
 pub fn eval_compensated_rows(rows: &[f64], width: usize, s: f64, out: &mut [f64]) {
-    eval_compensated_rows_plus(rows, width, s, |_| -0.0, out);
+    eval_compensated_rows_plus(rows, width, s, |_| -0.0, out, None);
 }
 
 /// Row `i` of `rows` at `s`, plus `extra(i)`, into `out[i]`:
 /// [`eval_compensated_plus`] of each row, bit for bit, in lockstep as
-/// [`eval_compensated_rows`].
+/// [`eval_compensated_rows`]; and, where `lo` is given, what rounding
+/// each to `out[i]` left out, into `lo[i]`.
 pub fn eval_compensated_rows_plus(
     rows: &[f64],
     width: usize,
     s: f64,
     extra: impl Fn(usize) -> f64,
     out: &mut [f64],
+    mut lo: Option<&mut [f64]>,
 ) {
     if width == 0 {
         for (i, o) in out.iter_mut().enumerate() {
             *o = extra(i);
+        }
+        if let Some(lo) = lo {
+            lo.fill(0.0);
         }
         return;
     }
@@ -101,13 +107,15 @@ pub fn eval_compensated_rows_plus(
         .zip(four_out.chunks_exact_mut(4))
         .enumerate()
     {
-        lockstep::<4>(group, width, s, |l| extra(4 * g + l), out);
+        let lo = lo.as_deref_mut().map(|lo| &mut lo[4 * g..4 * g + 4]);
+        lockstep::<4>(group, width, s, |l| extra(4 * g + l), out, lo);
     }
     let last = |l| extra(whole + l);
+    let rest_lo = lo.map(|lo| &mut lo[whole..count]);
     match rest_out.len() {
-        1 => lockstep::<1>(rest, width, s, last, rest_out),
-        2 => lockstep::<2>(rest, width, s, last, rest_out),
-        3 => lockstep::<3>(rest, width, s, last, rest_out),
+        1 => lockstep::<1>(rest, width, s, last, rest_out, rest_lo),
+        2 => lockstep::<2>(rest, width, s, last, rest_out, rest_lo),
+        3 => lockstep::<3>(rest, width, s, last, rest_out, rest_lo),
         _ => {}
     }
 }
@@ -121,6 +129,7 @@ fn lockstep<const L: usize>(
     s: f64,
     extra: impl Fn(usize) -> f64,
     out: &mut [f64],
+    lo: Option<&mut [f64]>,
 ) {
     let mut sum: [f64; L] = std::array::from_fn(|l| group[l * width + width - 1]);
     let mut error = [0.0; L];
@@ -136,8 +145,17 @@ fn lockstep<const L: usize>(
             sum[l] = next;
         }
     }
-    for l in 0..L {
-        out[l] = sum[l] + (error[l] + extra(l));
+    match lo {
+        Some(lo) => {
+            for l in 0..L {
+                (out[l], lo[l]) = two_sum(sum[l], error[l] + extra(l));
+            }
+        }
+        None => {
+            for l in 0..L {
+                out[l] = sum[l] + (error[l] + extra(l));
+            }
+        }
     }
 }
 
@@ -185,10 +203,40 @@ mod tests {
         let extra = |i: usize| 1e-17 * (i as f64 - 3.0);
         for count in 1..=9 {
             let mut out = vec![f64::NAN; count];
-            eval_compensated_rows_plus(&rows[..count * width], width, 0.37, extra, &mut out);
+            eval_compensated_rows_plus(&rows[..count * width], width, 0.37, extra, &mut out, None);
             for (i, (o, c)) in out.iter().zip(rows.chunks_exact(width)).enumerate() {
                 let alone = eval_compensated_plus(c, 0.37, extra(i));
                 assert_eq!(o.to_bits(), alone.to_bits(), "{count}, row {i}");
+            }
+        }
+    }
+
+    #[test]
+    fn the_rounding_left_out_carries_each_row_to_double_double() {
+        // Rows whose terms cancel to a small value: `hi + lo` must agree
+        // with a double-double Horner to far below an ulp of `hi` (the
+        // rounding of `hi` alone leaves up to half of one), and `hi` must
+        // be the row's value without `lo` asked for.
+        use crate::numerics::double_double::DoubleDouble;
+        let width = 9;
+        let rows: Vec<f64> = (0..5 * width)
+            .map(|k| ((k * 37 % 11) as f64 - 5.0) / 3.0 * 1.3f64.powi((k % width) as i32))
+            .collect();
+        for s in [-0.7, 0.37, 1.9] {
+            let mut out = vec![f64::NAN; 5];
+            let mut lo = vec![f64::NAN; 5];
+            eval_compensated_rows_plus(&rows, width, s, |_| 1e-17, &mut out, Some(&mut lo));
+            for (i, c) in rows.chunks_exact(width).enumerate() {
+                let exact = c.iter().rev().fold(DoubleDouble::default(), |acc, &c| {
+                    acc * s + DoubleDouble::from(c)
+                }) + DoubleDouble::from(1e-17);
+                let off = ((out[i] - exact.hi) + (lo[i] - exact.lo)).abs();
+                let scale: f64 = c.iter().map(|c| c.abs()).sum::<f64>() * s.abs().max(1.0).powi(8);
+                assert!(off < 1e-30 * scale, "row {i} at {s}: {off:.1e}");
+                assert_eq!(
+                    out[i].to_bits(),
+                    eval_compensated_plus(c, s, 1e-17).to_bits()
+                );
             }
         }
     }

@@ -234,48 +234,68 @@ fn a_mixed_affine_guard_fires_at_its_closed_form_under_the_linear_propagator() {
 
 /// An exactly periodic orbit under the linear propagator: the same
 /// roundings at the same steps of every period must not add up to a drift.
-/// A rotation at `w = fl(pi)` (`x' = w y`, `y' = -w x`) bounced off `x =
-/// 0` by `y -> -y` returns every `T = pi / w` exactly; after 10,000 impacts
-/// and a quarter period more its state is `(sin, cos)(w / 4 - 1e4 (pi -
-/// w))`, the shift from `w / 4` being `1e4 w (T - 1)`. Rounded to double
-/// at every step, the run drifted by 3.7e-13 (a tenth of an ulp of the
-/// phase per period, the same each period); carrying each whole step's
-/// rounding into the next, by 5.9e-14 (what remains is each impact's own
-/// location, and the step after it, which starts from the reset state).
+/// A rotation at `w` (`x' = w y`, `y' = -w x`) bounced off `x = 0` by `y ->
+/// -y` returns every `pi / w`; after `N` impacts and a little more its
+/// state is `(sin, cos)(w t mod pi)`, the phase taken in double-double
+/// (`w t` to 1e-32 of itself, `pi` to 1e-32). Rounded to double at every
+/// step, a run drifted by 3.7e-13 at `w = fl(pi)` (a tenth of an ulp of
+/// the phase per period); carrying each whole step's rounding into the
+/// next, by 2e-14 to 4e-13 over these frequencies (each reset at the
+/// double nearest the crossing, an ulp of the time off the guard, turns
+/// the motion round a little early or late); with each crossing located
+/// to double-double (`Linear::sharpen`), by the final state's rounding
+/// alone.
 #[test]
 fn an_exactly_periodic_orbit_does_not_drift_under_the_linear_propagator() {
     use flicker::models::automaton::{AutomatonBuilder, TransitionBuilder};
-    let w = std::f64::consts::PI;
-    let model = AutomatonBuilder::new()
-        .parameter("w", w)
-        .state("x", 0.0)
-        .state("y", 1.0)
-        .mode(
-            "free",
-            [("x", "w * y"), ("y", "-w * x")],
-            [TransitionBuilder::new("impact", "x")
-                .falling()
-                .barrier()
-                .reset("y", "-y")],
-        )
-        .build()
-        .expect("the model compiles");
-    let mut options = Options::until(1e4 + 0.25);
-    options.method = Method::Linear;
-    let mut log = Recorder::default();
-    let outcome = simulate(&model, 0, &[0.0, 1.0], &options, &mut log);
-    assert_eq!(outcome.status, Status::Completed, "{:?}", outcome.reason);
-    assert_eq!(log.events.len(), 10_000);
-    // pi - fl(pi), to double precision.
-    let pi_tail = 1.2246467991473532e-16;
-    let phase = w / 4.0 - 1e4 * pi_tail;
-    let error = (outcome.final_state[0] - phase.sin())
-        .abs()
-        .max((outcome.final_state[1] - phase.cos()).abs());
-    assert!(error < 1.5e-13, "drifted by {error:.2e}");
-    assert!(
-        error <= outcome.error_bound,
-        "{error:.2e} beyond the stated {:.2e}",
-        outcome.error_bound
-    );
+    use flicker::numerics::double_double::two_prod;
+    const PI_LO: f64 = 1.2246467991473532e-16;
+    for w in [std::f64::consts::PI, 3.0, 2.7, 2.3, 1.9, 1.3, 1.0, 0.77] {
+        let model = AutomatonBuilder::new()
+            .parameter("w", w)
+            .state("x", 0.0)
+            .state("y", 1.0)
+            .mode(
+                "free",
+                [("x", "w * y"), ("y", "-w * x")],
+                [TransitionBuilder::new("impact", "x")
+                    .falling()
+                    .barrier()
+                    .reset("y", "-y")],
+            )
+            .build()
+            .expect("the model compiles");
+        let impacts = 10_000.0;
+        let t_end = impacts * std::f64::consts::PI / w + 0.25;
+        let mut options = Options::until(t_end);
+        options.method = Method::Linear;
+        let mut log = Recorder::default();
+        let outcome = simulate(&model, 0, &[0.0, 1.0], &options, &mut log);
+        assert_eq!(outcome.status, Status::Completed, "{:?}", outcome.reason);
+        assert_eq!(log.events.len(), 10_000, "w = {w}");
+        // w t_end - k pi in double-double: every product split exactly.
+        let (p, p_lo) = two_prod(w, t_end);
+        let (q, q_lo) = two_prod(impacts, std::f64::consts::PI);
+        let phase = (p - q) + (p_lo - q_lo - impacts * PI_LO);
+        let error = (outcome.final_state[0] - phase.sin())
+            .abs()
+            .max((outcome.final_state[1] - phase.cos()).abs());
+        assert!(
+            error < 4.0 * f64::EPSILON,
+            "w = {w}: drifted by {error:.2e}"
+        );
+        assert!(
+            error <= outcome.error_bound,
+            "w = {w}: {error:.2e} beyond the stated {:.2e}",
+            outcome.error_bound
+        );
+        // Each reset is at the crossing itself, to double-double: the
+        // state it turns round is on the guard to far below an ulp.
+        let off = log
+            .events
+            .iter()
+            .map(|e| e.before[0].abs())
+            .fold(0.0, f64::max);
+        assert!(off < 1e-30, "w = {w}: a reset {off:.1e} off the guard");
+    }
 }
