@@ -3,7 +3,7 @@
 //! matrix-vector product instead of a Taylor series.
 //!
 //! With the augmented matrix `M = [[A, b], [0, 0]]` and `y = [x, 1]`, the
-//! flow over `tau` is `exp(M tau) y`. Steps are at most `h = 1 / |M|_1`
+//! flow over `tau` is `exp(M tau) y`. Steps are at most `h = REACH / |M|_1`
 //! long, over which the series of `exp(M h)` is summed to round-off by
 //! [`ORDER`] + 1 terms. Where the mode is small enough (see
 //! [`SOLVED_DIMENSION`]) this holds, once per mode:
@@ -38,9 +38,19 @@ use crate::engine::affine_flow::cos_sin;
 use crate::engine::model::{HybridModel, Mode};
 use crate::numerics::double_double::{DoubleDouble, dot};
 
-/// The degree of a step's series: with `|M| h <= 1`, the first term left
-/// out is below `1 / 25!` (7e-26) of the state.
+/// The degree of a step's series: with `|M| h <= REACH`, the terms left
+/// out sum to below `REACH^25 e^REACH / 25!` (7e-21) of the state.
 pub const ORDER: usize = 24;
+
+/// The longest step in units of `1 / |M|_1`. Over `|M| h = 1` the series
+/// would be summed to 1e-25, far past round-off; over 1.5 to 7e-21, and
+/// the double-double head of a state inside a step ([`FIRST`]) leaves
+/// 3e-8 of an ulp. A longer step costs its series nothing, and every step
+/// saved is a guard series, a root search and a map of the error set saved
+/// (the forced passages: 11,459 steps to 7,641, 1.40x heyoka's time to
+/// 1.12x). Past 1.5 the last terms of a guard's series (see
+/// `Linear::fit_guards`) would cut the steps back.
+pub const REACH: f64 = 1.5;
 
 /// The largest state whose mode is solved once (with its waves, an
 /// augmented state of `m <= SOLVED_DIMENSION + 1`): its propagator holds
@@ -56,7 +66,7 @@ pub const SOLVED_DIMENSION: usize = 32;
 pub struct AffineMode {
     /// `M`, row by row, `m^2` numbers (`m` the augmented state's length).
     pub rows: Vec<f64>,
-    /// The longest step, `1 / |M|_1` (infinite for `M = 0`).
+    /// The longest step, `REACH / |M|_1` (infinite for `M = 0`).
     pub h_bound: f64,
     /// The clock, where sines of it drive the flow.
     clock: Option<usize>,
@@ -85,7 +95,7 @@ pub struct AffineMode {
 /// The terms of a state's series summed in double-double where a step
 /// evaluates it inside (an event's state, a step cut short), so that the
 /// state and what its rounding left out are known to well below an ulp:
-/// past them the terms are below `(|M| h)^13 / 13!` (5e-9) of the state,
+/// past them the terms are below `(|M| h)^13 / 13!` (3e-8) of the state,
 /// and what their rounding adds is below that part of an ulp. A periodic
 /// impact orbit repeats that error every period: with six terms (1e-3 of
 /// an ulp) the mechanism's speed grew an ulp every 7,000 impacts.
@@ -289,7 +299,7 @@ impl AffineMode {
             .map(|j| column_norm(&augmented, j))
             .fold(0.0, f64::max);
         let h_bound = if norm > 0.0 {
-            1.0 / norm
+            REACH / norm
         } else {
             f64::INFINITY
         };
@@ -362,10 +372,10 @@ impl AffineMode {
     /// library's sine and cosine within an ulp, the first-order turn's
     /// product and sum within one each; the scale a power of two, exact),
     /// and drives the state by at most `drive` through a propagator of
-    /// norm at most `e` (`|M| h <= 1`). Zero where no wave drives the
-    /// flow.
+    /// norm at most `e^REACH` (`|M| h <= REACH`). Zero where no wave
+    /// drives the flow.
     pub fn wave_error(&self, h: f64) -> f64 {
-        std::f64::consts::E * 3.0 * f64::EPSILON * self.drive * h
+        REACH.exp() * 3.0 * f64::EPSILON * self.drive * h
     }
 
     /// `n + 1` (and two per wave), the augmented state's length.

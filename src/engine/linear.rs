@@ -4,8 +4,11 @@
 //!
 //! With the augmented matrix `M = [[A, b], [0, 0]]`, the flow from `y` is
 //! `exp(M tau) y = sum_k M^k y tau^k / k!`. Steps are bounded so that
-//! `|M| h <= 1`; over a step the series is then summed to round-off by its
-//! first [`ORDER`] + 1 terms (the rest is below `1 / 25!` of the state).
+//! `|M| h <= 1.5` ([`REACH`]); over a step the series is then summed to
+//! round-off by its first [`ORDER`] + 1 terms (the rest is below 7e-21 of
+//! the state).
+//!
+//! [`REACH`]: crate::engine::affine_mode::REACH
 //!
 //! A small mode is solved once ([`AffineMode`]): a whole step is one
 //! product with its propagator `exp(M h)`, and an affine guard's series
@@ -49,7 +52,7 @@ use crate::engine::integrator::Crossing;
 use crate::engine::locate::{Start, StepScan};
 use crate::engine::model::{HybridModel, Mode};
 use crate::numerics::double_double::{dot, two_prod, two_sum};
-use crate::numerics::polynomial::eval_compensated_rows_plus;
+use crate::numerics::polynomial::{eval, eval_compensated_rows_plus};
 
 /// The exact propagator's working state: each mode met so far solved once,
 /// and the current step.
@@ -164,7 +167,7 @@ impl Linear {
     }
 
     /// One step from `y0` in `mode`, as long as `h_max` and the bound
-    /// `|M| h <= 1` allow; fails if the mode's flow is not linear or the
+    /// `|M| h <= REACH` allow; fails if the mode's flow is not linear or the
     /// state stops being finite.
     pub fn step<M: HybridModel + ?Sized>(
         &mut self,
@@ -281,7 +284,7 @@ impl Linear {
     /// Each guard's series along the step (kept for [`Linear::locate`]),
     /// and the step shortened until every one of them is summed to
     /// round-off by its terms: the state's series converge over `|M| h <=
-    /// 1`, but a guard may read the clock through a sine of any frequency.
+    /// REACH`, but a guard may read the clock through a sine of any frequency.
     /// Returns the guard that shortened the step last, if one did: the one
     /// to blame where the step collapses (`sqrt(x)` near `x = 0`).
     fn fit_guards<M: HybridModel + ?Sized>(&mut self, model: &M, mode: Mode) -> Option<usize> {
@@ -309,12 +312,13 @@ impl Linear {
                 }
             }
             // The last two terms at the step's length far below round-off
-            // (1e-20 of the state's size: as far as the state's own, whose
-            // last term is at most 1 / 24! of it).
+            // (1e-18 of the state's size: as far as the state's own, whose
+            // last two are at most `REACH^23 / 23! + REACH^24 / 24!`, 5e-19,
+            // of it).
             while self.h > 0.0
                 && (c[ORDER - 1].abs() * self.h.powi(ORDER as i32 - 1)
                     + c[ORDER].abs() * self.h.powi(ORDER as i32))
-                    > 1e-20 * scale
+                    > 1e-18 * scale
             {
                 self.h *= 0.5;
                 shortened_by = Some(g);
@@ -461,7 +465,7 @@ impl Linear {
         let w = ORDER + 1;
         self.guard
             .copy_from_slice(&self.guards[guard * w..(guard + 1) * w]);
-        Some(crate::engine::taylor_method::locate_on_series(
+        let scan = crate::engine::taylor_method::locate_on_series(
             model,
             mode,
             guard,
@@ -469,7 +473,52 @@ impl Linear {
             self.h,
             start,
             uncertainty,
-        ))
+        );
+        Some(scan.map(|scan| self.crossed_by_the_end(model, mode, guard, start, scan)))
+    }
+
+    /// `scan`, or a crossing at the step's end where the series found none
+    /// but the guard at the end state (with what its rounding left out)
+    /// has crossed: the series, its terms rounded to double, and the end,
+    /// summed in double-double, may disagree about a crossing within an
+    /// ulp of the end, and the next step, starting past it, would never
+    /// see it (a crossing at `t_end` was lost so).
+    fn crossed_by_the_end<M: HybridModel + ?Sized>(
+        &self,
+        model: &M,
+        mode: Mode,
+        guard: usize,
+        start: Start,
+        scan: StepScan,
+    ) -> StepScan {
+        let row = self.modes[self.mode]
+            .as_ref()
+            .and_then(|solved| solved.guard_rows.get(guard)?.as_deref());
+        let (Some(row), None, Start::Armed) = (row, scan.crossing, start) else {
+            return scan;
+        };
+        let n = self.y1.len();
+        let (at_end, size) = (self.y1.iter().zip(&self.carry).zip(row))
+            .fold((row[n], row[n].abs()), |(sum, size), ((x, lo), c)| {
+                (sum + c * (x + lo), size + (c * x).abs())
+            });
+        // Only an end within rounding of the surface can disagree.
+        if at_end.abs() > 64.0 * f64::EPSILON * size {
+            return scan;
+        }
+        let w = ORDER + 1;
+        let series_end = eval(&self.guards[guard * w..(guard + 1) * w], self.h);
+        if model.guards(mode)[guard]
+            .direction
+            .accepts(series_end, at_end)
+        {
+            StepScan {
+                crossing: Some(1.0),
+                ..scan
+            }
+        } else {
+            scan
+        }
     }
 
     /// Propagator evaluations so far: the steps and exponentials taken.
@@ -477,7 +526,7 @@ impl Linear {
         self.evaluations.get()
     }
 
-    /// The truncation of one propagation's series: below `1 / 25!` of the
+    /// The truncation of one propagation's series: below 7e-21 of the
     /// state, nothing beside the step's rounding (which the engine adds:
     /// see `STEP_ROUNDING_ULPS` in `src/engine/simulation.rs`) and, where
     /// sines of the clock drive the flow, what their values' rounding at
