@@ -27,7 +27,7 @@ use crate::engine::model::{HybridModel, Mode};
 use crate::engine::period_record::{EventFacts, HEADROOM, Op, PeriodRecord};
 use crate::engine::tangent::{Rates, Tangents};
 use crate::engine::zeno;
-use crate::time::Time;
+use crate::time::{Span, Time};
 
 /// Round-off allowed per event, in ulps of the state's size (and of the
 /// time's for event times).
@@ -518,7 +518,7 @@ impl Bound {
 
     /// The run jumped over `periods` periods of `tau` (see
     /// [`periodic`](crate::engine::periodic)): its last event moves with it.
-    pub fn postpone(&mut self, periods: u64, tau: f64) {
+    pub fn postpone(&mut self, periods: u64, tau: Span) {
         self.last_event = self.last_event.map(|t| t.after_multiple(periods, tau));
     }
 

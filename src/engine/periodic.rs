@@ -38,7 +38,7 @@ use std::collections::VecDeque;
 
 use crate::engine::model::Mode;
 use crate::engine::names::Name;
-use crate::time::Time;
+use crate::time::{Span, Time};
 
 /// How far the state after an event may lie from the state after the
 /// previous one, in ulps of the state's largest component, for the orbit
@@ -130,22 +130,22 @@ impl Returns {
     }
 
     /// The time from the event the last returned to, to the last: the
-    /// period.
-    pub fn period(&self) -> f64 {
+    /// period, to double-double.
+    pub fn period(&self) -> Span {
         let k = self.cycle.unwrap_or(1);
         let last = self.visits.len() - 1;
         match (
             self.visits.get(last),
             last.checked_sub(k).and_then(|i| self.visits.get(i)),
         ) {
-            (Some(now), Some(then)) => now.t.since(then.t),
-            _ => f64::NAN,
+            (Some(now), Some(then)) => now.t.span_since(then.t),
+            _ => Span::from(f64::NAN),
         }
     }
 
     /// The run jumped over `periods` periods of `tau`: the events seen
     /// move with it.
-    pub fn postpone(&mut self, periods: u64, tau: f64) {
+    pub fn postpone(&mut self, periods: u64, tau: Span) {
         for v in &mut self.visits {
             v.t = v.t.after_multiple(periods, tau);
         }
@@ -200,7 +200,7 @@ mod tests {
         assert_eq!(r.cycle(), None, "the first event returns to nothing");
         r.visit((0, 0, None), 0, at(2.5), &[0.0, 1.0 + 2.0 * f64::EPSILON]);
         assert_eq!(r.cycle(), Some(1));
-        assert_eq!(r.period(), 1.5);
+        assert_eq!(r.period().value(), 1.5);
         r.visit((0, 1, None), 0, at(3.0), &[0.0, 1.0]);
         assert_eq!(r.cycle(), None, "another guard");
         r.visit((0, 1, None), 0, at(4.0), &[0.0, 1.0 + 1e-12]);
@@ -228,7 +228,7 @@ mod tests {
         assert_eq!(r.cycle(), None);
         wall(&mut r, 0, 3.0);
         assert_eq!(r.cycle(), Some(2));
-        assert_eq!(r.period(), 2.0);
+        assert_eq!(r.period().value(), 2.0);
         let counted: Vec<usize> = r.events().map(|(_, slot, _)| slot).collect();
         assert_eq!(counted, [1, 0]);
         let mut r = Returns::default();
@@ -236,7 +236,7 @@ mod tests {
             r.visit((0, slot, None), 0, Time::new(i as f64), &[slot as f64]);
         }
         assert_eq!(r.cycle(), Some(MAX_CYCLE), "the longest period");
-        assert_eq!(r.period(), MAX_CYCLE as f64);
+        assert_eq!(r.period().value(), MAX_CYCLE as f64);
         assert_eq!(r.events().count(), MAX_CYCLE);
         let mut r = Returns::default();
         for (i, slot) in (0..MAX_CYCLE + 1).chain([0]).enumerate() {

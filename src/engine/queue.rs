@@ -15,7 +15,7 @@ use ordered_float::NotNan;
 use priority_queue::PriorityQueue;
 use rustc_hash::FxBuildHasher;
 
-use crate::time::Time;
+use crate::time::{Span, Time};
 
 type Priority = Reverse<u128>;
 
@@ -88,7 +88,7 @@ impl EventQueue {
 
     /// Move every prediction `k tau` later (a run that jumps over `k`
     /// periods of `tau`); the order is unchanged.
-    pub fn postpone(&mut self, k: u64, tau: f64) {
+    pub fn postpone(&mut self, k: u64, tau: Span) {
         let slots: Vec<usize> = self.queue.iter().map(|(slot, _)| *slot).collect();
         for slot in slots {
             self.schedule(slot, self.exact[slot].after_multiple(k, tau));
@@ -133,7 +133,7 @@ mod tests {
         let mut q = EventQueue::default();
         q.schedule(0, Time::new(2.0));
         q.schedule(4, Time::new(1.5));
-        q.postpone(1000, 0.25);
+        q.postpone(1000, Span::from(0.25));
         assert_eq!(q.pop(), Some((4, Time::new(251.5))));
         assert_eq!(q.pop(), Some((0, Time::new(252.0))));
         assert!(q.pop().is_none());

@@ -63,7 +63,7 @@ use crate::engine::observer::Observer;
 use crate::engine::periodic;
 use crate::engine::run::Status;
 use crate::engine::zeno;
-use crate::time::Time;
+use crate::time::{Span, Time};
 
 /// Why the loop stopped, with a reason for anything but completion.
 #[derive(Debug, Clone)]
@@ -132,13 +132,13 @@ pub(crate) trait Segments {
     /// repeat the last period's.
     ///
     /// [`periodic`]: crate::engine::periodic
-    fn period(&self) -> Option<(f64, u64)> {
+    fn period(&self) -> Option<(Span, u64)> {
         None
     }
 
     /// Jump `periods` whole periods of `tau` ahead (the state repeats),
     /// counting their events in `ledger`.
-    fn jump(&mut self, periods: u64, tau: f64, ledger: &mut Ledger) {
+    fn jump(&mut self, periods: u64, tau: Span, ledger: &mut Ledger) {
         let _ = (periods, tau, ledger);
     }
 
@@ -200,16 +200,19 @@ fn turns<S: Segments + ?Sized, O: Observer + ?Sized>(
                 source.fire(guard, t, ledger, observer)?;
                 // An observer that looks at events sees every one fired.
                 if !observer.wants_details()
-                    && let Some((tau, events)) = source.period()
+                    && let Some((span, events)) = source.period()
                     // Events closer than the run resolves are the Zeno
                     // watch's, not a period's.
-                    && tau / events as f64 > zeno::resolution(t.value(), t_end)
+                    && span.value() / events as f64 > zeno::resolution(t.value(), t_end)
                 {
-                    let limit = samples.peek().map_or(t_end, |&s| s.min(t_end));
+                    let (tau, limit) = (
+                        span.value(),
+                        samples.peek().map_or(t_end, |&s| s.min(t_end)),
+                    );
                     let periods = periodic::periods_to_skip(source.origin(), tau, limit)
                         .min(ledger.jump_allowance((tau, events), source.origin()));
                     if periods > 0 {
-                        source.jump(periods, tau, ledger);
+                        source.jump(periods, span, ledger);
                     }
                 }
             }

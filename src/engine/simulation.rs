@@ -31,7 +31,7 @@ use crate::engine::run::{Options, Outcome, Status};
 use crate::engine::run_loop::{End, Segments, drive, end_window};
 use crate::engine::tangent::guard_gradient;
 use crate::numerics::central_difference::CBRT_EPSILON;
-use crate::time::Time;
+use crate::time::{Span, Time};
 
 /// The state at one of the sample times a run was asked for.
 #[derive(Debug, Clone, Copy)]
@@ -378,13 +378,13 @@ impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
         Ok(())
     }
 
-    fn period(&self) -> Option<(f64, u64)> {
+    fn period(&self) -> Option<(Span, u64)> {
         let events = self.returns.cycle()?;
         match self.motion {
             // The next event, predicted, is the same guard's again.
             Motion::Exact if events == 1 => {
                 let (next, at) = self.queue.peek()?;
-                (Some(next) == self.returns.last_slot()).then(|| (at.since(self.origin), 1))
+                (Some(next) == self.returns.last_slot()).then(|| (at.span_since(self.origin), 1))
             }
             // The events repeat the last period's, and so do the steps.
             Motion::Exact | Motion::Stepped => Some((self.returns.period(), events as u64)),
@@ -392,7 +392,7 @@ impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
         }
     }
 
-    fn jump(&mut self, periods: u64, tau: f64, ledger: &mut Ledger) {
+    fn jump(&mut self, periods: u64, tau: Span, ledger: &mut Ledger) {
         // A bound that carries errors goes over the periods as firing each
         // event would have, as far as its checks allow.
         let periods = if self.bound.idle() {
@@ -413,7 +413,12 @@ impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
             self.step_end = Some(self.origin.after(self.integrator.h()));
         }
         self.returns.postpone(periods, tau);
-        ledger.jumped(self.returns.events(), periods, tau, (from, self.origin));
+        ledger.jumped(
+            self.returns.events(),
+            periods,
+            tau.value(),
+            (from, self.origin),
+        );
     }
 
     fn renew(&mut self, t: Time) -> Result<(), End> {

@@ -462,3 +462,46 @@ fn a_period_whose_steps_run_to_the_end_is_not_jumped() {
         assert_eq!(logged[field], quiet[field], "{field}");
     }
 }
+
+/// A stepped orbit jumped over tens of thousands of periods lands where
+/// firing each event does, to the last ulps: the period, measured between
+/// two events' double-double times, is jumped as a double-double too.
+/// Rounded to a double, the mechanism's period (as an automaton, by the
+/// linear propagator) missed by 2e-18 each time: 8e-14 after 43,372
+/// periods, where firing each impact was 6e-17 off the closed form.
+#[test]
+fn a_jumped_stepped_orbit_lands_where_firing_each_event_does() {
+    use flicker::engine::Method;
+    use flicker::models::automaton::{AutomatonBuilder, TransitionBuilder};
+    let model = AutomatonBuilder::new()
+        .parameter("eta", 0.8)
+        .state("strain", 0.0)
+        .state("strain_rate", (2.0f64 * 0.1).sqrt())
+        .mode(
+            "flight",
+            [
+                ("strain", "strain_rate"),
+                ("strain_rate", "-(strain - (eta - 1))"),
+            ],
+            [TransitionBuilder::new("impact", "strain")
+                .falling()
+                .barrier()
+                .reset("strain", "0")
+                .reset("strain_rate", "-strain_rate")],
+        )
+        .build()
+        .expect("the model compiles");
+    let x0 = [0.0, (2.0f64 * 0.1).sqrt()];
+    let mut options = Options::until(1e5);
+    options.method = Method::Linear;
+    let mut every = Recorder::default();
+    let fired = simulate(&model, 0, &x0, &options, &mut every);
+    let jumped = simulate(&model, 0, &x0, &options, &mut ());
+    assert!(fired.fast_forward.is_none());
+    let periods = jumped.fast_forward.as_ref().expect("jumped").periods;
+    assert!(periods > 43_000, "{periods}");
+    assert_eq!(jumped.events, fired.events);
+    for (a, b) in jumped.final_state.iter().zip(&fired.final_state) {
+        assert!((a - b).abs() <= 4.0 * f64::EPSILON, "{a} jumped, {b} fired");
+    }
+}
