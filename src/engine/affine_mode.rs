@@ -88,8 +88,9 @@ pub struct AffineMode {
     /// Where the mode is small: each state component's rows `e_i M^k / k!`,
     /// `k = 0..=ORDER`, one component after another.
     pub state_rows: Option<Vec<f64>>,
-    /// The same rows for `k <= FIRST`, in double-double.
-    pub first_rows: Option<Vec<DoubleDouble>>,
+    /// The same rows for `k <= FIRST`, in double-double, and the clock's
+    /// component, which needs none (its series is `t + tau`, exact).
+    pub first_rows: Option<(Vec<DoubleDouble>, Option<usize>)>,
 }
 
 /// The terms of a state's series summed in double-double where a step
@@ -162,7 +163,7 @@ pub fn state_series_by_rows(state_rows: &[f64], y: &[f64], series: &mut [f64]) {
 /// the state, are one product of a cached row with `y`.
 pub fn state_series_in_two(
     state_rows: &[f64],
-    first: &[DoubleDouble],
+    (first, clock): (&[DoubleDouble], Option<usize>),
     y: &[f64],
     y_lo: &[f64],
     series: &mut [f64],
@@ -173,7 +174,15 @@ pub fn state_series_in_two(
     let components = state_rows
         .chunks_exact(w * m)
         .zip(first.chunks_exact((FIRST + 1) * m));
-    for ((rows, first), out) in components.zip(series.chunks_exact_mut(w)) {
+    for (i, ((rows, first), out)) in components.zip(series.chunks_exact_mut(w)).enumerate() {
+        if Some(i) == clock {
+            // `t + tau`: its terms exact in double, the start's residual
+            // the only one left out.
+            guard_series(rows, y, &ZEROS[..m], out);
+            lo.push(y_lo[i]);
+            lo.extend([0.0; FIRST]);
+            continue;
+        }
         let (head, tail) = out.split_at_mut(FIRST + 1);
         for (o, row) in head.iter_mut().zip(first.chunks_exact(m)) {
             let term = dot(row, y, y_lo);
@@ -323,7 +332,7 @@ impl AffineMode {
         };
         if m <= SOLVED_DIMENSION + 1 {
             solved.state_rows = Some(solved.component_rows(n));
-            solved.first_rows = Some(solved.first_component_rows(n));
+            solved.first_rows = Some((solved.first_component_rows(n), model.clock()));
             for g in 0..solved.guard_rows.len() {
                 solved.guard_rows[g] = solved.affine_guard_rows(model, mode, g, n);
             }

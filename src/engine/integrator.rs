@@ -327,7 +327,7 @@ impl Integrator {
     ) -> Option<f64> {
         match self {
             Integrator::Dop853(m) => m.sharpen(model, mode, y0, crossing, x),
-            Integrator::Linear(m) => m.sharpen(model, mode, crossing, x),
+            Integrator::Linear(m) => m.sharpen(crossing, x),
             _ => None,
         }
     }

@@ -90,10 +90,10 @@ pub struct Linear {
     /// What rounding the series' first terms left out, `FIRST + 1` per
     /// component (empty where the mode has no double-double rows).
     first_lo: RefCell<Vec<f64>>,
-    /// Scratch for an event's state: what rounding it left out, and the
-    /// flow there.
-    event_lo: Vec<f64>,
-    event_rate: Vec<f64>,
+    /// The last state summed inside the step, and what its rounding left
+    /// out, at the time into the step it was taken (NaN for none): an
+    /// event's state, which [`Linear::sharpen`] then moves.
+    evaluated: RefCell<(f64, Vec<f64>, Vec<f64>)>,
     /// The clock's component and what rounding the run's time to its
     /// reading left out, for the next step (see [`Linear::clock_at`]).
     clock: Option<(usize, f64)>,
@@ -119,8 +119,7 @@ impl Linear {
             y0_lo: vec![0.0; dimension + 1],
             lo_terms: RefCell::new((vec![0.0; dimension + 1], vec![0.0; dimension + 1])),
             first_lo: RefCell::new(Vec::new()),
-            event_lo: vec![0.0; dimension],
-            event_rate: vec![0.0; dimension],
+            evaluated: RefCell::new((f64::NAN, vec![0.0; dimension], vec![0.0; dimension])),
             clock: None,
             evaluations: Cell::new(0),
         }
@@ -207,6 +206,7 @@ impl Linear {
             .augment(y0, &self.y0_lo, &mut self.y0);
         self.h = h_bound.min(h_max);
         self.series_ready.set(false);
+        self.evaluated.get_mut().0 = f64::NAN;
         self.evaluations.set(self.evaluations.get() + 1);
         if model.has_series(mode) {
             let shortened_by = self.fit_guards(model, mode);
@@ -259,9 +259,9 @@ impl Linear {
         let mut first_lo = self.first_lo.borrow_mut();
         first_lo.clear();
         match (&solved.state_rows, &solved.first_rows) {
-            (Some(rows), Some(first)) => state_series_in_two(
+            (Some(rows), Some((first, clock))) => state_series_in_two(
                 rows,
-                first,
+                (first, *clock),
                 &self.y0,
                 &self.y0_lo,
                 &mut series,
@@ -366,10 +366,23 @@ impl Linear {
                 Some(terms) => terms.iter().rev().fold(0.0, |sum, c| sum * tau + c),
                 None => self.y0_lo[i] + tau * (once[i] + 0.5 * tau * twice[i]),
             };
-            let lo = lo.map(|lo| &mut lo[..n]);
-            eval_compensated_rows_plus(&series, ORDER + 1, tau, extra, &mut x[..n], lo);
+            let (at, hi, kept) = &mut *self.evaluated.borrow_mut();
+            eval_compensated_rows_plus(
+                &series,
+                ORDER + 1,
+                tau,
+                extra,
+                &mut x[..n],
+                Some(&mut kept[..n]),
+            );
+            *at = tau;
+            hi[..n].copy_from_slice(&x[..n]);
+            if let Some(lo) = lo {
+                lo[..n].copy_from_slice(&kept[..n]);
+            }
             return;
         }
+        self.evaluated.borrow_mut().0 = f64::NAN;
         let m = self.y0.len();
         let rows = &self.modes[self.mode]
             .as_ref()
@@ -394,33 +407,16 @@ impl Linear {
     /// that every period: a rotation bounced 10,000 times drifted by 4e-13
     /// with the double nearest each crossing, and by 3e-17 from this one.
     /// `None` for a guard that is not affine, or a crossing past the step.
-    pub fn sharpen<M: HybridModel + ?Sized>(
-        &mut self,
-        model: &M,
-        mode: Mode,
-        crossing: &Crossing,
-        x: &mut [f64],
-    ) -> Option<f64> {
-        if !self.inside(crossing.tau) || self.event_lo.len() != x.len() {
+    pub fn sharpen(&mut self, crossing: &Crossing, x: &mut [f64]) -> Option<f64> {
+        let n = x.len();
+        if !self.inside(crossing.tau) || self.evaluated.borrow().1.len() != n {
             return None;
         }
-        let mut lo = std::mem::take(&mut self.event_lo);
-        self.eval_split(crossing.tau, x, &mut lo);
-        let found = self.newton(model, mode, crossing, x, &lo);
-        self.event_lo = lo;
-        found
-    }
-
-    /// The Newton step of [`Linear::sharpen`] from the state `x + lo`.
-    fn newton<M: HybridModel + ?Sized>(
-        &mut self,
-        model: &M,
-        mode: Mode,
-        crossing: &Crossing,
-        x: &mut [f64],
-        lo: &[f64],
-    ) -> Option<f64> {
-        let n = x.len();
+        // The engine has just asked for the state there, as a rule.
+        if self.evaluated.borrow().0 != crossing.tau {
+            self.eval(crossing.tau, x);
+        }
+        let (_, hi, lo) = &*self.evaluated.borrow();
         let row = self.modes[self.mode]
             .as_ref()?
             .guard_rows
@@ -429,21 +425,28 @@ impl Linear {
         // The guard `c . x + d`, its products and sums carried exactly.
         let (c, d) = (&row[..n], row[n]);
         let (mut sum, mut error) = (d, 0.0);
-        for ((c, x), lo) in c.iter().zip(&*x).zip(lo) {
+        for ((c, x), lo) in c.iter().zip(hi).zip(lo) {
             let (product, product_error) = two_prod(*c, *x);
             let (next, sum_error) = two_sum(sum, product);
             sum = next;
             error += product_error + sum_error + c * lo;
         }
-        let rate = &mut self.event_rate;
-        model.rhs(mode, x, rate);
-        let slope: f64 = c.iter().zip(rate.iter()).map(|(c, r)| c * r).sum();
+        // The flow there, from the step's series.
+        let (w, tau) = (ORDER + 1, crossing.tau);
+        let series = self.series.borrow();
+        let rate = |i: usize| {
+            let terms = &series[i * w..(i + 1) * w];
+            (1..w)
+                .rev()
+                .fold(0.0, |sum, k| sum * tau + k as f64 * terms[k])
+        };
+        let slope: f64 = c.iter().enumerate().map(|(i, c)| c * rate(i)).sum();
         let shift = -(sum + error) / slope;
         if !shift.is_finite() || shift.abs() > crossing.reach {
             return None;
         }
-        for ((x, lo), rate) in x.iter_mut().zip(lo).zip(rate.iter()) {
-            *x += lo + rate * shift;
+        for (i, x) in x.iter_mut().enumerate() {
+            *x = hi[i] + (lo[i] + rate(i) * shift);
         }
         Some(shift)
     }
