@@ -176,9 +176,11 @@ pub fn state_series_in_two(
         .zip(first.chunks_exact((FIRST + 1) * m));
     for (i, ((rows, first), out)) in components.zip(series.chunks_exact_mut(w)).enumerate() {
         if Some(i) == clock {
-            // `t + tau`: its terms exact in double, the start's residual
-            // the only one left out.
-            guard_series(rows, y, &ZEROS[..m], out);
+            // `t + tau`: its terms exact in double (past the first two,
+            // zero), the start's residual the only one left out.
+            let (head, rest) = out.split_at_mut(2);
+            guard_series(&rows[..2 * m], y, &ZEROS[..m], head);
+            rest.fill(0.0);
             lo.push(y_lo[i]);
             lo.extend([0.0; FIRST]);
             continue;

@@ -381,7 +381,12 @@ impl Tangents {
         let mut rate_before = std::mem::take(&mut self.up);
         let mut rate_after = std::mem::take(&mut self.down);
         self.rate(model, mode, before, &mut rate_before);
-        self.rate(model, mode_after, after, &mut rate_after);
+        if mode_after == mode && after == before {
+            // A marker: the same flow at the same state.
+            rate_after.copy_from_slice(&rate_before);
+        } else {
+            self.rate(model, mode_after, after, &mut rate_after);
+        }
         let (closing, largest_jump) =
             saltation::matrix(&reset, gradient, &rate_before, &rate_after, out);
         self.a = reset;
