@@ -79,7 +79,7 @@ impl Time {
     /// between two events, which a run may multiply by millions.
     pub fn span_since(self, earlier: Time) -> Span {
         let (s, e) = two_sum(self.hi, -earlier.hi);
-        let (hi, lo) = quick_two_sum(s, e + (self.lo - earlier.lo));
+        let (hi, lo) = two_sum(s, e + (self.lo - earlier.lo));
         Span { hi, lo }
     }
 

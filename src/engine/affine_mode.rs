@@ -36,7 +36,7 @@ use nalgebra::DMatrix;
 use crate::engine::adaptive::StepFailure;
 use crate::engine::affine_flow::cos_sin;
 use crate::engine::model::{HybridModel, Mode};
-use crate::numerics::double_double::{DoubleDouble, dot};
+use crate::numerics::double_double::{DoubleDouble, dots};
 
 /// The degree of a step's series: with `|M| h <= REACH`, the terms left
 /// out sum to below `REACH^25 e^REACH / 25!` (7e-21) of the state.
@@ -88,9 +88,20 @@ pub struct AffineMode {
     /// Where the mode is small: each state component's rows `e_i M^k / k!`,
     /// `k = 0..=ORDER`, one component after another.
     pub state_rows: Option<Vec<f64>>,
-    /// The same rows for `k <= FIRST`, in double-double, and the clock's
-    /// component, which needs none (its series is `t + tau`, exact).
-    pub first_rows: Option<(Vec<DoubleDouble>, Option<usize>)>,
+    /// The same rows for `k <= FIRST`, in double-double.
+    pub first_rows: Option<FirstRows>,
+}
+
+/// Each state component's rows `e_i M^k / k!`, `k = 0..=FIRST`, in
+/// double-double, for [`state_series_in_two`]: by column (the `FIRST + 1`
+/// rows' entries `j` together), their high and low parts apart, one
+/// component after another; and the clock's component, which needs none
+/// (its series is `t + tau`, exact).
+#[derive(Debug, Clone)]
+pub struct FirstRows {
+    hi: Vec<f64>,
+    lo: Vec<f64>,
+    clock: Option<usize>,
 }
 
 /// The terms of a state's series summed in double-double where a step
@@ -140,30 +151,16 @@ pub fn state_series(
     }
 }
 
-/// [`state_series`] for a mode solved once, from its
-/// [`AffineMode::state_rows`]: each coefficient is one product of a cached
-/// row with `y`, rounded once, and the products are independent of each
-/// other (a chain of `ORDER` products with `M` waits on each in turn).
-pub fn state_series_by_rows(state_rows: &[f64], y: &[f64], series: &mut [f64]) {
-    const ZEROS: [f64; SOLVED_DIMENSION + 1] = [0.0; SOLVED_DIMENSION + 1];
-    let (w, m) = (ORDER + 1, y.len());
-    for (rows, out) in state_rows
-        .chunks_exact(w * m)
-        .zip(series.chunks_exact_mut(w))
-    {
-        guard_series(rows, y, &ZEROS[..m], out);
-    }
-}
-
-/// [`state_series_by_rows`] with each component's first `FIRST + 1`
-/// terms from its double-double rows (`first`, the layout of
-/// [`AffineMode::first_rows`]), from `y` and the residual `y_lo` of its
-/// rounding: each rounded once, and what that left out pushed onto `lo`,
-/// `FIRST + 1` per component. The terms past them, each at most `5e-9` of
-/// the state, are one product of a cached row with `y`.
+/// [`state_series`] for a mode solved once, from `y` and the residual
+/// `y_lo` of its rounding: each component's first `FIRST + 1` terms from
+/// its double-double rows ([`FirstRows`]), each rounded once and what that
+/// left out pushed onto `lo` (`FIRST + 1` per component); the terms past
+/// them, each at most `3e-8` of the state, one product of a cached row of
+/// [`AffineMode::state_rows`] with `y`. The products are independent of
+/// each other (a chain of `ORDER` products with `M` waits on each in turn).
 pub fn state_series_in_two(
     state_rows: &[f64],
-    (first, clock): (&[DoubleDouble], Option<usize>),
+    first: &FirstRows,
     y: &[f64],
     y_lo: &[f64],
     series: &mut [f64],
@@ -171,11 +168,15 @@ pub fn state_series_in_two(
 ) {
     const ZEROS: [f64; SOLVED_DIMENSION + 1] = [0.0; SOLVED_DIMENSION + 1];
     let (w, m) = (ORDER + 1, y.len());
-    let components = state_rows
-        .chunks_exact(w * m)
-        .zip(first.chunks_exact((FIRST + 1) * m));
-    for (i, ((rows, first), out)) in components.zip(series.chunks_exact_mut(w)).enumerate() {
-        if Some(i) == clock {
+    let head_len = (FIRST + 1) * m;
+    let components = (state_rows.chunks_exact(w * m)).zip(
+        first
+            .hi
+            .chunks_exact(head_len)
+            .zip(first.lo.chunks_exact(head_len)),
+    );
+    for (i, ((rows, columns), out)) in components.zip(series.chunks_exact_mut(w)).enumerate() {
+        if Some(i) == first.clock {
             // `t + tau`: its terms exact in double (past the first two,
             // zero), the start's residual the only one left out.
             let (head, rest) = out.split_at_mut(2);
@@ -186,8 +187,7 @@ pub fn state_series_in_two(
             continue;
         }
         let (head, tail) = out.split_at_mut(FIRST + 1);
-        for (o, row) in head.iter_mut().zip(first.chunks_exact(m)) {
-            let term = dot(row, y, y_lo);
+        for (o, term) in head.iter_mut().zip(dots::<{ FIRST + 1 }>(columns, y, y_lo)) {
             *o = term.hi;
             lo.push(term.lo);
         }
@@ -334,7 +334,12 @@ impl AffineMode {
         };
         if m <= SOLVED_DIMENSION + 1 {
             solved.state_rows = Some(solved.component_rows(n));
-            solved.first_rows = Some((solved.first_component_rows(n), model.clock()));
+            // The clock's series is `t + tau` where its row of `M` says
+            // `t' = 1`, as an automaton's does.
+            let clock = model.clock().filter(|&c| {
+                c < n && (0..m).all(|j| solved.rows[c * m + j] == if j == n { 1.0 } else { 0.0 })
+            });
+            solved.first_rows = Some(solved.first_component_rows(n, clock));
             for g in 0..solved.guard_rows.len() {
                 solved.guard_rows[g] = solved.affine_guard_rows(model, mode, g, n);
             }
@@ -394,7 +399,8 @@ impl AffineMode {
         (self.rows.len() as f64).sqrt().round() as usize
     }
 
-    /// `exp(M h)` row by row, each entry to about 106 bits: the series
+    /// `exp(M h)` row by row, to double-double rounding and the series'
+    /// truncation (below 7e-21 of the state, see [`ORDER`]): the series
     /// `sum_k (M h)^k / k!` in double-double.
     fn propagator_over(&self, h: f64, m: usize) -> Vec<DoubleDouble> {
         let mut term: Vec<DoubleDouble> = (0..m * m)
@@ -461,26 +467,38 @@ impl AffineMode {
         all
     }
 
-    /// Each state component's rows `e_i M^k / k!`, `k = 0..=FIRST`, one
-    /// component after another, in double-double.
-    fn first_component_rows(&self, n: usize) -> Vec<DoubleDouble> {
+    /// The state components' [`FirstRows`].
+    fn first_component_rows(&self, n: usize, clock: Option<usize>) -> FirstRows {
         let m = self.augmented_len();
-        let mut all = Vec::with_capacity(n * (FIRST + 1) * m);
+        let (mut hi, mut lo) = (Vec::with_capacity(n * (FIRST + 1) * m), Vec::new());
+        let mut rows = vec![DoubleDouble::default(); (FIRST + 1) * m];
         for i in 0..n {
-            let start = all.len();
-            all.extend((0..m).map(|j| DoubleDouble::from(if i == j { 1.0 } else { 0.0 })));
+            rows.fill(DoubleDouble::default());
+            if Some(i) == clock {
+                // Its series is summed in double (see
+                // `state_series_in_two`): its rows stay zero.
+                hi.resize(hi.len() + (FIRST + 1) * m, 0.0);
+                lo.resize(lo.len() + (FIRST + 1) * m, 0.0);
+                continue;
+            }
+            rows[i] = DoubleDouble::from(1.0);
             for k in 1..=FIRST {
                 // row_k = row_{k-1} M / k.
-                let previous = start + (k - 1) * m;
                 for j in 0..m {
                     let sum = (0..m).fold(DoubleDouble::default(), |acc, l| {
-                        acc + all[previous + l] * self.rows[l * m + j]
+                        acc + rows[(k - 1) * m + l] * self.rows[l * m + j]
                     });
-                    all.push(sum.divide(k as f64));
+                    rows[k * m + j] = sum.divide(k as f64);
+                }
+            }
+            for j in 0..m {
+                for k in 0..=FIRST {
+                    hi.push(rows[k * m + j].hi);
+                    lo.push(rows[k * m + j].lo);
                 }
             }
         }
-        all
+        FirstRows { hi, lo, clock }
     }
 
     /// `row M^k / k!` for `k = 0..=ORDER`, one after another.
@@ -564,24 +582,45 @@ mod tests {
         };
         let w = ORDER + 1;
         let mut series = vec![0.0; 2 * w];
-        state_series_by_rows(&mode.component_rows(2), &[0.0, 0.0, 1.0], &mut series);
-        let mut factorial = 1.0;
+        let mut lo = Vec::new();
+        let (y, y_lo) = ([0.0, 0.0, 1.0], [0.0; 3]);
+        let first = mode.first_component_rows(2, None);
+        state_series_in_two(
+            &mode.component_rows(2),
+            &first,
+            &y,
+            &y_lo,
+            &mut series,
+            &mut lo,
+        );
+        let mut factorial = DoubleDouble::from(1.0);
         for k in 0..w {
             if k > 0 {
-                factorial *= k as f64;
+                factorial = factorial * k as f64;
             }
             let sign = if k % 4 < 2 { 1.0 } else { -1.0 };
             // sin t at odd k, cos t - 1 at even k > 0: +-1 / k!.
             let (x, y) = match k {
                 0 => (0.0, 0.0),
-                k if k % 2 == 0 => (0.0, sign / factorial),
-                _ => (sign / factorial, 0.0),
+                k if k % 2 == 0 => (0.0, sign / factorial.hi),
+                _ => (sign / factorial.hi, 0.0),
             };
             for (got, want) in [(series[k], x), (series[w + k], y)] {
                 assert!(
                     (got - want).abs() <= 4.0 * f64::EPSILON * want.abs(),
                     "{k}: {got} vs {want}"
                 );
+            }
+            // The first terms to double-double: `(hi + lo) k!` is +-1 to
+            // far below an ulp.
+            if k <= FIRST {
+                for (i, want) in [(0, x), (1, y)] {
+                    let term = DoubleDouble::from(series[i * w + k])
+                        + DoubleDouble::from(lo[i * (FIRST + 1) + k]);
+                    let one = if want == 0.0 { 0.0 } else { want.signum() };
+                    let off = (term * factorial + DoubleDouble::from(-one)).round();
+                    assert!(off.abs() < 1e-30, "{k}, component {i}: {off:e}");
+                }
             }
         }
     }

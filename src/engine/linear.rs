@@ -45,8 +45,7 @@ use nalgebra::{DMatrix, DVector};
 use crate::engine::adaptive::StepFailure;
 pub use crate::engine::affine_mode::ORDER;
 use crate::engine::affine_mode::{
-    AffineMode, FIRST, guard_series, mat_vec, state_series, state_series_by_rows,
-    state_series_in_two,
+    AffineMode, FIRST, guard_series, mat_vec, state_series, state_series_in_two,
 };
 use crate::engine::integrator::Crossing;
 use crate::engine::locate::{Start, StepScan};
@@ -127,9 +126,8 @@ impl Linear {
 
     /// The next step starts at a time whose clock reading (component
     /// `clock`) left out `rounding`: every step starts from the exact
-    /// time, whether it continues a whole step (whose carry holds the
-    /// same), one cut short (which carries nothing), or starts at an
-    /// event. A flow driven by sines of the clock otherwise sees its
+    /// time, whether it continues a step (whose carry holds the same) or
+    /// starts at an event. A flow driven by sines of the clock otherwise sees its
     /// forcing shifted against the state by up to half an ulp of `t` at
     /// each such step, which adds up where nothing damps it (`x' = cos(w
     /// t)` with a marker: 4e-10 after 2000 passages to `t = 1e4`, 2e-16
@@ -196,7 +194,7 @@ impl Linear {
             *l = if continues { *c } else { 0.0 };
         }
         // The clock's residual is the engine's, whatever the step before
-        // left (a step cut short carries nothing).
+        // left.
         if let Some((clock, rounding)) = self.clock {
             self.y0_lo[clock] = rounding;
         }
@@ -259,16 +257,15 @@ impl Linear {
         let mut first_lo = self.first_lo.borrow_mut();
         first_lo.clear();
         match (&solved.state_rows, &solved.first_rows) {
-            (Some(rows), Some((first, clock))) => state_series_in_two(
+            (Some(rows), Some(first)) => state_series_in_two(
                 rows,
-                (first, *clock),
+                first,
                 &self.y0,
                 &self.y0_lo,
                 &mut series,
                 &mut first_lo,
             ),
-            (Some(rows), None) => state_series_by_rows(rows, &self.y0, &mut series),
-            (None, _) => {
+            _ => {
                 let (term, next) = &mut *self.terms.borrow_mut();
                 state_series(&solved.rows, &self.y0, &mut series, term, next);
             }
@@ -294,9 +291,10 @@ impl Linear {
         // Measured as the state's own series are: against the state's size
         // (a guard's own coefficients, which a fast sine makes large, would
         // excuse any step).
-        let scale = self.y0[..self.y1.len()]
-            .iter()
-            .fold(1.0_f64, |m, v| m.max(v.abs()));
+        let clock = self.clock.map(|(c, _)| c);
+        let scale = (self.y0[..self.y1.len()].iter().enumerate())
+            .filter(|&(i, _)| Some(i) != clock)
+            .fold(1.0_f64, |m, (_, v)| m.max(v.abs()));
         let mut shortened_by = None;
         let mut series = std::mem::take(&mut self.guards);
         for g in 0..guards {
@@ -405,7 +403,8 @@ impl Linear {
     /// off the guard by the rounding of `tau` turns the motion round from
     /// there, a little early or late, and a periodic impact orbit repeats
     /// that every period: a rotation bounced 10,000 times drifted by 4e-13
-    /// with the double nearest each crossing, and by 3e-17 from this one.
+    /// with the double nearest each crossing, and by 1e-17 to 6e-17 (its
+    /// final state's rounding) from this one.
     /// `None` for a guard that is not affine, or a crossing past the step.
     pub fn sharpen(&mut self, crossing: &Crossing, x: &mut [f64]) -> Option<f64> {
         let n = x.len();
@@ -442,7 +441,12 @@ impl Linear {
         };
         let slope: f64 = c.iter().enumerate().map(|(i, c)| c * rate(i)).sum();
         let shift = -(sum + error) / slope;
-        if !shift.is_finite() || shift.abs() > crossing.reach {
+        // The search found the double nearest the crossing: a shift beyond
+        // a few of its ulps is no refinement (and the state moves to first
+        // order only, its second order below 1e-20 of the step's swing
+        // here); nor may it go before the step's start.
+        let polish = (8.0 * f64::EPSILON * tau.abs().max(self.h * 1e-8)).min(crossing.reach);
+        if !shift.is_finite() || shift.abs() > polish || tau + shift < 0.0 {
             return None;
         }
         for (i, x) in x.iter_mut().enumerate() {
@@ -481,11 +485,11 @@ impl Linear {
     }
 
     /// `scan`, or a crossing at the step's end where the series found none
-    /// but the guard at the end state (with what its rounding left out)
-    /// has crossed: the series, its terms rounded to double, and the end,
-    /// summed in double-double, may disagree about a crossing within an
-    /// ulp of the end, and the next step, starting past it, would never
-    /// see it (a crossing at `t_end` was lost so).
+    /// but the step going on from the end starts past the surface: the
+    /// series, its terms rounded to double, and the end with what its
+    /// rounding left out may disagree about a crossing within an ulp of
+    /// the end, and the next step, starting past it, would never see it (a
+    /// crossing at `t_end` was lost so).
     fn crossed_by_the_end<M: HybridModel + ?Sized>(
         &self,
         model: &M,
@@ -500,11 +504,22 @@ impl Linear {
         let (Some(row), None, Start::Armed) = (row, scan.crossing, start) else {
             return scan;
         };
+        // The guard's first term in the step that goes on from here, as
+        // that step will sum it (see `guard_series`): what decides whether
+        // that step starts before the surface or past it.
         let n = self.y1.len();
-        let (at_end, size) = (self.y1.iter().zip(&self.carry).zip(row))
-            .fold((row[n], row[n].abs()), |(sum, size), ((x, lo), c)| {
-                (sum + c * (x + lo), size + (c * x).abs())
-            });
+        let (c, d) = (&row[..n], row[n]);
+        let mut at_end = c.iter().zip(&self.y1).fold(0.0, |sum, (c, x)| sum + c * x) + d;
+        if self.carry.iter().any(|lo| *lo != 0.0) {
+            at_end += c
+                .iter()
+                .zip(&self.carry)
+                .fold(0.0, |sum, (c, lo)| sum + c * lo);
+        }
+        let size = c
+            .iter()
+            .zip(&self.y1)
+            .fold(d.abs(), |size, (c, x)| size + (c * x).abs());
         // Only an end within rounding of the surface can disagree.
         if at_end.abs() > 64.0 * f64::EPSILON * size {
             return scan;
