@@ -155,7 +155,14 @@ pub fn search_fall(c: &[f64], a: f64, b: f64) -> Result<Option<f64>, String> {
         budget: std::cell::Cell::new(MAX_PIECES),
         gave_up: std::cell::Cell::new(false),
     };
-    let root = bound.search((from, b), (at, eval(c, b)), &mut None, 0);
+    let end = eval(c, b);
+    // Falling all the way from above zero to below it (most impacts' steps,
+    // a guard's approach): one root, refined at once, where the pieces
+    // would halve the step until one of them showed as much.
+    if at.0 > 0.0 && end <= 0.0 && falls_throughout(c, b) {
+        return Ok(Some(bound.refine((from, at), (b, end))));
+    }
+    let root = bound.search((from, b), (at, end), &mut None, 0);
     if bound.gave_up.get() {
         return Err(format!(
             "the first root on [{a:e}, {b:e}] could not be isolated within {MAX_PIECES} pieces \
@@ -163,6 +170,22 @@ pub fn search_fall(c: &[f64], a: f64, b: f64) -> Result<Option<f64>, String> {
         ));
     }
     Ok(root)
+}
+
+/// Whether `p' < 0` on all of `[0, b]`: below the convex quadratic
+/// `c_1 + 2 c_2 s + R s^2`, `R = sum_{k >= 3} max(0, k c_k) b^(k - 3)` (the
+/// rising terms at their largest, `s^(k - 1) <= s^2 b^(k - 3)`), which is
+/// largest at an end of the step.
+fn falls_throughout(c: &[f64], b: f64) -> bool {
+    let (Some(&c1), Some(&c2)) = (c.get(1), c.get(2)) else {
+        return c.get(1).is_some_and(|&c1| c1 < 0.0);
+    };
+    let rising = (c.iter().enumerate().skip(3).rev()).fold(0.0, |acc, (k, ck)| {
+        mul_add(acc, b, (k as f64 * ck).max(0.0))
+    });
+    let at_end = c1 + 2.0 * c2 * b + rising * b * b;
+    let pad = 1e-12 * (c1.abs() + 2.0 * (c2 * b).abs() + rising * b * b);
+    c1 < 0.0 && at_end + pad < 0.0
 }
 
 /// The coefficients of `p(a + h)` in `h`: `p^(k)(a) / k!`. The first three
@@ -539,6 +562,25 @@ mod tests {
             (s - exact).abs() <= 8.0 * f64::EPSILON * exact,
             "{s} {exact}"
         );
+    }
+
+    #[test]
+    fn a_fall_all_the_way_is_proven_and_a_turn_is_not() {
+        // p' = -2 + s - 0.3 s^2 < 0 on [0, 1]; p' = -1 + 2 s turns at 1/2;
+        // p' = 0.1 + ... rises at the start.
+        assert!(falls_throughout(&[1.0, -2.0, 0.5, -0.1], 1.0));
+        assert!(!falls_throughout(&[1.0, -1.0, 1.0], 1.0));
+        assert!(!falls_throughout(&[1.0, 0.1, -1.0], 1.0));
+        // Its largest rising term counts at the step's end: -1 + 0.9 s^2
+        // falls on [0, 1], not on [0, 1.1].
+        assert!(falls_throughout(&[1.0, -1.0, 0.0, 0.3], 1.0));
+        assert!(!falls_throughout(&[1.0, -1.0, 0.0, 0.3], 1.1));
+        // The root it then refines: (1 - 2 s)(1 + s^2), from 1 down
+        // through 1/2.
+        let c = [1.0, -2.0, 1.0, -2.0];
+        assert!(falls_throughout(&c, 0.9));
+        let root = first_fall(&c, 0.0, 0.9).unwrap().unwrap();
+        assert!((root - 0.5).abs() <= 4.0 * f64::EPSILON, "{root}");
     }
 
     #[test]
