@@ -144,6 +144,36 @@ mod tests {
     }
 
     #[test]
+    fn a_span_keeps_what_a_double_period_loses() {
+        // Two events 1/3 apart (as a double-double) at times near 1e4:
+        // their span times a million lands where a million additions of
+        // the span do; the span rounded to a double misses by about 1e-12.
+        let third = 1.0 / 3.0;
+        let residual = -3.0f64.mul_add(third, -1.0) / 3.0;
+        let start = Time::new(1e4).after(1e-13);
+        let later = start.after(third).after(residual);
+        let span = later.span_since(start);
+        assert_eq!(span.value(), third);
+        let k = 1_000_000;
+        let mut added = start;
+        for _ in 0..k {
+            added = added.after(third).after(residual);
+        }
+        let jumped = start.after_multiple(k, span);
+        assert!(
+            jumped.since(added).abs() < 1e-20,
+            "{:e}",
+            jumped.since(added)
+        );
+        let rounded = start.after_multiple(k, Span::from(span.value()));
+        assert!(
+            rounded.since(added).abs() > 1e-12,
+            "{:e}",
+            rounded.since(added)
+        );
+    }
+
+    #[test]
     fn since_is_antisymmetric_and_ordered() {
         let a = Time::new(1e7).after(1e-9).after(3e-25);
         let b = Time::new(1e7);

@@ -564,6 +564,49 @@ mod tests {
     }
 
     #[test]
+    fn the_clock_s_series_is_its_time_and_its_rate() {
+        // x' = t, t' = 1 from (0.5, 3 + 2e-16 unrounded): x = 0.5 + 3 s +
+        // s^2 / 2, t = 3 + s; the clock's residual is its own first term's
+        // and x's slope's.
+        let rows = vec![0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0];
+        let mode = AffineMode {
+            rows,
+            h_bound: 1.0,
+            clock: None,
+            waves: Vec::new(),
+            drive: 0.0,
+            propagator: None,
+            series_steps: 0,
+            guard_rows: Vec::new(),
+            state_rows: None,
+            first_rows: None,
+        };
+        let (w, y, y_lo) = (ORDER + 1, [0.5, 3.0, 1.0], [0.0, 2e-16, 0.0]);
+        let (mut series, mut lo) = (vec![f64::NAN; 2 * w], Vec::new());
+        let first = mode.first_component_rows(2, Some(1));
+        state_series_in_two(
+            &mode.component_rows(2),
+            &first,
+            &y,
+            &y_lo,
+            &mut series,
+            &mut lo,
+        );
+        let mut x = vec![0.0; w];
+        x[..3].copy_from_slice(&[0.5, 3.0, 0.5]);
+        let mut t = vec![0.0; w];
+        t[..2].copy_from_slice(&[3.0, 1.0]);
+        assert_eq!(&series[..w], &x[..]);
+        assert_eq!(&series[w..], &t[..]);
+        let mut x_lo = vec![0.0; FIRST + 1];
+        x_lo[1] = 2e-16;
+        let mut t_lo = vec![0.0; FIRST + 1];
+        t_lo[0] = 2e-16;
+        assert_eq!(&lo[..FIRST + 1], &x_lo[..]);
+        assert_eq!(&lo[FIRST + 1..], &t_lo[..]);
+    }
+
+    #[test]
     fn state_rows_give_the_cosine_and_sine_series() {
         // x' = y + 1, y' = -x from (0, 0) (the augmented 1 last): x = sin t,
         // y = cos t - 1.
