@@ -598,9 +598,9 @@ mod tests {
         t[..2].copy_from_slice(&[3.0, 1.0]);
         assert_eq!(&series[..w], &x[..]);
         assert_eq!(&series[w..], &t[..]);
-        let mut x_lo = vec![0.0; FIRST + 1];
+        let mut x_lo = [0.0; FIRST + 1];
         x_lo[1] = 2e-16;
-        let mut t_lo = vec![0.0; FIRST + 1];
+        let mut t_lo = [0.0; FIRST + 1];
         t_lo[0] = 2e-16;
         assert_eq!(&lo[..FIRST + 1], &x_lo[..]);
         assert_eq!(&lo[FIRST + 1..], &t_lo[..]);
