@@ -528,11 +528,32 @@ impl AffineMode {
 mod tests {
     use super::*;
 
-    #[test]
-    fn a_rotation_step_is_its_cosine_and_sine() {
-        // x' = y, y' = -x: M h with h = 1 (|M|_1 = 1).
-        let rows = vec![0.0, 1.0, 0.0, -1.0, 0.0, 0.0, 0.0, 0.0, 0.0];
-        let mode = AffineMode {
+    /// The two states' series of the 3 x 3 augmented matrix `rows` from
+    /// `y` and `y_lo` ([`state_series_in_two`]), and their first terms'
+    /// residuals.
+    fn two_series(
+        rows: Vec<f64>,
+        clock: Option<usize>,
+        y: [f64; 3],
+        y_lo: [f64; 3],
+    ) -> (Vec<f64>, Vec<f64>) {
+        let mode = of_rows(rows);
+        let (mut series, mut lo) = (vec![f64::NAN; 2 * (ORDER + 1)], Vec::new());
+        let first = mode.first_component_rows(2, clock);
+        state_series_in_two(
+            &mode.component_rows(2),
+            &first,
+            &y,
+            &y_lo,
+            &mut series,
+            &mut lo,
+        );
+        (series, lo)
+    }
+
+    /// A mode of the augmented matrix `rows` alone, for what reads only it.
+    fn of_rows(rows: Vec<f64>) -> AffineMode {
+        AffineMode {
             rows,
             h_bound: 1.0,
             clock: None,
@@ -543,7 +564,14 @@ mod tests {
             guard_rows: Vec::new(),
             state_rows: None,
             first_rows: None,
-        };
+        }
+    }
+
+    #[test]
+    fn a_rotation_step_is_its_cosine_and_sine() {
+        // x' = y, y' = -x: M h with h = 1 (|M|_1 = 1).
+        let rows = vec![0.0, 1.0, 0.0, -1.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+        let mode = of_rows(rows);
         let p = mode.propagator_over(1.0, 3);
         let (c, s) = (1.0_f64.cos(), 1.0_f64.sin());
         let expected = [c, s, 0.0, -s, c, 0.0, 0.0, 0.0, 1.0];
@@ -569,29 +597,8 @@ mod tests {
         // s^2 / 2, t = 3 + s; the clock's residual is its own first term's
         // and x's slope's.
         let rows = vec![0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0];
-        let mode = AffineMode {
-            rows,
-            h_bound: 1.0,
-            clock: None,
-            waves: Vec::new(),
-            drive: 0.0,
-            propagator: None,
-            series_steps: 0,
-            guard_rows: Vec::new(),
-            state_rows: None,
-            first_rows: None,
-        };
-        let (w, y, y_lo) = (ORDER + 1, [0.5, 3.0, 1.0], [0.0, 2e-16, 0.0]);
-        let (mut series, mut lo) = (vec![f64::NAN; 2 * w], Vec::new());
-        let first = mode.first_component_rows(2, Some(1));
-        state_series_in_two(
-            &mode.component_rows(2),
-            &first,
-            &y,
-            &y_lo,
-            &mut series,
-            &mut lo,
-        );
+        let w = ORDER + 1;
+        let (series, lo) = two_series(rows, Some(1), [0.5, 3.0, 1.0], [0.0, 2e-16, 0.0]);
         let mut x = vec![0.0; w];
         x[..3].copy_from_slice(&[0.5, 3.0, 0.5]);
         let mut t = vec![0.0; w];
@@ -611,31 +618,8 @@ mod tests {
         // x' = y + 1, y' = -x from (0, 0) (the augmented 1 last): x = sin t,
         // y = cos t - 1.
         let rows = vec![0.0, 1.0, 1.0, -1.0, 0.0, 0.0, 0.0, 0.0, 0.0];
-        let mode = AffineMode {
-            rows,
-            h_bound: 1.0 / 2.0,
-            clock: None,
-            waves: Vec::new(),
-            drive: 0.0,
-            propagator: None,
-            series_steps: 0,
-            guard_rows: Vec::new(),
-            state_rows: None,
-            first_rows: None,
-        };
         let w = ORDER + 1;
-        let mut series = vec![0.0; 2 * w];
-        let mut lo = Vec::new();
-        let (y, y_lo) = ([0.0, 0.0, 1.0], [0.0; 3]);
-        let first = mode.first_component_rows(2, None);
-        state_series_in_two(
-            &mode.component_rows(2),
-            &first,
-            &y,
-            &y_lo,
-            &mut series,
-            &mut lo,
-        );
+        let (series, lo) = two_series(rows, None, [0.0, 0.0, 1.0], [0.0; 3]);
         let mut factorial = DoubleDouble::from(1.0);
         for k in 0..w {
             if k > 0 {
