@@ -426,7 +426,11 @@ impl Bound {
                     .map(|(g, x)| (g * x).abs())
                     .sum::<f64>();
         let widen = jump * residual / closing.abs();
-        self.errors.map(&self.matrix, widen);
+        // A marker's saltation is the identity (the same flow on both
+        // sides of a state it leaves as it was): nothing to map.
+        if widen != 0.0 || !is_identity(&self.matrix, self.gradient.len()) {
+            self.errors.map(&self.matrix, widen);
+        }
         let facts = EventFacts {
             closing,
             depth,
@@ -568,5 +572,32 @@ impl Bound {
                 + self.crossing_rounding
                 + ROUNDOFF_ULPS * f64::EPSILON * t.value().abs()
         })
+    }
+}
+
+/// Whether the row-major `n x n` matrix `m` is exactly the identity.
+fn is_identity(m: &[f64], n: usize) -> bool {
+    n > 0
+        && m.len() == n * n
+        && (m.chunks_exact(n).enumerate()).all(|(i, row)| {
+            (row.iter().enumerate()).all(|(j, &x)| x == f64::from(u8::from(i == j)))
+        })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::is_identity;
+
+    #[test]
+    fn only_the_identity_is_the_identity() {
+        assert!(is_identity(&[1.0, 0.0, -0.0, 1.0], 2));
+        assert!(is_identity(&[1.0], 1));
+        // A saltation that moves anything at all is mapped.
+        assert!(!is_identity(&[1.0, 1e-300, 0.0, 1.0], 2));
+        assert!(!is_identity(&[1.0, 0.0, 0.0, -1.0], 2));
+        assert!(!is_identity(&[1.0, 0.0, 0.0, f64::NAN], 2));
+        // No matrix, or one of the wrong size, is not the identity.
+        assert!(!is_identity(&[], 0));
+        assert!(!is_identity(&[1.0, 0.0, 0.0], 2));
     }
 }

@@ -310,6 +310,12 @@ impl Integrator {
         }
     }
 
+    /// Whether [`Integrator::locate`] can search the last step from inside
+    /// it (Taylor's method: a marker that fired there lets the step go on).
+    pub fn locates_inside(&self) -> bool {
+        matches!(self, Integrator::Taylor(_))
+    }
+
     /// The correction to a crossing at `tau` into the last step where the
     /// method's dense output is less accurate than its steps (DOP853, see
     /// [`Dop853::sharpen`]), or where the method knows the state at the

@@ -777,6 +777,7 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
             && t.value() < self.options.t_end;
         if !(self.motion == Motion::Stepped
             && self.stepped
+            && self.integrator.locates_inside()
             && jump.mode == mode
             && jump.leaves.is_none()
             && !guard.barrier

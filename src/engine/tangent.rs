@@ -24,9 +24,10 @@ pub struct Tangents {
     /// The Jacobian of the last mode asked about, if it is constant (a
     /// linear flow, or one driven by a function of time).
     constant: Option<(Mode, Option<Vec<f64>>)>,
-    /// The last tangent of such a flow and its `tau`: a fixed-step method
-    /// asks for the same one at every step.
-    constant_tangent: Option<(f64, Vec<f64>)>,
+    /// The last two tangents of such a flow and their `tau`: a fixed-step
+    /// method asks for the same one at every step, and an event between
+    /// two steps for one of its own (which must not push the step's out).
+    constant_tangents: [Option<(f64, Vec<f64>)>; 2],
     x: Vec<f64>,
     up: Vec<f64>,
     down: Vec<f64>,
@@ -70,7 +71,7 @@ impl Tangents {
         Tangents {
             n,
             constant: None,
-            constant_tangent: None,
+            constant_tangents: [None, None],
             x: vec![0.0; n],
             up: vec![0.0; n],
             down: vec![0.0; n],
@@ -93,7 +94,7 @@ impl Tangents {
                 .constant_jacobian(mode)
                 .map(|a| (0..n * n).map(|k| a[(k / n, k % n)]).collect());
             self.constant = Some((mode, exact));
-            self.constant_tangent = None;
+            self.constant_tangents = [None, None];
         }
         self.constant.as_ref().and_then(|(_, a)| a.as_deref())
     }
@@ -147,9 +148,8 @@ impl Tangents {
         if self.constant_part(model, mode).is_some() {
             // A constant Jacobian (a linear flow, or one driven by t): the
             // tangent is exp(tau A), no states needed.
-            if let Some((known, tangent)) = &self.constant_tangent
-                && *known == tau
-            {
+            let cached = self.constant_tangents.iter().flatten();
+            if let Some((_, tangent)) = cached.into_iter().find(|(known, _)| *known == tau) {
                 out.copy_from_slice(tangent);
                 (self.a, self.c) = (first, x);
                 return;
@@ -161,12 +161,20 @@ impl Tangents {
             }
             without_clock(n, model.clock(), &mut x);
             exp(n, &x, out);
-            match &mut self.constant_tangent {
+            // The shorter of the two gives way: a whole step is the longest.
+            let [a, b] = &mut self.constant_tangents;
+            let slot = match (a.as_ref(), b.as_ref()) {
+                (None, _) => a,
+                (_, None) => b,
+                (Some((ta, _)), Some((tb, _))) if ta <= tb => a,
+                _ => b,
+            };
+            match slot {
                 Some((known, tangent)) => {
                     *known = tau;
                     tangent.copy_from_slice(out);
                 }
-                None => self.constant_tangent = Some((tau, out.to_vec())),
+                None => *slot = Some((tau, out.to_vec())),
             }
         } else {
             // Magnus' sixth-order generator from the Jacobians at the three
@@ -772,6 +780,7 @@ mod tests {
     use super::*;
     use crate::engine::{Direction, Guard, Jump, Name};
     use crate::names;
+    use nalgebra::DMatrix;
 
     /// `theta'' = -sin(theta)`: a Jacobian that turns along the orbit, so
     /// that its values at two times do not commute.
@@ -882,6 +891,40 @@ mod tests {
             out[2] * f0[0] + out[3] * f0[1],
         ];
         assert!(farthest(&mapped, &f1) < 1e-15, "{mapped:?} against {f1:?}");
+    }
+
+    /// `x'' = -x`: a constant Jacobian, whose tangent over `tau` is the
+    /// rotation by `tau`.
+    struct Oscillator;
+
+    #[rustfmt::skip]
+    impl HybridModel for Oscillator {
+        fn dimension(&self) -> usize { 2 }
+        fn state_names(&self, _: Mode) -> &[Name] { names!["x", "v"] }
+        fn mode_name(&self, _: Mode) -> &str { "swing" }
+        fn guards(&self, _: Mode) -> &[Guard] { NO_GUARD }
+        fn guard(&self, _: Mode, _: usize, _: &[f64]) -> f64 { -1.0 }
+        fn flow(&self, _: Mode) -> Flow { Flow::Ode }
+        fn rhs(&self, _: Mode, x: &[f64], dx: &mut [f64]) { dx[0] = x[1]; dx[1] = -x[0] }
+        fn reset(&self, _: Mode, _: usize, _: &mut [f64]) -> Jump { Jump::to(0) }
+        fn constant_jacobian(&self, _: Mode) -> Option<DMatrix<f64>> {
+            Some(DMatrix::from_row_slice(2, 2, &[0.0, 1.0, -1.0, 0.0]))
+        }
+    }
+
+    #[test]
+    fn a_constant_flow_s_tangents_are_each_their_own_stretch_s() {
+        // Whole steps with an event's stretch between them, in every order
+        // the two cached tangents can be asked for: each is the rotation
+        // by its own stretch, never the other's.
+        let mut tangents = Tangents::new(2);
+        let at = |_: f64, _: &mut [f64]| panic!("a constant flow needs no states");
+        for tau in [1.3, 0.4, 1.3, 0.7, 1.3, 1.3, 0.4, 0.7, 2.0, 1.3] {
+            let mut out = [0.0; 4];
+            tangents.ode(&Oscillator, 0, (tau, None), at, &mut out);
+            let (c, s) = (f64::cos(tau), f64::sin(tau));
+            assert!(farthest(&out, &[c, s, -s, c]) < 1e-15, "tau {tau}: {out:?}");
+        }
     }
 
     #[test]

@@ -128,7 +128,15 @@ impl Parallelepiped {
 
 /// The unit vector along a plane vector, if it has a direction.
 fn direction(v: &[f64]) -> Option<(f64, f64)> {
-    let length = v[0].hypot(v[1]);
+    // The plain root of the squares, correctly rounded enough for a frame
+    // (any orthonormal one encloses the set), where no square overflows or
+    // underflows to lose the length; `hypot` (a libm call) elsewhere.
+    let squares = v[0] * v[0] + v[1] * v[1];
+    let length = if squares.is_normal() && squares < 1e300 {
+        squares.sqrt()
+    } else {
+        v[0].hypot(v[1])
+    };
     (length > 0.0 && length.is_finite()).then(|| (v[0] / length, v[1] / length))
 }
 
