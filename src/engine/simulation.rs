@@ -919,13 +919,18 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
     }
 
     /// Where guards may be undefined, stop at one that is not finite at
-    /// `(origin, state)`: a crossing cannot be looked for in it.
+    /// `(origin, state)`: a crossing cannot be looked for in it. An affine
+    /// guard is defined wherever the state is (which every step checks),
+    /// and a step's search refuses its series where they overflow.
     fn check_guards(&self) -> Result<(), End> {
         let (model, mode) = (self.model, self.mode);
         if !model.may_be_undefined() {
             return Ok(());
         }
         for (g, guard) in model.guards(mode).iter().enumerate() {
+            if guard.affine {
+                continue;
+            }
             let value = model.guard(mode, g, &self.state);
             if !value.is_finite() {
                 let why = model
