@@ -302,6 +302,14 @@ pub trait HybridModel {
     /// Apply the reset of `guard`, which has just fired at state `x`.
     fn reset(&self, mode: Mode, guard: usize, x: &mut [f64]) -> Jump;
 
+    /// Whether the transition of `guard` in `mode` only marks a passage (a
+    /// Poincare section, a threshold): it resets nothing and stays in its
+    /// mode, so no later state depends on its state to the last bits.
+    fn marks_only(&self, mode: Mode, guard: usize) -> bool {
+        let _ = (mode, guard);
+        false
+    }
+
     /// Whether the run ends at the event of `guard` in `mode` (status
     /// `completed`, at the event's time, in the state after its reset).
     fn terminal(&self, mode: Mode, guard: usize) -> bool {

@@ -681,6 +681,11 @@ impl HybridModel for Automaton {
         self.is_terminal(mode, guard)
     }
 
+    fn marks_only(&self, mode: Mode, guard: usize) -> bool {
+        let reset = &self.modes[mode].resets[guard];
+        reset.targets.is_empty() && matches!(reset.pick, Target::Fixed) && reset.to == mode
+    }
+
     fn clock(&self) -> Option<usize> {
         self.clock.then(|| self.states.len() - 1)
     }
