@@ -366,16 +366,30 @@ impl Bound {
         let guard = &model.guards(mode)[slot];
         self.gradient_of(model, mode, slot, before);
         let along = self.errors.along(&self.gradient);
-        let (closing, jump) = self.tangents.saltation(
-            model,
-            mode,
-            slot,
-            before,
-            &self.gradient,
-            mode_after,
-            after,
-            &mut self.matrix,
-        );
+        let (closing, jump) = if mode_after == mode && model.marks_only(mode, slot) {
+            // A passage: the same flow on both sides of a state it leaves
+            // as it was, its saltation the identity.
+            self.tangents.rate(model, mode, before, &mut self.rate);
+            let n = self.gradient.len();
+            for (k, m) in self.matrix.iter_mut().enumerate() {
+                *m = f64::from(u8::from(k % (n + 1) == 0));
+            }
+            let closing = (self.gradient.iter().zip(&self.rate))
+                .map(|(g, f)| g * f)
+                .sum();
+            (closing, 0.0)
+        } else {
+            self.tangents.saltation(
+                model,
+                mode,
+                slot,
+                before,
+                &self.gradient,
+                mode_after,
+                after,
+                &mut self.matrix,
+            )
+        };
         let shift = time_shift(along, closing, depth);
         let since = self.last_event.map(|last| t.since(last));
         // Events closer than the run can resolve are the Zeno watch's to
@@ -417,15 +431,16 @@ impl Bound {
         // Where the event was located, the guard is not exactly zero: the
         // reset came that residual's time early or late (rounding at
         // least), which leaves `f+ - R f-` times it in the state.
-        let residual = model.guard(mode, slot, before).abs()
-            + f64::EPSILON
-                * self
-                    .gradient
-                    .iter()
-                    .zip(before)
-                    .map(|(g, x)| (g * x).abs())
-                    .sum::<f64>();
-        let widen = jump * residual / closing.abs();
+        let widen = if jump == 0.0 {
+            0.0
+        } else {
+            let residual = model.guard(mode, slot, before).abs()
+                + f64::EPSILON
+                    * (self.gradient.iter().zip(before))
+                        .map(|(g, x)| (g * x).abs())
+                        .sum::<f64>();
+            jump * residual / closing.abs()
+        };
         // A marker's saltation is the identity (the same flow on both
         // sides of a state it leaves as it was): nothing to map.
         if widen != 0.0 || !is_identity(&self.matrix, self.gradient.len()) {
