@@ -183,6 +183,9 @@ impl ErrorSet {
     /// Whether `limit > self.along(gradient) + spread`, asking the cheaper
     /// parallelepiped first: its answer bounds the smaller of the two, so
     /// where it settles the question the ellipsoid need not be asked.
+    /// Inlined: a replayed period asks it at every step (see
+    /// `Bound::replay`), where a call costs more than the question.
+    #[inline(always)]
     pub fn within(&self, gradient: &[f64], spread: f64, limit: f64) -> bool {
         if let (Some((box_, _)), false) = (&self.enclosures, self.poisoned)
             && limit > box_.along(&self.reduced(gradient)) + spread

@@ -127,6 +127,7 @@ impl Parallelepiped {
 }
 
 /// The unit vector along a plane vector, if it has a direction.
+#[inline(always)]
 fn direction(v: &[f64]) -> Option<(f64, f64)> {
     // The plain root of the squares, correctly rounded enough for a frame
     // (any orthonormal one encloses the set), where no square overflows or
