@@ -115,7 +115,10 @@ fn replay_period(ops: &[Op<'_>], errors: &mut ErrorSet, (largest, last): &mut (f
             if !shift.is_finite() || (timed && shift > 0.5 * since) {
                 return false;
             }
-            errors.map(saltation, widen);
+            // As the event itself did (see `Bound::across`).
+            if widen != 0.0 || !is_identity(saltation, gradient.len()) {
+                errors.map(saltation, widen);
+            }
             true
         }
     })
@@ -366,9 +369,10 @@ impl Bound {
         let guard = &model.guards(mode)[slot];
         self.gradient_of(model, mode, slot, before);
         let along = self.errors.along(&self.gradient);
-        let (closing, jump) = if mode_after == mode && model.marks_only(mode, slot) {
-            // A passage: the same flow on both sides of a state it leaves
-            // as it was, its saltation the identity.
+        let passage = mode_after == mode && after == before && model.marks_only(mode, slot);
+        let (closing, jump) = if passage {
+            // The same flow on both sides of a state the event left as it
+            // was: the saltation is the identity.
             self.tangents.rate(model, mode, before, &mut self.rate);
             let n = self.gradient.len();
             for (k, m) in self.matrix.iter_mut().enumerate() {
@@ -441,8 +445,8 @@ impl Bound {
                         .sum::<f64>();
             jump * residual / closing.abs()
         };
-        // A marker's saltation is the identity (the same flow on both
-        // sides of a state it leaves as it was): nothing to map.
+        // An identity saltation (a passage's; a reset that changes nothing
+        // there) maps nothing.
         if widen != 0.0 || !is_identity(&self.matrix, self.gradient.len()) {
             self.errors.map(&self.matrix, widen);
         }

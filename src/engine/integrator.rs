@@ -80,9 +80,6 @@ pub struct Crossing<'a> {
     pub crossed: &'a dyn Fn(f64) -> bool,
     /// The guard's place among its mode's guards.
     pub slot: usize,
-    /// Whether the transition only marks a passage (see
-    /// [`HybridModel::marks_only`]).
-    pub passage: bool,
 }
 
 /// Whether `method` can run every one of `modes` of `model`, by [`motion`]'s
@@ -241,17 +238,6 @@ impl Integrator {
             Integrator::Verlet(m) => m.eval(tau, x),
             Integrator::Linear(m) => m.eval(tau, x),
             Integrator::Taylor(m) => m.eval(tau, x),
-        }
-    }
-
-    /// The state at a passage marker `tau` into the last step (see
-    /// [`HybridModel::marks_only`]): what the run goes on from. The
-    /// linear propagator sums its series in double there (see
-    /// [`Linear::eval_in_double`]); the others as [`Integrator::eval`].
-    pub fn eval_passage(&self, tau: f64, x: &mut [f64]) {
-        match self {
-            Integrator::Linear(m) => m.eval_in_double(tau, x),
-            _ => self.eval(tau, x),
         }
     }
 

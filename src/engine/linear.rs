@@ -29,10 +29,7 @@
 //! ([`Linear::sharpen`]): a reset at the double nearest the crossing is
 //! up to an ulp of the time off the guard, the same at every period (the
 //! mechanism, each event fired: 8e-14 off at the end before, 6e-17 now; a
-//! rotation bounced 10,000 times: up to 4e-13 before, 6e-17 now). A
-//! passage marker resets nothing that an orbit repeats: its state is summed
-//! in double and its crossing left where the search put it
-//! ([`Linear::eval_in_double`]).
+//! rotation bounced 10,000 times: up to 4e-13 before, 6e-17 now).
 //!
 //! Events are found on the guards' polynomials: where the model gives its
 //! guards' Taylor series along a flow ([`HybridModel::guard_series`]), by
@@ -48,7 +45,7 @@ use nalgebra::{DMatrix, DVector};
 use crate::engine::adaptive::StepFailure;
 pub use crate::engine::affine_mode::ORDER;
 use crate::engine::affine_mode::{
-    AffineMode, FIRST, SOLVED_DIMENSION, guard_series, mat_vec, state_series, state_series_in_two,
+    AffineMode, FIRST, guard_series, mat_vec, state_series, state_series_in_two,
 };
 use crate::engine::integrator::Crossing;
 use crate::engine::locate::{Start, StepScan};
@@ -335,29 +332,6 @@ impl Linear {
         self.eval_with(tau, x, None);
     }
 
-    /// The state `tau` into the step summed in double, the start's residual
-    /// on its first term only: where no later state depends on it to the
-    /// last bits (a passage marker's, which the run goes on from as from
-    /// any state), at a third of [`Linear::eval`]'s cost. The double-double
-    /// state and the sharpened crossing serve a reset that a periodic orbit
-    /// repeats (see [`Linear::sharpen`]), which a passage does not make.
-    /// As [`Linear::eval`] where the mode keeps no rows or past the step.
-    pub fn eval_in_double(&self, tau: f64, x: &mut [f64]) {
-        const ZEROS: [f64; SOLVED_DIMENSION + 1] = [0.0; SOLVED_DIMENSION + 1];
-        let rows = (self.modes[self.mode].as_ref()).and_then(|solved| solved.state_rows.as_deref());
-        let Some(rows) = rows.filter(|_| self.inside(tau)) else {
-            return self.eval(tau, x);
-        };
-        let (w, m) = (ORDER + 1, self.y0.len());
-        let mut series = [0.0; ORDER + 1];
-        let components = x.iter_mut().zip(rows.chunks_exact(w * m)).zip(&self.y0_lo);
-        for ((x, rows), lo) in components {
-            guard_series(rows, &self.y0, &ZEROS[..m], &mut series);
-            series[0] += lo;
-            *x = eval(&series, tau);
-        }
-    }
-
     /// [`Linear::eval`], and what rounding the state left out into `lo`
     /// (zero beyond the step).
     fn eval_split(&self, tau: f64, x: &mut [f64], lo: &mut [f64]) {
@@ -434,7 +408,7 @@ impl Linear {
     /// `None` for a guard that is not affine, or a crossing past the step.
     pub fn sharpen(&mut self, crossing: &Crossing, x: &mut [f64]) -> Option<f64> {
         let n = x.len();
-        if crossing.passage || !self.inside(crossing.tau) || self.evaluated.borrow().1.len() != n {
+        if !self.inside(crossing.tau) || self.evaluated.borrow().1.len() != n {
             return None;
         }
         // The engine has just asked for the state there, as a rule.

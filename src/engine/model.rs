@@ -303,8 +303,10 @@ pub trait HybridModel {
     fn reset(&self, mode: Mode, guard: usize, x: &mut [f64]) -> Jump;
 
     /// Whether the transition of `guard` in `mode` only marks a passage (a
-    /// Poincare section, a threshold): it resets nothing and stays in its
-    /// mode, so no later state depends on its state to the last bits.
+    /// Poincare section, a threshold): it resets nothing (its reset's
+    /// Jacobian is the identity) and stays in its mode, so its saltation
+    /// is the identity. The run still goes on from the state it located,
+    /// which is located as exactly as a reset's.
     fn marks_only(&self, mode: Mode, guard: usize) -> bool {
         let _ = (mode, guard);
         false

@@ -205,15 +205,8 @@ impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
         let (model, mode) = (self.model, self.mode);
         let guard = &model.guards(mode)[slot];
         let mut before = std::mem::take(&mut self.before);
-        let passage = model.marks_only(mode, slot);
-        match self.motion {
-            Motion::Stepped if passage && self.stepped => {
-                let tau = self.step_offset + t.since(self.origin);
-                self.integrator.eval_passage(tau, &mut before);
-            }
-            _ => self.state_at(t.since(self.origin), &mut before),
-        }
-        let t = self.sharpen((slot, passage), t, &mut before);
+        self.state_at(t.since(self.origin), &mut before);
+        let t = self.sharpen(slot, t, &mut before);
         self.set_clock(t, &mut before);
         // How far into the current step the event is.
         let into_step = self.step_offset + t.since(self.origin);
@@ -563,9 +556,8 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
     /// [`Integrator::sharpen`]); the correction stays within a thousandth of
     /// the step and before the next queued event, so the order of events
     /// is kept. A re-fire at the segment's start is left alone: its state
-    /// is the segment's own. A passage (`passage`, see
-    /// [`HybridModel::marks_only`]) is the integrator's to decline.
-    fn sharpen(&mut self, (slot, passage): (usize, bool), t: Time, x: &mut [f64]) -> Time {
+    /// is the segment's own.
+    fn sharpen(&mut self, slot: usize, t: Time, x: &mut [f64]) -> Time {
         let tau = t.since(self.origin);
         // An event due at t_end is fired there (see run_loop.rs).
         if !(self.motion == Motion::Stepped && self.stepped)
@@ -610,7 +602,6 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
             guard: &guard,
             crossed: &crossed,
             slot,
-            passage,
         };
         let correction = self
             .integrator
@@ -928,18 +919,13 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
     }
 
     /// Where guards may be undefined, stop at one that is not finite at
-    /// `(origin, state)`: a crossing cannot be looked for in it. An affine
-    /// guard is defined wherever the state is (which every step checks),
-    /// and a step's search refuses its series where they overflow.
+    /// `(origin, state)`: a crossing cannot be looked for in it.
     fn check_guards(&self) -> Result<(), End> {
         let (model, mode) = (self.model, self.mode);
         if !model.may_be_undefined() {
             return Ok(());
         }
         for (g, guard) in model.guards(mode).iter().enumerate() {
-            if guard.affine {
-                continue;
-            }
             let value = model.guard(mode, g, &self.state);
             if !value.is_finite() {
                 let why = model

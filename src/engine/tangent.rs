@@ -24,9 +24,10 @@ pub struct Tangents {
     /// The Jacobian of the last mode asked about, if it is constant (a
     /// linear flow, or one driven by a function of time).
     constant: Option<(Mode, Option<Vec<f64>>)>,
-    /// The last two tangents of such a flow and their `tau`: a fixed-step
-    /// method asks for the same one at every step, and an event between
-    /// two steps for one of its own (which must not push the step's out).
+    /// The last two tangents of such a flow and their `tau`, the latest
+    /// used first: a fixed-step method asks for the same one at every
+    /// step, and an event between two steps for one of its own (which
+    /// must not push the step's out).
     constant_tangents: [Option<(f64, Vec<f64>)>; 2],
     x: Vec<f64>,
     up: Vec<f64>,
@@ -148,9 +149,13 @@ impl Tangents {
         if self.constant_part(model, mode).is_some() {
             // A constant Jacobian (a linear flow, or one driven by t): the
             // tangent is exp(tau A), no states needed.
-            let cached = self.constant_tangents.iter().flatten();
-            if let Some((_, tangent)) = cached.into_iter().find(|(known, _)| *known == tau) {
-                out.copy_from_slice(tangent);
+            let hit = (self.constant_tangents.iter())
+                .position(|cached| cached.as_ref().is_some_and(|(known, _)| *known == tau));
+            if let Some(slot) = hit {
+                self.constant_tangents.swap(0, slot);
+                if let Some((_, tangent)) = &self.constant_tangents[0] {
+                    out.copy_from_slice(tangent);
+                }
                 (self.a, self.c) = (first, x);
                 return;
             }
@@ -161,20 +166,14 @@ impl Tangents {
             }
             without_clock(n, model.clock(), &mut x);
             exp(n, &x, out);
-            // The shorter of the two gives way: a whole step is the longest.
-            let [a, b] = &mut self.constant_tangents;
-            let slot = match (a.as_ref(), b.as_ref()) {
-                (None, _) => a,
-                (_, None) => b,
-                (Some((ta, _)), Some((tb, _))) if ta <= tb => a,
-                _ => b,
-            };
-            match slot {
+            // The one used less lately gives way, and the new one goes first.
+            self.constant_tangents.swap(0, 1);
+            match &mut self.constant_tangents[0] {
                 Some((known, tangent)) => {
                     *known = tau;
                     tangent.copy_from_slice(out);
                 }
-                None => *slot = Some((tau, out.to_vec())),
+                empty => *empty = Some((tau, out.to_vec())),
             }
         } else {
             // Magnus' sixth-order generator from the Jacobians at the three

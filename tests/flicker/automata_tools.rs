@@ -352,3 +352,39 @@ fn the_event_table_of_an_automaton_has_its_states_before_and_after() {
     }
     assert!(rows > 30, "{rows} bounces");
 }
+
+/// Only a transition that resets nothing and stays in its mode marks a
+/// passage (its saltation the identity, see `HybridModel::marks_only`): a
+/// reset, even of one state to itself, or a change of mode, does not.
+#[test]
+fn only_a_transition_that_changes_nothing_marks_a_passage() {
+    use flicker::engine::HybridModel;
+    use flicker::models::automaton::{AutomatonBuilder, TransitionBuilder};
+    let model = AutomatonBuilder::new()
+        .state("x", 1.0)
+        .state("v", 0.0)
+        .mode(
+            "a",
+            [("x", "v"), ("v", "-x")],
+            [
+                TransitionBuilder::new("section", "x").rising(),
+                TransitionBuilder::new("kept", "x").reset("v", "v"),
+                TransitionBuilder::new("away", "v").to("b"),
+                TransitionBuilder::new("bounce", "x")
+                    .falling()
+                    .barrier()
+                    .reset("v", "-v"),
+            ],
+        )
+        .mode(
+            "b",
+            [("x", "v"), ("v", "-x")],
+            [TransitionBuilder::new("back", "v").to("a")],
+        )
+        .initial_mode("a")
+        .build()
+        .expect("the model compiles");
+    let marks: Vec<bool> = (0..4).map(|g| model.marks_only(0, g)).collect();
+    assert_eq!(marks, [true, false, false, false]);
+    assert!(!model.marks_only(1, 0));
+}
