@@ -369,31 +369,16 @@ impl Bound {
         let guard = &model.guards(mode)[slot];
         self.gradient_of(model, mode, slot, before);
         let along = self.errors.along(&self.gradient);
-        let passage = mode_after == mode && after == before && model.marks_only(mode, slot);
-        let (closing, jump) = if passage {
-            // The same flow on both sides of a state the event left as it
-            // was: the saltation is the identity.
-            self.tangents.rate(model, mode, before, &mut self.rate);
-            let n = self.gradient.len();
-            for (k, m) in self.matrix.iter_mut().enumerate() {
-                *m = f64::from(u8::from(k % (n + 1) == 0));
-            }
-            let closing = (self.gradient.iter().zip(&self.rate))
-                .map(|(g, f)| g * f)
-                .sum();
-            (closing, 0.0)
-        } else {
-            self.tangents.saltation(
-                model,
-                mode,
-                slot,
-                before,
-                &self.gradient,
-                mode_after,
-                after,
-                &mut self.matrix,
-            )
-        };
+        let (closing, jump) = self.tangents.saltation(
+            model,
+            mode,
+            slot,
+            before,
+            &self.gradient,
+            mode_after,
+            after,
+            &mut self.matrix,
+        );
         let shift = time_shift(along, closing, depth);
         let since = self.last_event.map(|last| t.since(last));
         // Events closer than the run can resolve are the Zeno watch's to
@@ -598,9 +583,8 @@ impl Bound {
 fn is_identity(m: &[f64], n: usize) -> bool {
     n > 0
         && m.len() == n * n
-        && (m.chunks_exact(n).enumerate()).all(|(i, row)| {
-            (row.iter().enumerate()).all(|(j, &x)| x == f64::from(u8::from(i == j)))
-        })
+        && (m.chunks_exact(n).enumerate())
+            .all(|(i, row)| (row.iter().enumerate()).all(|(j, &x)| x == f64::from(i == j)))
 }
 
 #[cfg(test)]

@@ -355,8 +355,9 @@ impl Tangents {
 
     /// The saltation matrix of `guard`'s event at `before` in `mode`, into
     /// `out` ([`saltation::matrix`]), the reset's Jacobian the model's or
-    /// central differences: the closing speed and the largest jump of the
-    /// rate.
+    /// central differences (a passage's, see [`HybridModel::marks_only`],
+    /// the identity without either): the closing speed and the largest
+    /// jump of the rate.
     #[allow(clippy::too_many_arguments)]
     pub fn saltation<M: HybridModel + ?Sized>(
         &mut self,
@@ -370,6 +371,19 @@ impl Tangents {
         out: &mut [f64],
     ) -> (f64, f64) {
         let n = self.n;
+        if mode_after == mode && after == before && model.marks_only(mode, guard) {
+            // A passage: the same flow on both sides of a state it left as
+            // it was. Its saltation is the identity; only its closing speed
+            // is asked of the flow.
+            let mut rate = std::mem::take(&mut self.up);
+            self.rate(model, mode, before, &mut rate);
+            for (k, o) in out[..n * n].iter_mut().enumerate() {
+                *o = f64::from(k % (n + 1) == 0);
+            }
+            let closing = gradient.iter().zip(&rate).map(|(g, f)| g * f).sum();
+            self.up = rate;
+            return (closing, 0.0);
+        }
         let mut reset = std::mem::take(&mut self.a);
         // The reset's Jacobian: the model's, else central differences.
         let exact = model.reset_jacobian(mode, guard, before, &mut reset[..n * n]);
