@@ -23,7 +23,7 @@ if [ "${1:-}" = "--heyoka-cases" ]; then
   "$venv/bin/python" -c "import heyoka, mpmath" 2>/dev/null || "$venv/bin/pip" install --quiet heyoka mpmath
   n="${2:-7}"
   cd "$top"
-  for case in case1_mechanism case2_henon_heiles case2b_hh_noevents case3_pendulum case4_forced; do
+  for case in case1_mechanism case2_henon_heiles case2b_hh_noevents case2d_hh_tangent case3_pendulum case4_forced; do
     FLICKER="$top/target/release/flicker" "$venv/bin/python" "$top/benches/peers/heyoka/$case.py" "$n"
   done
   exit 0
