@@ -21,14 +21,22 @@
 //!   rest, 100 impacts), medians of 7 runs, and their ratio; and the charts
 //!   by Taylor's method at machine precision.
 //!
+//! - one Taylor series of Henon-Heiles at order 20 (machine precision),
+//!   compiled, called 20,000 times in a loop: nanoseconds a call, the
+//!   median of 15 such loops (heyoka's whole step of the same flow, series
+//!   and all, is timed by `benches/peers/heyoka/case2b_hh_noevents.py`).
+//!
 //! heyoka itself is timed beside it by `benches/peers/heyoka_mechanism.py`,
 //! SciPy by `benches/peers/scipy_mechanism.py --automaton`.
 
+use std::hint::black_box;
 use std::time::Instant;
 
 use serde_json::{Value, json};
 
+use flicker::engine::HybridModel;
 use flicker::log::JsonlWriter;
+use flicker::models::automaton::AutomatonBuilder;
 use flicker::models::mechanism::{ExactOrbit, Mechanism};
 use flicker::runner::Control;
 use flicker::scene::Registry;
@@ -215,5 +223,50 @@ fn main() {
     println!(
         "  charts automaton, taylor (default)   {taylor_impacts} impacts in {taylor_seconds:.4} s ({:.2}x)",
         taylor_seconds / builtin_seconds
+    );
+
+    println!();
+    series_in_a_loop();
+}
+
+/// One compiled Taylor series of Henon-Heiles at order 20, in a loop.
+fn series_in_a_loop() {
+    let henon_heiles = AutomatonBuilder::new()
+        .state("x", 0.05)
+        .state("y", 0.3)
+        .state("px", 0.3521363372331802)
+        .state("py", 0.0)
+        .mode(
+            "m",
+            [
+                ("x", "px"),
+                ("y", "py"),
+                ("px", "-x - 2 * x * y"),
+                ("py", "-y - x^2 + y^2"),
+            ],
+            [],
+        )
+        .build()
+        .unwrap();
+    let (order, calls) = (20, 20_000);
+    let x0 = [0.05, 0.3, 0.3521363372331802, 0.0];
+    let mut series = vec![0.0; 4 * (order + 1)];
+    // Warmed up: the series is compiled after its first calls.
+    for _ in 0..1000 {
+        henon_heiles.flow_series(0, &x0, order, &mut series);
+    }
+    let (seconds, _) = median_of(15, || {
+        for i in 0..calls {
+            // A state that changes, as a run's does.
+            let mut x = black_box(x0);
+            x[0] += (i % 2) as f64 * 1e-9;
+            henon_heiles.flow_series(0, &x, order, &mut series);
+            black_box(&series);
+        }
+        calls
+    });
+    println!(
+        "a Henon-Heiles series at order 20, compiled, in a loop: {:.0} ns a call (median of 15 loops of {calls})",
+        seconds / calls as f64 * 1e9
     );
 }

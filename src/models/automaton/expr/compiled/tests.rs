@@ -80,6 +80,9 @@ fn every_compiled_instruction_gives_the_interpreters_bits() {
     same_as_interpreted(&["cos(x + y)", "sin(2 * x) * cos(y)"], &xy, &state);
     same_as_interpreted(&["sinh(x) - y", "cosh(y) * x"], &xy, &state);
     same_as_interpreted(&["exp(-x) * y", "-exp(x * y)"], &xy, &state);
+    // A value kept in a register (`x * y`), used again after a function's
+    // call has clobbered the registers.
+    same_as_interpreted(&["(x * y) * sin(y) + x * y", "x"], &xy, &state);
     // A rate that is an input, or a constant (a clock), or the same
     // register as another's.
     same_as_interpreted(&["y", "x", "1"], &["x", "y", "t"], &[0.2, 0.1, 5.0]);
