@@ -145,7 +145,7 @@ fn lower(tape: &Tape, layout: &Layout) -> Option<Code> {
     use crate::models::automaton::expr::compiled::machine::Emitter;
     use crate::models::automaton::expr::tape::{FUNS, FUNS2};
 
-    let mut e = Emitter::new()?;
+    let mut e = Emitter::new(layout.extents(tape.outputs.len()))?;
     let anywhere = layout.output(0);
     for (r, &op) in tape.ops.iter().enumerate() {
         let r = r as u32;

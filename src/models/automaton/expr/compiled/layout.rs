@@ -1,8 +1,9 @@
 //! Where compiled code finds each register's coefficients (a value is a
-//! series of one): three buffers, each addressed from its own base
-//! register.
+//! series of one): three buffers, which the code reaches through its
+//! windows (`machine.rs`).
 //!
-//! - the work buffer: the main series of every computed register, then
+//! - the work buffer: the main series of every computed register, one
+//!   after another, then
 //!   the helper series (the partner `cos` of a `sin`), `width`
 //!   coefficients each, as the interpreter keeps them; an evaluation's
 //!   outputs after them;
@@ -34,6 +35,8 @@ pub struct Layout {
     helpers: usize,
     /// Where the integers start in the pool.
     integers: usize,
+    /// How long the state is (the inputs' series).
+    state: usize,
 }
 
 /// The byte offset of coefficient `index` (displacements are 32-bit; the
@@ -45,6 +48,10 @@ fn bytes(index: usize) -> i32 {
 impl Layout {
     pub fn new(tape: &Tape, width: usize) -> Layout {
         let mut pool = Vec::new();
+        // The computed registers' series one after another, with no room
+        // left for the others (the code reaches more of them through its
+        // windows, see `machine.rs`).
+        let mut computed = 0;
         let series = (0..tape.ops.len())
             .map(|r| match tape.ops[r] {
                 Op::Const(c) => {
@@ -54,17 +61,28 @@ impl Layout {
                     (Base::Pool, at)
                 }
                 Op::Input(i) => (Base::State, i as usize * width),
-                _ => (Base::Work, r * width),
+                _ => {
+                    computed += 1;
+                    (Base::Work, (computed - 1) * width)
+                }
             })
             .collect();
         let integers = pool.len();
         pool.extend((0..=width).map(|j| j as f64));
         pool.push(-1.0);
+        let inputs = (tape.ops.iter())
+            .filter_map(|op| match op {
+                Op::Input(i) => Some(*i as usize + 1),
+                _ => None,
+            })
+            .max()
+            .unwrap_or(0);
         Layout {
             pool,
             series,
-            helpers: tape.ops.len() * width,
+            helpers: computed * width,
             integers,
+            state: inputs * width,
         }
     }
 
@@ -89,6 +107,12 @@ impl Layout {
     /// How long the work buffer is for `outputs` evaluated outputs.
     pub fn work(&self, outputs: usize) -> usize {
         2 * self.helpers + outputs
+    }
+
+    /// The bytes the code may address in each buffer (work, state, pool),
+    /// with `outputs` evaluated outputs.
+    pub fn extents(&self, outputs: usize) -> [usize; 3] {
+        [self.work(outputs), self.state, self.pool.len()].map(|n| n * size_of::<f64>())
     }
 
     /// The integer `j` as a float.

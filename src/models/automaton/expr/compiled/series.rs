@@ -67,7 +67,7 @@ pub struct CompiledFlow {
 }
 
 /// The most terms (coefficient operations) a compiled series may hold:
-/// about 25 bytes of code each, so 100 MB at most.
+/// 15 to 25 bytes of code each, so 100 MB at most.
 const MAX_TERMS: usize = 4_000_000;
 
 impl CompiledFlow {
@@ -224,7 +224,7 @@ fn lower(tape: &Tape, layout: &Layout, order: usize) -> Option<Code> {
     use crate::models::automaton::expr::compiled::machine::Emitter;
     use crate::models::automaton::expr::tape::Fun;
 
-    let mut e = Emitter::new()?;
+    let mut e = Emitter::new(layout.extents(0))?;
     let constant = |r: u32| matches!(tape.ops[r as usize], Op::Const(_));
     let degree = degrees(tape);
     // The terms `j` of a Cauchy sum `sum_j a_j b_(k - j)` (from `lo`) whose
