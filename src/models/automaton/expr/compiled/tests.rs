@@ -109,6 +109,26 @@ fn every_compiled_instruction_gives_the_interpreters_bits() {
         &["t", "p", "q", "x", "y"],
         &[1.5, -0.25, 0.125, 0.4, -0.3],
     );
+    // A chain of twelve coupled cubic oscillators with a sine: more
+    // series than the code has windows into its buffers, so that places
+    // past them are reached from the buffers' bases, and windows set
+    // again after the sine's call.
+    let names: Vec<String> = (0..12).map(|i| format!("x{i}")).collect();
+    let rates: Vec<String> = (0..12)
+        .map(|i| {
+            let (left, right) = (&names[(i + 11) % 12], &names[(i + 1) % 12]);
+            let me = &names[i];
+            if i == 5 {
+                format!("{left} - 2 * {me} + {right} - {me}^3 + 0.1 * sin({left} * {right})")
+            } else {
+                format!("{left} - 2 * {me} + {right} - {me}^3 + c * {left} * {me}")
+            }
+        })
+        .collect();
+    let inputs: Vec<&str> = names.iter().map(String::as_str).collect();
+    let texts: Vec<&str> = rates.iter().map(String::as_str).collect();
+    let start: Vec<f64> = (0..12).map(|i| 0.1 * (i as f64 - 5.5)).collect();
+    same_as_interpreted(&texts, &inputs, &start);
     // Squares of polynomials: their pairs and middle terms past the
     // degree left out.
     same_as_interpreted(
