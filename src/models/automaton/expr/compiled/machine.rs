@@ -17,7 +17,8 @@
 //! of code instead of 18 KB, and a bare run of it 9% faster.
 //!
 //! Every result is stored, and the last ones stored are also kept in
-//! xmm4-xmm15 (see `Kept`): an operand read soon after it was written
+//! xmm4-xmm15 (see `Kept`; arithmetic computes in the register that then
+//! keeps its value, `Emitter::fresh`): an operand read soon after it was written
 //! comes from its register, not back through memory, where each store
 //! and load would add the processor's store-to-load latency to the
 //! series' chain of dependent terms (a Henon-Heiles series at order 20,
@@ -120,18 +121,23 @@ mod x64 {
                 .find(|&r| self.places[r as usize] == Some(place))
         }
 
-        /// A register for a copy of `place` (which no other then holds).
-        fn take(&mut self, place: Place) -> u8 {
-            if let Some(r) = self.find(place) {
-                self.places[r as usize] = None;
-            }
+        /// The next register in turn, holding nothing now.
+        fn fresh(&mut self) -> u8 {
             if !KEPT.contains(&self.next) {
                 self.next = KEPT.start;
             }
             let r = self.next;
             self.next += 1;
-            self.places[r as usize] = Some(place);
+            self.places[r as usize] = None;
             r
+        }
+
+        /// Register `r` holds `place` (which no other then does).
+        fn hold(&mut self, place: Place, r: u8) {
+            if let Some(old) = self.find(place) {
+                self.places[old as usize] = None;
+            }
+            self.places[r as usize] = Some(place);
         }
 
         fn forget(&mut self) {
@@ -325,11 +331,24 @@ mod x64 {
         pub fn div(&mut self, x: u8, place: Place) {
             self.at(DIVSD, x, place);
         }
+        /// A register to compute a value in that is then stored: it keeps
+        /// the value with no copy (see [`Emitter::store`]).
+        pub fn fresh(&mut self) -> u8 {
+            self.kept.fresh()
+        }
+
+        /// Store `x` at `place`, and keep it in a register: `x` itself
+        /// where it came from [`Emitter::fresh`], else a copy.
         pub fn store(&mut self, place: Place, x: u8) {
             let (base, d) = self.address(place, false);
             self.sse(MOVSD_STORE, x, Operand::Memory(base, d));
-            let copy = self.kept.take(place);
-            self.sse(MOVAPD, copy, Operand::Register(x));
+            if KEPT.contains(&x) {
+                self.kept.hold(place, x);
+            } else {
+                let copy = self.kept.fresh();
+                self.kept.hold(place, copy);
+                self.sse(MOVAPD, copy, Operand::Register(x));
+            }
         }
         pub fn zero(&mut self, x: u8) {
             self.sse(XORPD, x, Operand::Register(x));

@@ -237,54 +237,75 @@ fn lower(tape: &Tape, layout: &Layout, order: usize) -> Option<Code> {
         for (r, &op) in tape.ops.iter().enumerate() {
             let r = r as u32;
             let out = layout.at(r, k);
-            match op {
+            // Arithmetic computes in a fresh register, which keeps the value
+            // it stores; a function's recurrence works in xmm0-xmm3.
+            let result = match op {
                 Op::Const(_) | Op::Input(_) => continue,
                 Op::Add(a, b) => {
-                    e.load(0, layout.at(a, k));
-                    e.add(0, layout.at(b, k));
+                    let x = e.fresh();
+                    e.load(x, layout.at(a, k));
+                    e.add(x, layout.at(b, k));
+                    x
                 }
                 Op::Sub(a, b) => {
-                    e.load(0, layout.at(a, k));
-                    e.sub(0, layout.at(b, k));
+                    let x = e.fresh();
+                    e.load(x, layout.at(a, k));
+                    e.sub(x, layout.at(b, k));
+                    x
                 }
                 Op::Neg(a) => {
-                    e.load(0, layout.at(a, k));
-                    e.negate(0);
+                    let x = e.fresh();
+                    e.load(x, layout.at(a, k));
+                    e.negate(x);
+                    x
                 }
                 Op::Mul(a, b) if constant(a) => {
-                    e.load(0, layout.at(a, 0));
-                    e.mul(0, layout.at(b, k));
+                    let x = e.fresh();
+                    e.load(x, layout.at(a, 0));
+                    e.mul(x, layout.at(b, k));
+                    x
                 }
                 Op::Mul(a, b) if constant(b) => {
-                    e.load(0, layout.at(a, k));
-                    e.mul(0, layout.at(b, 0));
+                    let x = e.fresh();
+                    e.load(x, layout.at(a, k));
+                    e.mul(x, layout.at(b, 0));
+                    x
                 }
                 // A square as the interpreter's (`recurrences::square`):
                 // each pair once, doubled, then the middle term; the terms
                 // past its degree are exact zeros and left out.
                 Op::Mul(a, b) if a == b && k >= 1 => {
+                    let x = e.fresh();
                     let terms = terms(a, a, k, 0);
                     let pairs = *terms.start()..=(*terms.end()).min((k - 1) / 2);
-                    e.product(0, |j| layout.at(a, j), |j| layout.at(a, j), k, pairs);
-                    e.add_registers(0, 0);
+                    e.product(x, |j| layout.at(a, j), |j| layout.at(a, j), k, pairs);
+                    e.add_registers(x, x);
                     if k.is_multiple_of(2) && terms.contains(&(k / 2)) {
                         e.load(1, layout.at(a, k / 2));
                         e.mul(1, layout.at(a, k / 2));
-                        e.add_registers(0, 1);
+                        e.add_registers(x, 1);
                     }
+                    x
                 }
-                Op::Mul(a, b) => e.product(
-                    0,
-                    |j| layout.at(a, j),
-                    |j| layout.at(b, j),
-                    k,
-                    terms(a, b, k, 0),
-                ),
+                Op::Mul(a, b) => {
+                    let x = e.fresh();
+                    e.product(
+                        x,
+                        |j| layout.at(a, j),
+                        |j| layout.at(b, j),
+                        k,
+                        terms(a, b, k, 0),
+                    );
+                    x
+                }
                 Op::Div(a, b) if constant(b) => {
-                    e.load(0, layout.at(a, k));
-                    e.div(0, layout.at(b, 0));
+                    let x = e.fresh();
+                    e.load(x, layout.at(a, k));
+                    e.div(x, layout.at(b, 0));
+                    x
                 }
                 Op::Div(a, b) => {
+                    let x = e.fresh();
                     // a = q b: q_k = (a_k - sum_{j=1..k} b_j q_{k-j}) / b_0.
                     e.product(
                         2,
@@ -293,9 +314,10 @@ fn lower(tape: &Tape, layout: &Layout, order: usize) -> Option<Code> {
                         k,
                         terms(b, r, k, 1),
                     );
-                    e.load(0, layout.at(a, k));
-                    e.sub_registers(0, 2);
-                    e.div(0, layout.at(b, 0));
+                    e.load(x, layout.at(a, k));
+                    e.sub_registers(x, 2);
+                    e.div(x, layout.at(b, 0));
+                    x
                 }
                 Op::Call(f @ (Fun::Sin | Fun::Cos | Fun::Sinh | Fun::Cosh), a) => {
                     let hyperbolic = matches!(f, Fun::Sinh | Fun::Cosh);
@@ -337,6 +359,7 @@ fn lower(tape: &Tape, layout: &Layout, order: usize) -> Option<Code> {
                     e.mul_registers(2, signed);
                     e.copy(signed, 2);
                     e.store(layout.helper(r, k), 1);
+                    0
                 }
                 Op::Call(Fun::Exp, a) => {
                     if k == 0 {
@@ -358,17 +381,19 @@ fn lower(tape: &Tape, layout: &Layout, order: usize) -> Option<Code> {
                         e.add_registers(0, 2);
                     }
                     e.div(0, layout.integer(k));
+                    0
                 }
                 Op::Pow(..) | Op::Call(..) | Op::Call2(..) => return None,
-            }
-            e.store(out, 0);
+            };
+            e.store(out, result);
         }
         // The state's order k + 1 is the rate's order k over k + 1.
         for (i, &o) in tape.outputs.iter().enumerate() {
-            e.load(0, layout.at(o, k));
-            e.div(0, layout.integer(k + 1));
+            let x = e.fresh();
+            e.load(x, layout.at(o, k));
+            e.div(x, layout.integer(k + 1));
             let to = i32::try_from((i * width + k + 1) * size_of::<f64>()).ok()?;
-            e.store((Base::State, to), 0);
+            e.store((Base::State, to), x);
         }
     }
     e.finish()
