@@ -18,9 +18,9 @@
 //!
 //! Every result is stored, and the last ones stored are also kept in
 //! xmm4-xmm15 (see `Kept`; arithmetic computes in the register that then
-//! keeps its value, `Emitter::fresh`): an operand read soon after it was written
-//! comes from its register, not back through memory, where each store
-//! and load would add the processor's store-to-load latency to the
+//! keeps its value, `Emitter::fresh`): an operand read soon after it was
+//! written comes from its register, not back through memory, where each
+//! store and load would add the processor's store-to-load latency to the
 //! series' chain of dependent terms (a Henon-Heiles series at order 20,
 //! called in a loop: 215 -> 137 ns). The arithmetic, and so every bit, is
 //! the same. A call clobbers those registers and may write any place, so
