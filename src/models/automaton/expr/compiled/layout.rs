@@ -3,10 +3,9 @@
 //! windows (`machine.rs`).
 //!
 //! - the work buffer: the main series of every computed register, one
-//!   after another, then
-//!   the helper series (the partner `cos` of a `sin`), `width`
-//!   coefficients each, as the interpreter keeps them; an evaluation's
-//!   outputs after them;
+//!   after another, then the helper series (the partner `cos` of a
+//!   `sin`), `width` coefficients each, as the interpreter keeps them;
+//!   an evaluation's outputs after them;
 //! - the state: the inputs' series (a flow's, which its code writes
 //!   order by order) or values, read in place (the interpreter copies
 //!   them into its registers);
@@ -35,7 +34,7 @@ pub struct Layout {
     helpers: usize,
     /// Where the integers start in the pool.
     integers: usize,
-    /// How long the state is (the inputs' series).
+    /// How much of the state the rates read (the inputs' series).
     state: usize,
 }
 
@@ -109,8 +108,10 @@ impl Layout {
         2 * self.helpers + outputs
     }
 
-    /// The bytes the code may address in each buffer (work, state, pool),
-    /// with `outputs` evaluated outputs.
+    /// The bytes of each buffer the code reads most (work, state, pool),
+    /// with `outputs` evaluated outputs: where its windows go. (A flow's
+    /// code also writes the series of states no rate reads, past the
+    /// state's extent, from its base.)
     pub fn extents(&self, outputs: usize) -> [usize; 3] {
         [self.work(outputs), self.state, self.pool.len()].map(|n| n * size_of::<f64>())
     }

@@ -4,27 +4,27 @@
 //! nothing, and keep the interpreter.
 //!
 //! The code is one function, `extern "sysv64" fn(work, state, pool)`,
-//! straight-line and run once a step: kilobytes of it (12 KB for
+//! straight-line and run once a step: kilobytes of it (11 KB for
 //! Henon-Heiles at order 20), fetched anew at each step beside the rest of
 //! the step's code, so that in a run its size sets its pace more than its
-//! arithmetic does. It works in
-//! xmm0-xmm3, and reaches the buffers through windows (see `Window`):
-//! general registers pointing into them, so that most places take a
-//! one-byte displacement. The arithmetic is encoded by hand (`Emitter::sse`:
-//! dynasm gives a register chosen at run time a SIB byte and a four-byte
-//! displacement at every use); the rest (the prologue, calls) by dynasm.
-//! Windows and hand encoding made a Henon-Heiles series of order 20 12 KB
-//! of code instead of 18 KB, and a bare run of it 9% faster.
+//! arithmetic does. It reaches the buffers through windows (see
+//! `Window`): general registers pointing into them, so that most places
+//! take a one-byte displacement. The arithmetic is encoded by hand
+//! (`Emitter::sse`: dynasm gives a register chosen at run time a SIB byte
+//! and a four-byte displacement at every use); the rest (the prologue,
+//! calls) by dynasm. That made Henon-Heiles' series 12 KB of code instead
+//! of 18 KB, and a bare run of it 9% faster.
 //!
 //! Every result is stored, and the last ones stored are also kept in
 //! xmm4-xmm15 (see `Kept`; arithmetic computes in the register that then
-//! keeps its value, `Emitter::fresh`): an operand read soon after it was
-//! written comes from its register, not back through memory, where each
-//! store and load would add the processor's store-to-load latency to the
-//! series' chain of dependent terms (a Henon-Heiles series at order 20,
-//! called in a loop: 215 -> 137 ns). The arithmetic, and so every bit, is
-//! the same. A call clobbers those registers and may write any place, so
-//! it forgets them; memory holds every value, so nothing is saved.
+//! keeps its value, `Emitter::fresh`; a function's recurrence works in
+//! xmm0-xmm3): an operand read soon after it was written comes from its
+//! register, not back through memory, where each store and load would add
+//! the processor's store-to-load latency to the series' chain of dependent
+//! terms (Henon-Heiles' series in a loop: 222-238 -> 140 ns). The
+//! arithmetic, and so every bit, is the same. A call clobbers those
+//! registers and may write any place, so it forgets them; memory holds
+//! every value, so nothing is saved.
 
 #[cfg(target_arch = "x86_64")]
 pub use x64::{Code, Emitter};
@@ -67,12 +67,21 @@ mod x64 {
         }
     }
 
-    /// General registers that hold the buffers' windows (see [`Window`]):
-    /// first those a call keeps (each buffer's first window, from which
-    /// the others are set, is one of them), then those a call clobbers,
-    /// set again after each call. rsp and r12 would take a SIB byte at
-    /// each use; rax, rdi, rsi and rdx carry a call's arguments.
-    const KEPT_BY_CALLS: [u8; 5] = [3, 5, 13, 14, 15]; // rbx rbp r13 r14 r15
+    /// The register holding each buffer's base window (its address plus
+    /// `REACH`), from which its other windows are set: one a call keeps.
+    fn base(buffer: Base) -> u8 {
+        match buffer {
+            Base::Work => 3,  // rbx
+            Base::State => 5, // rbp
+            Base::Pool => 13, // r13
+        }
+    }
+
+    /// General registers for the windows past the bases: first those a
+    /// call keeps, then those it clobbers, set again after each call. rsp
+    /// and r12 would take a SIB byte at each use; rax, rdi, rsi and rdx
+    /// carry a call's arguments.
+    const KEPT_BY_CALLS: [u8; 2] = [14, 15]; // r14 r15
     const CLOBBERED_BY_CALLS: [u8; 5] = [1, 8, 9, 10, 11]; // rcx r8 r9 r10 r11
 
     /// A general register holding a buffer's address plus `center` bytes:
@@ -95,12 +104,11 @@ mod x64 {
         asm: Assembler,
         entry: AssemblyOffset,
         kept: Kept,
-        /// Each buffer's first window (its base, center `REACH`) first, in
-        /// the order of [`Base`], then the others.
+        /// The windows past the buffers' bases.
         windows: Vec<Window>,
     }
 
-    /// The registers that hold copies of the places stored last.
+    /// The registers that keep the values of the places stored last.
     const KEPT: std::ops::Range<u8> = 4..16;
 
     /// Which place each of the registers [`KEPT`] holds a copy of, the
@@ -182,17 +190,10 @@ mod x64 {
                 ; lea rbp, [rsi + REACH]
                 ; lea r13, [rdx + REACH]
             );
-            let buffers = [Base::Work, Base::State, Base::Pool];
-            let mut windows: Vec<Window> = (buffers.iter().zip(KEPT_BY_CALLS))
-                .map(|(&buffer, register)| Window {
-                    buffer,
-                    center: REACH,
-                    register,
-                })
-                .collect();
-            // The others, the state's first (its series are the products'
-            // factors), while registers last.
-            let mut free = KEPT_BY_CALLS[3..].iter().chain(&CLOBBERED_BY_CALLS);
+            // The state's first (its series are the products' factors),
+            // while registers last.
+            let mut windows = Vec::new();
+            let mut free = KEPT_BY_CALLS.iter().chain(&CLOBBERED_BY_CALLS);
             'buffers: for (buffer, extent) in [
                 (Base::State, extents[1]),
                 (Base::Work, extents[0]),
@@ -220,32 +221,24 @@ mod x64 {
             Some(e)
         }
 
-        /// Set the windows past the buffers' first ones whose registers
-        /// `which` names, from those.
+        /// Set the windows whose registers `which` names, from the bases.
         fn set_windows(&mut self, which: impl Fn(u8) -> bool) {
-            for w in self.windows[3..].iter().copied() {
+            for w in self.windows.iter().copied() {
                 if which(w.register) {
-                    let (base, d) = self.address((w.buffer, w.center), true);
-                    dynasm!(self.asm ; .arch x64 ; lea Rq(w.register), [Rq(base) + d]);
+                    let (b, d) = (base(w.buffer), w.center - REACH);
+                    dynasm!(self.asm ; .arch x64 ; lea Rq(w.register), [Rq(b) + d]);
                 }
             }
         }
 
         /// The register and displacement that address `place`: through a
-        /// window that reaches it, else from its buffer's base (or from
-        /// that alone, `from_base`).
-        fn address(&self, place: Place, from_base: bool) -> (u8, i32) {
-            let (buffer, offset) = place;
-            let mut windows = self.windows.iter().filter(|w| w.buffer == buffer);
-            let base = windows.next().copied();
-            let near = (!from_base)
-                .then(|| windows.find(|w| (-REACH..REACH).contains(&(offset - w.center))))
-                .flatten()
-                .copied();
-            match near.or(base) {
+        /// window that reaches it, else from its buffer's base.
+        fn address(&self, (buffer, offset): Place) -> (u8, i32) {
+            let reaches =
+                |w: &&Window| w.buffer == buffer && (-REACH..REACH).contains(&(offset - w.center));
+            match self.windows.iter().find(reaches) {
                 Some(w) => (w.register, offset - w.center),
-                // Unreachable: every buffer has its base window.
-                None => (0, offset),
+                None => (base(buffer), offset - REACH),
             }
         }
 
@@ -284,8 +277,8 @@ mod x64 {
             let operand = match self.kept.find(place) {
                 Some(r) => Operand::Register(r),
                 None => {
-                    let (base, d) = self.address(place, false);
-                    Operand::Memory(base, d)
+                    let (b, d) = self.address(place);
+                    Operand::Memory(b, d)
                 }
             };
             self.sse(op, x, operand);
@@ -340,8 +333,8 @@ mod x64 {
         /// Store `x` at `place`, and keep it in a register: `x` itself
         /// where it came from [`Emitter::fresh`], else a copy.
         pub fn store(&mut self, place: Place, x: u8) {
-            let (base, d) = self.address(place, false);
-            self.sse(MOVSD_STORE, x, Operand::Memory(base, d));
+            let (b, d) = self.address(place);
+            self.sse(MOVSD_STORE, x, Operand::Memory(b, d));
             if KEPT.contains(&x) {
                 self.kept.hold(place, x);
             } else {
@@ -380,8 +373,8 @@ mod x64 {
         /// xmm0 and xmm1, a float result in xmm0), the two places passed
         /// by address.
         pub fn call(&mut self, helper: *const (), kind: u32, first: Place, second: Place) {
-            let (fb, fd) = self.address(first, false);
-            let (sb, sd) = self.address(second, false);
+            let (fb, fd) = self.address(first);
+            let (sb, sd) = self.address(second);
             let (kind, helper) = (kind as i32, helper as i64);
             self.kept.forget();
             dynasm!(self.asm
@@ -499,17 +492,16 @@ mod x64 {
         fn places_are_addressed_through_their_windows() {
             let mut e = Emitter::new([2000, 600, 100]).unwrap();
             // Work's base (rbx, center 128), state's (rbp), pool's (r13).
-            assert_eq!(e.address((Base::Work, 0), false), (3, -128));
-            assert_eq!(e.address((Base::State, 255), false), (5, 127));
-            assert_eq!(e.address((Base::Pool, 8), false), (13, -120));
+            assert_eq!(e.address((Base::Work, 0)), (3, -128));
+            assert_eq!(e.address((Base::State, 255)), (5, 127));
+            assert_eq!(e.address((Base::Pool, 8)), (13, -120));
             // The state's second window (r14, center 384), then the
             // third (r15, 640), then work's (rcx, r8, ...).
-            assert_eq!(e.address((Base::State, 256), false), (14, -128));
-            assert_eq!(e.address((Base::State, 600), false), (15, -40));
-            assert_eq!(e.address((Base::Work, 300), false), (1, -84));
-            // From the base alone, or past every window: four bytes.
-            assert_eq!(e.address((Base::State, 600), true), (5, 472));
-            assert_eq!(e.address((Base::Pool, 800), false), (13, 672));
+            assert_eq!(e.address((Base::State, 256)), (14, -128));
+            assert_eq!(e.address((Base::State, 600)), (15, -40));
+            assert_eq!(e.address((Base::Work, 300)), (1, -84));
+            // Past every window: from the base, by four bytes.
+            assert_eq!(e.address((Base::Pool, 800)), (13, 672));
             e.store((Base::State, 600), 0);
             assert!(e.finish().is_some());
         }
