@@ -109,7 +109,7 @@ pub fn compare<'py>(
         ("final_error", |r| Some(r.final_error)),
         ("max_event_time_error", |r| r.max_event_time_error),
         ("energy_error", |r| r.energy_error),
-        ("error_bound", |r| Some(r.error_bound)),
+        ("error_bound", |r| r.error_bound),
         ("event_time_bound", |r| r.event_time_bound),
     ];
     for (key, value) in numbers {

@@ -22,9 +22,11 @@
 //!   time error (its size over the closing speed); an exact run pays for
 //!   nothing else.
 
-use crate::engine::error_set::{ErrorSet, TRACKED};
+use crate::engine::commuting::{Firing, Recent};
+use crate::engine::error_set::{CARRIED, ErrorSet};
 use crate::engine::model::{HybridModel, Mode};
 use crate::engine::period_record::{EventFacts, HEADROOM, Op, PeriodRecord};
+use crate::engine::run::ErrorEstimate;
 use crate::engine::tangent::{Rates, Tangents};
 use crate::engine::zeno;
 use crate::time::{Span, Time};
@@ -50,9 +52,11 @@ pub(crate) struct Bound {
     event_time_bound: f64,
     last_time_bound: f64,
     last_event: Option<Time>,
-    /// The largest state component seen (initial state and events): the
-    /// round-off allowance's scale.
+    /// The largest state component the bound is about seen (initial state
+    /// and events): the round-off allowance's scale.
     state_scale: f64,
+    /// How many leading components the bound is about.
+    bounded: usize,
     /// Scratch: the rate of the state at an event.
     rate: Vec<f64>,
     /// The clock component, which carries no error.
@@ -63,6 +67,9 @@ pub(crate) struct Bound {
     crossing_rounding: f64,
     /// The operations of the last period, for a jump over whole periods.
     record: PeriodRecord,
+    /// The last events, to tell whether one whose order is in doubt
+    /// commutes with them.
+    recent: Recent,
 }
 
 /// How far errors `along` a guard's gradient move its event in time, at
@@ -140,30 +147,40 @@ fn opening_checks_hold(ops: &[Op<'_>], errors: &ErrorSet) -> bool {
 }
 
 impl Bound {
-    /// No error yet, for a run of dimension `n` from `x0`, whose component
-    /// `clock` (if any) is the run's time, which carries no error, and
-    /// whose flows round to ulps of `rounding` at least
+    /// No error yet, for a run of dimension `n` from `x0` whose bound is
+    /// about its first `bounded` components
+    /// ([`HybridModel::bounded_dimension`]), whose component `clock` (if
+    /// any) is the run's time, which carries no error, and whose flows
+    /// round to ulps of `rounding` at least
     /// ([`HybridModel::exact_flow_scale`]).
-    pub fn new(n: usize, x0: &[f64], clock: Option<usize>, rounding: f64) -> Self {
+    pub fn new(
+        (n, bounded): (usize, usize),
+        x0: &[f64],
+        clock: Option<usize>,
+        rounding: f64,
+    ) -> Self {
+        let bounded = bounded.min(n);
         Bound {
-            errors: ErrorSet::new(n).with_exact(clock),
+            errors: ErrorSet::new(n).holding(bounded, clock),
             tangents: Tangents::new(n),
-            matrix: vec![0.0; if n <= TRACKED { n * n } else { 0 }],
+            matrix: vec![0.0; if n <= CARRIED { n * n } else { 0 }],
             gradient: vec![0.0; n],
             affine_gradients: (None, Vec::new()),
             affine_sums: (None, Vec::new()),
             event_time_bound: 0.0,
             last_time_bound: 0.0,
             last_event: None,
-            state_scale: x0
+            state_scale: x0[..bounded]
                 .iter()
                 .enumerate()
                 .filter(|(i, _)| Some(*i) != clock)
                 .fold(rounding.abs(), |m: f64, (_, v)| m.max(v.abs())),
             clock,
+            bounded,
             rate: vec![0.0; n],
             crossing_rounding: 0.0,
             record: PeriodRecord::default(),
+            recent: Recent::default(),
         }
     }
 
@@ -297,7 +314,7 @@ impl Bound {
     /// exact run too).
     #[inline(always)]
     pub fn note_state(&mut self, before: &[f64]) {
-        for (i, x) in before.iter().enumerate() {
+        for (i, x) in before[..self.bounded].iter().enumerate() {
             let size = x.abs();
             if size > self.state_scale && Some(i) != self.clock {
                 self.state_scale = size;
@@ -396,6 +413,25 @@ impl Bound {
             self.last_time_bound = shift;
             self.event_time_bound = self.event_time_bound.max(shift);
         }
+        let firing = Firing {
+            t,
+            mode,
+            guard: slot,
+            before,
+            mode_after,
+        };
+        // An order in doubt matters only where the events do not commute:
+        // the time that counts is the time since the last one that may not.
+        let doubt = |since: f64| shift > 0.5 * since;
+        let since = match since {
+            Some(since) if !guard.internal && doubt(since) => {
+                Some(
+                    self.recent
+                        .since_conflict(model, &mut self.tangents, &firing, doubt),
+                )
+            }
+            since => since,
+        };
         if !shift.is_finite() {
             return Err(format!(
                 "the `{}` event at t = {} comes at zero closing speed (a graze) with an integration \
@@ -405,16 +441,17 @@ impl Bound {
                 t.value(),
             ));
         }
-        if let Some(since) = since.filter(|since| !guard.internal && shift > 0.5 * since) {
+        if let Some(since) = since.filter(|&since| !guard.internal && doubt(since)) {
             return Err(format!(
                 "the `{}` event at t = {} may be off by {shift:.2e} in time (its guard by {along:.2e}, \
-                 closing at {:.2e}), more than half the {since:.3e} since the previous event: the \
-                 integration error so far ({:.2e} in the state) leaves the events' order and count \
-                 uncertain, so {method} cannot be trusted past here; tighten the method or use an exact one",
+                 closing at {:.2e}), more than half the {since:.3e} since an earlier event whose \
+                 order with it matters: the integration error so far ({:.2e} in the state) leaves the \
+                 events' order and count uncertain, so {method} cannot be trusted past here; tighten \
+                 the method or use an exact one",
                 guard.name,
                 t.value(),
                 closing.abs(),
-                self.errors.state_bound(),
+                self.errors.state_bound().unwrap_or(f64::NAN),
             ));
         }
         // Where the event was located, the guard is not exactly zero: the
@@ -434,6 +471,9 @@ impl Bound {
         // there) maps nothing.
         if widen != 0.0 || !is_identity(&self.matrix, self.gradient.len()) {
             self.errors.map(&self.matrix, widen);
+        }
+        if !guard.internal {
+            self.recent.push(&firing);
         }
         let facts = EventFacts {
             closing,
@@ -562,10 +602,28 @@ impl Bound {
         }
     }
 
-    /// The bound on every state component after `events` events.
-    pub fn state_bound(&self, events: u64) -> f64 {
-        self.errors.state_bound()
-            + ROUNDOFF_ULPS * f64::EPSILON * self.state_scale * (1 + events) as f64
+    /// The bound on every state component after `events` events; `None`
+    /// where the errors are not carried (see [`Bound::uncarried_estimate`]).
+    pub fn state_bound(&self, events: u64) -> Option<f64> {
+        (self.errors.state_bound()).map(|carried| carried + self.roundoff(events))
+    }
+
+    /// What stands in for the bound where the errors are not carried: the
+    /// local errors summed, not amplified by the flow or the events;
+    /// `None` where a bound is.
+    pub fn uncarried_estimate(&self, events: u64) -> Option<ErrorEstimate> {
+        (!self.errors.tracked()).then(|| ErrorEstimate {
+            value: self.errors.estimate() + self.roundoff(events),
+            made_by: format!(
+                "the steps' local errors summed, not carried through the flow or across events \
+                 (errors are carried up to {CARRIED} state components)"
+            ),
+        })
+    }
+
+    /// The round-off allowance after `events` events.
+    fn roundoff(&self, events: u64) -> f64 {
+        ROUNDOFF_ULPS * f64::EPSILON * self.state_scale * (1 + events) as f64
     }
 
     /// The bound on every event time of a run that reached `t`; `None`

@@ -12,7 +12,7 @@ use crate::engine::model::Mode;
 use crate::engine::names::Name;
 use crate::engine::observer::{EventRecord, Observer, SETTLE};
 use crate::engine::periodic::Counted;
-use crate::engine::run::{FastForward, Options, Outcome, Status};
+use crate::engine::run::{ErrorEstimate, FastForward, Options, Outcome, Status};
 use crate::engine::run_loop::{BUDGET_CHECK, CLOCK_EVERY, End, PROGRESS_SECONDS};
 use crate::engine::zeno::ZenoWatch;
 use crate::time::Time;
@@ -26,7 +26,8 @@ pub(crate) struct Final<'a> {
     pub state: Vec<f64>,
     pub energy: Option<f64>,
     pub flow_evaluations: u64,
-    pub error_bound: f64,
+    pub error_bound: Option<f64>,
+    pub error_estimate: Option<ErrorEstimate>,
     pub event_time_bound: Option<f64>,
 }
 
@@ -429,6 +430,7 @@ impl<'o> Ledger<'o> {
             final_state: last.state,
             flow_evaluations: last.flow_evaluations,
             error_bound: last.error_bound,
+            error_estimate: last.error_estimate,
             event_time_bound: last.event_time_bound,
             fast_forward: self.fast_forward,
             wall_seconds: self.started.elapsed().as_secs_f64(),

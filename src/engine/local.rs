@@ -121,7 +121,8 @@ pub fn simulate_local<M: LocalModel + ?Sized, O: Observer + ?Sized>(
         state: Vec::new(),
         energy: model.energy(now),
         flow_evaluations: evaluations,
-        error_bound: 0.0,
+        error_bound: Some(0.0),
+        error_estimate: None,
         event_time_bound: None,
     };
     let guards = model.guards();

@@ -114,10 +114,14 @@ pub struct Outcome {
     /// The largest error any state component may carry at the end: the
     /// numerical steps' local errors carried through the flow and across
     /// every event (see [`bound`](crate::engine::bound)), plus a round-off allowance of
-    /// [`ROUNDOFF_ULPS`](crate::engine::bound::ROUNDOFF_ULPS) ulps of the state's size (or the model's rounding scale) per event. Above
-    /// [`TRACKED`](crate::engine::error_set::TRACKED) state components,
-    /// the plain sum of the local errors instead.
-    pub error_bound: f64,
+    /// [`ROUNDOFF_ULPS`](crate::engine::bound::ROUNDOFF_ULPS) ulps of the state's size (or the model's rounding scale) per event.
+    /// `None` where no bound is carried (above
+    /// [`CARRIED`](crate::engine::error_set::CARRIED) state components):
+    /// [`Outcome::error_estimate`] says what is known instead.
+    pub error_bound: Option<f64>,
+    /// Where no bound is carried, what stands in for it and how it was
+    /// made; `None` where `error_bound` is stated.
+    pub error_estimate: Option<ErrorEstimate>,
     /// The largest error any event time may carry: each event's share of
     /// the state error divided by its closing speed, plus a round-off
     /// allowance of [`ROUNDOFF_ULPS`](crate::engine::bound::ROUNDOFF_ULPS) ulps of the time reached; `None`
@@ -130,6 +134,17 @@ pub struct Outcome {
     pub fast_forward: Option<FastForward>,
     /// Wall time the run took, in seconds.
     pub wall_seconds: f64,
+}
+
+/// What stands in for an error bound where none is carried: a number
+/// that is not a bound, and how it was made.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ErrorEstimate {
+    /// The estimated largest error of any state component at the end.
+    pub value: f64,
+    /// How the estimate was made, in words (the summary's
+    /// `error_estimate_by`).
+    pub made_by: String,
 }
 
 /// The periods a run jumped over, summed over its jumps.

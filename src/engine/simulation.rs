@@ -443,7 +443,11 @@ impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
             mode: self.mode,
             state: &x,
             events: ledger.events(),
-            bound: self.bound.state_bound(ledger.events()) + step,
+            // Not known where no bound is carried.
+            bound: self
+                .bound
+                .state_bound(ledger.events())
+                .map_or(f64::NAN, |b| b + step),
         });
         self.before = x;
     }
@@ -514,7 +518,7 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
             motions: Vec::new(),
             exact_evaluations: 0,
             bound: Bound::new(
-                n,
+                (n, model.bounded_dimension()),
                 x0,
                 model.clock(),
                 // Only the closed forms round about their own scale.
@@ -1408,6 +1412,7 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
             energy: model.energy(self.mode, &self.state),
             flow_evaluations: self.integrator.evaluations() + self.exact_evaluations,
             error_bound: self.bound.state_bound(ledger.events()),
+            error_estimate: self.bound.uncarried_estimate(ledger.events()),
             event_time_bound: self.bound.event_time_bound(self.origin),
             state: self.state,
         };

@@ -11,7 +11,7 @@
 //!
 //! [`ErrorSet`]: crate::engine::error_set::ErrorSet
 
-use crate::engine::error_set::TRACKED;
+use crate::engine::error_set::{CARRIED, TRACKED};
 use crate::engine::model::{Flow, HybridModel, Mode};
 use crate::engine::saltation;
 use crate::numerics::central_difference::step_for;
@@ -78,11 +78,11 @@ impl Tangents {
             down: vec![0.0; n],
             // Matrices only where errors are tracked (a long chain as an
             // ODE would hold gigabytes it never uses).
-            a: vec![0.0; if n <= TRACKED { n * n } else { 0 }],
-            c: vec![0.0; if n <= TRACKED { n * n } else { 0 }],
-            d: vec![0.0; if n <= TRACKED { n * n } else { 0 }],
-            e: vec![0.0; if n <= TRACKED { n * n } else { 0 }],
-            nodes: std::array::from_fn(|_| vec![0.0; if n <= TRACKED { n * n } else { 0 }]),
+            a: vec![0.0; if n <= CARRIED { n * n } else { 0 }],
+            c: vec![0.0; if n <= CARRIED { n * n } else { 0 }],
+            d: vec![0.0; if n <= CARRIED { n * n } else { 0 }],
+            e: vec![0.0; if n <= CARRIED { n * n } else { 0 }],
+            nodes: std::array::from_fn(|_| vec![0.0; if n <= CARRIED { n * n } else { 0 }]),
         }
     }
 
@@ -486,8 +486,29 @@ fn magnus(n: usize, h: f64, nodes: &[Vec<f64>; 3], out: &mut [f64]) {
         6 => magnus_sized::<6>(h, nodes, out),
         7 => magnus_sized::<7>(h, nodes, out),
         8 => magnus_sized::<8>(h, nodes, out),
-        // No tangent past TRACKED states (see `exp_dense`).
-        _ => out.fill(f64::NAN),
+        n => magnus_dynamic(n, h, nodes, out),
+    }
+}
+
+/// [`magnus_sized`] for the larger sizes, in nalgebra's matrices (built
+/// from the row-major nodes, written back row-major).
+fn magnus_dynamic(n: usize, h: f64, nodes: &[Vec<f64>; 3], out: &mut [f64]) {
+    use nalgebra::DMatrix;
+    let [a1, a2, a3] =
+        std::array::from_fn(|k| DMatrix::from_row_slice(n, n, &nodes[k][..n * n]) * h);
+    let commutator = |a: &DMatrix<f64>, b: &DMatrix<f64>| a * b - b * a;
+    let alpha1 = a2.clone();
+    let alpha2 = (&a3 - &a1) * (15f64.sqrt() / 3.0);
+    let alpha3 = (&a3 - &a2 * 2.0 + &a1) * (10.0 / 3.0);
+    let c1 = commutator(&alpha1, &alpha2);
+    let c2 = commutator(&alpha1, &(&alpha3 * 2.0 + &c1));
+    let left = &alpha1 * -20.0 - &alpha3 + &c1;
+    let right = &alpha2 - &c2 / 60.0;
+    let omega = &alpha1 + &alpha3 / 12.0 + commutator(&left, &right) / 240.0;
+    for (i, row) in out.chunks_exact_mut(n).enumerate() {
+        for (j, o) in row.iter_mut().enumerate() {
+            *o = omega[(i, j)];
+        }
     }
 }
 
@@ -593,10 +614,21 @@ fn exp_dense(n: usize, a: &[f64], out: &mut [f64]) {
         6 => exp_sized::<6>(a, out),
         7 => exp_sized::<7>(a, out),
         8 => exp_sized::<8>(a, out),
-        // No tangent is taken past TRACKED states (no error set is kept
-        // there): were one asked for, its bound would be infinite.
-        _ => out.fill(f64::NAN),
+        n => exp_dynamic(n, a, out),
     }
+}
+
+/// [`exp`] for the larger sizes: nalgebra's (Pade's (13, 13) approximant,
+/// scaling and squaring as Higham 2005). The row-major `a` read
+/// column-major is its transpose, whose exponential is the transpose of
+/// `exp(a)`: written back column-major, `exp(a)` row-major.
+fn exp_dynamic(n: usize, a: &[f64], out: &mut [f64]) {
+    if !a[..n * n].iter().all(|x| x.is_finite()) {
+        out.fill(f64::NAN);
+        return;
+    }
+    let transposed = nalgebra::DMatrix::from_column_slice(n, n, &a[..n * n]).exp();
+    out[..n * n].copy_from_slice(transposed.as_slice());
 }
 
 /// An `N x N` matrix.
@@ -1016,13 +1048,13 @@ mod tests {
         assert_eq!(row_norm(0, &[]), 0.0);
     }
 
-    /// Every size up to TRACKED: a rotation by `w` beside a Jordan block
-    /// `g I + S` (`S` the shift), whose exponential is `e^g / (j - i)!`
-    /// above the diagonal.
+    /// Every size up to TRACKED, and past it (nalgebra's exponential): a
+    /// rotation by `w` beside a Jordan block `g I + S` (`S` the shift),
+    /// whose exponential is `e^g / (j - i)!` above the diagonal.
     #[test]
     fn exp_of_a_rotation_beside_a_jordan_block_is_its_closed_form_at_every_size() {
         let (w, g) = (0.7, 0.1);
-        for n in 3..=TRACKED {
+        for n in 3..=TRACKED + 4 {
             let mut a = vec![0.0; n * n];
             (a[1], a[n]) = (-w, w);
             for i in 2..n {
@@ -1051,6 +1083,25 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn magnus_past_the_fixed_sizes_is_the_same_generator() {
+        // Three Jacobians that do not commute: nalgebra's generator is the
+        // fixed size's to rounding.
+        let n = TRACKED;
+        let node = |k: usize| -> Vec<f64> {
+            (0..n * n)
+                .map(|e| ((e * 7 + k * 13) % 11) as f64 / 11.0 - 0.5)
+                .collect()
+        };
+        let nodes = [node(0), node(1), node(2)];
+        let (mut fixed, mut dynamic) = (vec![0.0; n * n], vec![0.0; n * n]);
+        magnus_sized::<TRACKED>(0.3, &nodes, &mut fixed);
+        magnus_dynamic(n, 0.3, &nodes, &mut dynamic);
+        let beyond_the_midpoint = farthest(&fixed, &nodes[1].iter().map(|a| 0.3 * a).collect::<Vec<_>>());
+        assert!(beyond_the_midpoint > 1e-3, "{beyond_the_midpoint}");
+        assert!(farthest(&fixed, &dynamic) < 1e-15, "{fixed:?} vs {dynamic:?}");
     }
 
     #[test]

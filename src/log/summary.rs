@@ -6,8 +6,11 @@
 //! `energy_initial`, `energy_final`, `max_energy_error` (relative, against
 //! the model's energy scale), `final_state` (named components), `final_mode`,
 //! `zeno`, `flow_evaluations`, `error_bound` (the largest error a state
-//! component may carry), `event_time_bound` (the same for event times, null
-//! where not tracked), `wall_seconds`, `log` (path of the event log or
+//! component may carry; null where no bound is carried),
+//! `error_estimate` and `error_estimate_by` (where no bound is carried,
+//! what stands in for it and how it was made; else null),
+//! `event_time_bound` (the same for event times, null where not carried),
+//! `wall_seconds`, `log` (path of the event log or
 //! null); for chains, `momentum` (total, at the end) and
 //! `momentum_balance_error` (against the end load's and the wall's
 //! impulses, relative; exact path only), null for other models; with
@@ -53,6 +56,8 @@ pub fn summary(report: &Report, model: &str, scene: &Path, log: Option<&Path>) -
         "zeno": o.zeno,
         "flow_evaluations": o.flow_evaluations,
         "error_bound": o.error_bound,
+        "error_estimate": o.error_estimate.as_ref().map(|e| e.value),
+        "error_estimate_by": o.error_estimate.as_ref().map(|e| e.made_by.as_str()),
         "event_time_bound": o.event_time_bound,
         "wall_seconds": o.wall_seconds,
         "log": log.map(|p| p.display().to_string()),

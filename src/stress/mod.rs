@@ -63,8 +63,9 @@ pub struct Measured {
     /// events both have.
     pub time_error: Option<f64>,
     /// The bound the run stated on its final state's error
-    /// ([`Outcome::error_bound`](crate::engine::Outcome::error_bound)).
-    pub error_bound: f64,
+    /// ([`Outcome::error_bound`](crate::engine::Outcome::error_bound)),
+    /// where it carries one.
+    pub error_bound: Option<f64>,
     /// The bound it stated on its event times' errors, where it tracks
     /// them ([`Outcome::event_time_bound`](crate::engine::Outcome::event_time_bound)).
     pub event_time_bound: Option<f64>,
@@ -90,13 +91,21 @@ pub fn classify(m: &Measured) -> Verdict {
             ),
         };
     }
-    if !(m.final_error <= m.error_bound) {
-        return Verdict::Drifted {
-            why: format!(
-                "final state {:.1e} off, beyond its stated bound {:.1e}",
-                m.final_error, m.error_bound
-            ),
-        };
+    match m.error_bound {
+        Some(bound) if !(m.final_error <= bound) => {
+            return Verdict::Drifted {
+                why: format!(
+                    "final state {:.1e} off, beyond its stated bound {bound:.1e}",
+                    m.final_error
+                ),
+            };
+        }
+        None => {
+            return Verdict::Drifted {
+                why: "the run states no bound on its final state".into(),
+            };
+        }
+        Some(_) => {}
     }
     match (m.time_error, m.event_time_bound) {
         (Some(e), Some(bound)) if !(e <= bound) => Verdict::Drifted {
@@ -206,7 +215,7 @@ pub fn run_case(
         final_error: run.final_error,
         time_error: run.time_error,
         // A reference that is itself a run is off by its own bound too.
-        error_bound: o.error_bound + reference.error_bound,
+        error_bound: o.error_bound.map(|b| b + reference.error_bound),
         event_time_bound: o.event_time_bound.map(|b| b + reference.event_time_bound),
     };
     Ok(Row {
@@ -223,7 +232,8 @@ impl Measured {
     /// How many times its error the run's bound on its final state is
     /// (`None` where the error is zero: nothing to measure the bound by).
     pub fn state_ratio(&self) -> Option<f64> {
-        ratio(self.error_bound, Some(self.final_error))
+        self.error_bound
+            .and_then(|bound| ratio(bound, Some(self.final_error)))
     }
 
     /// The same for its event times.
@@ -266,7 +276,7 @@ pub fn markdown(rows: &[Row]) -> String {
             r.method,
             outcome,
             number(Some(m.final_error)),
-            number(Some(m.error_bound)),
+            number(m.error_bound),
             ratio(m.state_ratio()),
             number(m.time_error),
             number(m.event_time_bound),
@@ -294,7 +304,7 @@ mod tests {
             reference_events: 32,
             final_error: 1e-9,
             time_error: Some(1e-8),
-            error_bound: 2e-9,
+            error_bound: Some(2e-9),
             event_time_bound: Some(2e-8),
         }
     }
@@ -313,6 +323,12 @@ mod tests {
         assert!(matches!(classify(&m), Verdict::Drifted { .. }));
         let m = Measured {
             final_error: f64::NAN,
+            ..sound()
+        };
+        assert!(matches!(classify(&m), Verdict::Drifted { .. }));
+        // A run that carries no bound has none to be within.
+        let m = Measured {
+            error_bound: None,
             ..sound()
         };
         assert!(matches!(classify(&m), Verdict::Drifted { .. }));
@@ -337,7 +353,7 @@ mod tests {
         for events in [31, 33] {
             let m = Measured {
                 events,
-                error_bound: f64::INFINITY,
+                error_bound: Some(f64::INFINITY),
                 event_time_bound: Some(f64::INFINITY),
                 ..sound()
             };

@@ -48,11 +48,11 @@ pub struct Row {
     pub max_event_time_error: Option<f64>,
     /// Largest relative energy error the run saw, for a model with an energy.
     pub energy_error: Option<f64>,
-    /// The bound the run stated on its final state's error
-    /// ([`Outcome::error_bound`]).
+    /// The bound the run stated on its final state's error, where it
+    /// carries one ([`Outcome::error_bound`]).
     ///
     /// [`Outcome::error_bound`]: crate::engine::Outcome::error_bound
-    pub error_bound: f64,
+    pub error_bound: Option<f64>,
     /// The bound it stated on its event times' errors, where it tracks them
     /// ([`Outcome::event_time_bound`]).
     ///

@@ -214,7 +214,7 @@ fn sampling_a_run_changes_nothing_and_reads_the_flow() {
             let (eps, rate) = exact.state_at(*t);
             // Exact: the closed form to round-off; Dormand-Prince: within
             // the error bound the run states.
-            let allowed = with.error_bound.max(1e-12);
+            let allowed = with.error_bound.unwrap().max(1e-12);
             assert!((x[0] - eps).abs() <= allowed, "{method:?} t = {t}: {x:?}");
             // Within an impact's time error the rate may be either side of
             // its flip; the exact flow's sample at the impact itself sees

@@ -101,9 +101,9 @@ fn every_run_ends_within_its_stated_bounds_or_says_it_cannot() {
                         .abs()
                         .max((outcome.final_state[1] - r).abs());
                     prop_assert!(
-                        error <= outcome.error_bound,
+                        error <= outcome.error_bound.unwrap(),
                         "{what}: final error {error:.2e} above its bound {:.2e}",
-                        outcome.error_bound
+                        outcome.error_bound.unwrap()
                     );
                     let bound = outcome.event_time_bound.unwrap();
                     for (k, event) in log.events.iter().enumerate() {

@@ -37,9 +37,9 @@ fn assert_within_bound(outcome: &Outcome, want: (f64, f64)) {
     let got = (outcome.final_state[0], outcome.final_state[1]);
     let err = (got.0 - want.0).abs().max((got.1 - want.1).abs());
     assert!(
-        err <= outcome.error_bound,
+        err <= outcome.error_bound.unwrap(),
         "final state {got:?}, reference {want:?}: error {err:.2e} above the stated bound {:.2e}",
-        outcome.error_bound
+        outcome.error_bound.unwrap()
     );
 }
 

@@ -26,6 +26,7 @@ mod fuzz_regressions;
 mod golden;
 mod homogenized;
 mod invariants;
+mod large_automata;
 mod lyapunov;
 mod mechanism_angle;
 mod mechanism_strain;

@@ -314,10 +314,10 @@ fn keeps_its_word(
         .zip(state)
         .map(|(x, r)| f((d(*x) - *r).abs()))
         .fold(0.0, f64::max);
-    if error > outcome.error_bound + 8.0 * f64::EPSILON * scale {
+    if error > outcome.error_bound.unwrap() + 8.0 * f64::EPSILON * scale {
         return Err(format!(
             "final state {error:.2e} off the reference, beyond its stated bound {:.2e}",
-            outcome.error_bound
+            outcome.error_bound.unwrap()
         ));
     }
     Ok(true)

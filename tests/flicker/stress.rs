@@ -62,7 +62,7 @@ fn no_method_is_silently_wrong_and_each_says_why_it_fails() {
         if r.verdict == Verdict::Passed {
             let m = &r.measured;
             assert!(
-                m.final_error <= m.error_bound,
+                m.final_error <= m.error_bound.unwrap(),
                 "{} with {}: {m:?}",
                 r.case,
                 r.method

@@ -13,33 +13,33 @@
 //! each time: the wrapping effect, which the ellipsoid beside it does not
 //! have.
 
-use super::TRACKED;
+use super::storage::Storage;
 
-/// The parallelepiped, for dimensions up to [`TRACKED`].
+/// The parallelepiped, its matrices kept in `S` (see [`Storage`]).
 #[derive(Debug, Clone)]
-pub(super) struct Parallelepiped {
+pub(super) struct Parallelepiped<S: Storage> {
     n: usize,
-    /// Orthonormal directions, column-major `n x n` (fixed arrays: the
-    /// map below runs at every step, and small copies of slices of
-    /// unknown length are calls).
-    basis: [f64; TRACKED * TRACKED],
+    /// Orthonormal directions, column-major `n x n` (fixed arrays for the
+    /// small sizes: the map below runs at every step, and small copies of
+    /// slices of unknown length are calls).
+    basis: S::Matrix,
     /// Half-widths along each direction.
-    radii: [f64; TRACKED],
-    order: [usize; TRACKED],
+    radii: S::Vector,
+    order: S::Order,
 }
 
-impl Parallelepiped {
-    /// No error, in dimension `n <= TRACKED`.
+impl<S: Storage> Parallelepiped<S> {
+    /// No error, in dimension `n` (that `S` holds).
     pub(super) fn new(n: usize) -> Self {
-        let mut basis = [0.0; TRACKED * TRACKED];
+        let mut basis = S::matrix(n);
         for i in 0..n {
-            basis[i * n + i] = 1.0;
+            basis.as_mut()[i * n + i] = 1.0;
         }
         Parallelepiped {
             n,
             basis,
-            radii: [0.0; TRACKED],
-            order: std::array::from_fn(|i| i),
+            radii: S::vector(n),
+            order: S::order(n),
         }
     }
 
@@ -48,19 +48,22 @@ impl Parallelepiped {
     /// (see [`unrolled`](super::unrolled)).
     #[inline(always)]
     pub(super) fn map(&mut self, n: usize, m: &[f64], local: f64) {
-        let mut product = [0.0; TRACKED * TRACKED];
+        let mut product = S::matrix(n);
+        let product = product.as_mut();
+        let (basis, old_radii) = (self.basis.as_mut(), self.radii.as_ref());
         // product = m * basis, column-major.
         for j in 0..n {
             for i in 0..n {
-                product[j * n + i] = (0..n).map(|k| m[i * n + k] * self.basis[j * n + k]).sum();
+                product[j * n + i] = (0..n).map(|k| m[i * n + k] * basis[j * n + k]).sum();
             }
         }
         // Longest error columns first: Q's first direction follows the
         // dominant error.
-        let mut weight = [0.0; TRACKED];
+        let mut weight = S::vector(n);
+        let weight = weight.as_mut();
         for (j, w) in weight[..n].iter_mut().enumerate() {
             let column = &product[j * n..(j + 1) * n];
-            *w = column.iter().map(|x| x * x).sum::<f64>() * self.radii[j] * self.radii[j];
+            *w = column.iter().map(|x| x * x).sum::<f64>() * old_radii[j] * old_radii[j];
         }
         // The old basis is spent: the new one is written over it.
         if n == 2 {
@@ -70,16 +73,16 @@ impl Parallelepiped {
             let (c, s) = direction(&product[2 * first..2 * first + 2])
                 .or_else(|| direction(&product[2 - 2 * first..4 - 2 * first]))
                 .unwrap_or((1.0, 0.0));
-            self.basis[..4].copy_from_slice(&[c, s, -s, c]);
+            basis[..4].copy_from_slice(&[c, s, -s, c]);
         } else {
-            let order = &mut self.order[..n];
+            let order = &mut self.order.as_mut()[..n];
             order.sort_unstable_by(|&a, &b| weight[b].total_cmp(&weight[a]));
-            orthonormalize(n, &product, order, &mut self.basis);
+            orthonormalize::<S>(n, product, order, basis);
         }
-        let q = &self.basis;
+        let q = &*basis;
         // New radii: |Q^T product| r + |Q^T| local.
-        let mut radii = [0.0; TRACKED];
-        for (a, r) in radii[..n].iter_mut().enumerate() {
+        let mut radii = S::vector(n);
+        for (a, r) in radii.as_mut()[..n].iter_mut().enumerate() {
             let qa = &q[a * n..(a + 1) * n];
             // Loops, not iterator sums, so that they unroll with the rest
             // (the same sums: f64's start from -0.0).
@@ -89,7 +92,7 @@ impl Parallelepiped {
                 for i in 0..n {
                     dot += qa[i] * product[j * n + i];
                 }
-                carried += dot.abs() * self.radii[j];
+                carried += dot.abs() * old_radii[j];
             }
             let spread: f64 = qa.iter().map(|x| x.abs()).sum();
             *r = carried + spread * local;
@@ -104,11 +107,11 @@ impl Parallelepiped {
 
     /// The half-width of the set along each component, the largest.
     pub(super) fn state_bound(&self) -> f64 {
-        let n = self.n;
+        let (n, basis, radii) = (self.n, self.basis.as_ref(), self.radii.as_ref());
         (0..n)
             .map(|i| {
                 (0..n)
-                    .map(|j| self.basis[j * n + i].abs() * self.radii[j])
+                    .map(|j| basis[j * n + i].abs() * radii[j])
                     .sum::<f64>()
             })
             .fold(0.0, f64::max)
@@ -116,11 +119,11 @@ impl Parallelepiped {
 
     /// The half-width of the set along `gradient`.
     pub(super) fn along(&self, gradient: &[f64]) -> f64 {
-        let n = self.n;
+        let (n, basis, radii) = (self.n, self.basis.as_ref(), self.radii.as_ref());
         (0..n)
             .map(|j| {
-                let dot: f64 = (0..n).map(|i| gradient[i] * self.basis[j * n + i]).sum();
-                dot.abs() * self.radii[j]
+                let dot: f64 = (0..n).map(|i| gradient[i] * basis[j * n + i]).sum();
+                dot.abs() * radii[j]
             })
             .sum()
     }
@@ -144,12 +147,12 @@ fn direction(v: &[f64]) -> Option<(f64, f64)> {
 /// Orthonormal columns `q` (column-major) spanning the columns of `m` taken
 /// in `order`, completed by unit vectors where `m` is rank-deficient (a
 /// reset that collapses a direction). Gram-Schmidt twice over, which keeps
-/// `q` orthogonal to round-off for the small `n` tracked.
+/// `q` orthogonal to round-off for the `n` carried.
 #[inline(always)]
-fn orthonormalize(n: usize, m: &[f64], order: &[usize], q: &mut [f64]) {
+fn orthonormalize<S: Storage>(n: usize, m: &[f64], order: &[usize], q: &mut [f64]) {
     let mut filled = 0;
-    let mut candidate = [0.0; TRACKED];
-    let candidate = &mut candidate[..n];
+    let mut candidate = S::vector(n);
+    let candidate = &mut candidate.as_mut()[..n];
     for pick in order
         .iter()
         .map(|&j| Some(j))

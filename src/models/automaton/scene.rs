@@ -437,7 +437,17 @@ impl SceneModel for AutomatonScene {
                 .and_then(|k| times.get(k).copied())
                 .unwrap_or(f64::NAN)
         });
-        Ok(reference.with_bounds(o.error_bound, o.event_time_bound.unwrap_or(0.0)))
+        let Some(error_bound) = o.error_bound else {
+            return Err(SceneError::field(
+                "states",
+                format!(
+                    "the reference run ({kind}) carries no error bound with {} state components, \
+                     so it cannot stand for the truth",
+                    self.automaton.dimension()
+                ),
+            ));
+        };
+        Ok(reference.with_bounds(error_bound, o.event_time_bound.unwrap_or(0.0)))
     }
 
     fn clone_box(&self) -> Box<dyn SceneModel> {
