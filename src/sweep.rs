@@ -9,6 +9,10 @@
 //! ```
 //!
 //! `scene` is a path (relative to the sweep file) or an inline scene object.
+//! `"past_horizon": true` runs every point on past its horizon as a
+//! pseudo-orbit (see `engine::horizon`), as `flicker run --past-horizon`
+//! does: a sweep through a chaotic window then completes, and each row's
+//! `horizon` says where its point's own answer ends.
 //! Each grid entry names a key of the scene by its dotted path and gives its
 //! values, as a list or as `from`, `to`, `count` (evenly spaced, or
 //! geometrically with `"spacing": "log"`). Points are the Cartesian product,
@@ -48,6 +52,8 @@ pub struct Sweep {
     pub axes: Vec<Axis>,
     /// The scene models its points may be of.
     pub registry: Registry,
+    /// Every point goes on past its horizon (`past_horizon`).
+    pub past_horizon: bool,
 }
 
 /// Which points this process runs.
@@ -103,6 +109,8 @@ pub struct Row {
     pub energy_error: Option<f64>,
     /// Simulated time the run reached.
     pub t_reached: f64,
+    /// The run's horizon (see [`crate::engine::Outcome::horizon`]).
+    pub horizon: Option<f64>,
 }
 
 /// Whether `value` is a sweep (an object with `scene` and `grid`) rather
@@ -174,6 +182,16 @@ fn parse(value: &Value, folder: &Path, registry: &Registry) -> Result<Sweep, Sce
         ));
     }
     f.optional_string("description")?;
+    let past_horizon = match f.optional("past_horizon") {
+        None => false,
+        Some(Value::Bool(b)) => *b,
+        Some(_) => {
+            return Err(SceneError::field(
+                "past_horizon",
+                "must be true or false".into(),
+            ));
+        }
+    };
     f.finish()?;
     let points = axes
         .iter()
@@ -201,6 +219,7 @@ fn parse(value: &Value, folder: &Path, registry: &Registry) -> Result<Sweep, Sce
         base,
         axes,
         registry: registry.clone(),
+        past_horizon,
     })
 }
 
@@ -337,6 +356,7 @@ impl Sweep {
             period_error: None,
             energy_error: None,
             t_reached: 0.0,
+            horizon: None,
         };
         let scene = match self
             .scene_at(point)
@@ -348,6 +368,10 @@ impl Sweep {
         if control.stopped() {
             return failed(format!("{}; not begun", control.stop_reason()));
         }
+        let control = &Control {
+            past_horizon: self.past_horizon,
+            ..control.clone()
+        };
         let mut times = FirstAndLast::default();
         let report = match scene.run(control, &mut times) {
             Ok(report) => report,
@@ -378,6 +402,7 @@ impl Sweep {
                 .map(|(a, b)| ((a - b) / b).abs()),
             energy_error: o.max_energy_error,
             t_reached: o.t_reached,
+            horizon: o.horizon,
         }
     }
 
@@ -420,6 +445,7 @@ impl Sweep {
                 "period_error",
                 "energy_error",
                 "t_reached",
+                "horizon",
             ]
             .map(str::to_string),
         );
@@ -487,6 +513,7 @@ pub fn write_csv(
             number(r.period_error),
             number(r.energy_error),
             number(Some(r.t_reached)),
+            number(r.horizon),
         ]);
         writer.write_record(&record)?;
     }

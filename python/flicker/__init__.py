@@ -76,9 +76,10 @@ class Run:
             `mode_after` (str), `before` and `after` (float64, shape
             `(n, len(state_names))`, NaN where an event's mode has no such
             state), `energy_before`, `energy_after` (float64, NaN without an
-            energy), and the labels the model gives (`unit` as int64,
-            `rel_velocity`, `x`) where it has them. None if the run was
-            asked for no events.
+            energy), `shadow` (bool: the event comes past the run's
+            horizon, in a run asked to go past it), and the labels the
+            model gives (`unit` as int64, `rel_velocity`, `x`) where it has
+            them. None if the run was asked for no events.
         state_names: the columns of `before` and `after`.
         trace: for chains and continua, a dict of float64 arrays `t`,
             `energy`, `momentum`, `right_end` at the scene's sample times;
@@ -117,6 +118,7 @@ class Run:
             "energy_after": columns["energy_after"],
             "before": columns["before"],
             "after": columns["after"],
+            "shadow": columns["shadow"],
         }
         for name, values, counts in columns["labels"]:
             whole = counts and not np.isnan(values).any()
@@ -180,6 +182,7 @@ def run(
     events: bool = True,
     sensitivities: Optional[Sequence[str]] = None,
     t_eval: Optional[Sequence[float]] = None,
+    past_horizon: bool = False,
 ) -> Run:
     """Run a scene and return its `Run`.
 
@@ -203,6 +206,11 @@ def run(
         t_eval: times (from 0 to t_end, any order) at which to keep the
             state, with its error bound: `Run.samples` (automata and the
             mechanism).
+        past_horizon: go on past the run's horizon (where its error bound
+            can no longer decide what happens) as a pseudo-orbit instead of
+            stopping there: the run completes, its summary states
+            `horizon` and no bound, and every event from the horizon on is
+            flagged (`events["shadow"]`).
 
     Raises:
         SceneError: the scene or an argument is refused; `field` and
@@ -223,6 +231,7 @@ def run(
         t_eval=None
         if t_eval is None
         else [float(t) for t in np.asarray(t_eval, dtype=np.float64).ravel()],
+        past_horizon=bool(past_horizon),
     )
     return Run(raw)
 
@@ -264,7 +273,9 @@ def sweep(sweep_file: Scene, *, threads: Optional[int] = None) -> Dict[str, Any]
     (default: one per core). Returns a dict of columns, as `flicker sweep`
     writes them: `point`, each axis, `status` (list of str), `events`,
     `first_impact`, `impact_period`, `exact_period`, `period_error`,
-    `energy_error`, `t_reached` (NaN where a value is missing)."""
+    `energy_error`, `t_reached`, `horizon` (NaN where a value is missing).
+    A sweep with `"past_horizon": true` runs each point on past its
+    horizon, as `run(..., past_horizon=True)` does."""
     text, path = _source(sweep_file)
     return _flicker.sweep(text, path, threads=threads)
 

@@ -23,6 +23,7 @@ def run(
     events: bool = True,
     sensitivities: Optional[List[str]] = None,
     t_eval: Optional[List[float]] = None,
+    past_horizon: bool = False,
 ) -> Dict[str, Any]: ...
 def check(text: Optional[str] = None, path: Optional[str] = None) -> List[str]: ...
 def compare(

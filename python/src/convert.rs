@@ -44,6 +44,10 @@ pub fn events<'py>(py: Python<'py>, columns: &mut EventColumns) -> PyResult<Boun
     for (key, values) in [("before", table.before), ("after", table.after)] {
         out.set_item(key, values.into_pyarray(py).reshape([n, width])?)?;
     }
+    out.set_item(
+        "shadow",
+        std::mem::take(&mut columns.shadow).into_pyarray(py),
+    )?;
     let labels = PyList::empty(py);
     for label in std::mem::take(&mut columns.labels) {
         labels.append((label.name, label.values.into_pyarray(py), label.counts))?;

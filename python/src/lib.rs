@@ -110,7 +110,7 @@ impl Observer for Keep {
 /// see `convert::events`), `fields` (a chain's or continuum's trace and
 /// profiles, or None).
 #[pyfunction]
-#[pyo3(signature = (text=None, path=None, t_end=None, method=None, rtol=None, atol=None, step=None, log=None, events=true, sensitivities=None, t_eval=None))]
+#[pyo3(signature = (text=None, path=None, t_end=None, method=None, rtol=None, atol=None, step=None, log=None, events=true, sensitivities=None, t_eval=None, past_horizon=false))]
 #[allow(clippy::too_many_arguments)]
 fn run<'py>(
     py: Python<'py>,
@@ -125,6 +125,7 @@ fn run<'py>(
     events: bool,
     sensitivities: Option<Vec<String>>,
     t_eval: Option<Vec<f64>>,
+    past_horizon: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (mut scene, label) = load(py, text, path)?;
     if let Some(t) = t_end {
@@ -180,6 +181,7 @@ fn run<'py>(
         stop: Some(stop.clone()),
         max_wall_seconds: None,
         deadline: None,
+        past_horizon,
     };
     let done = AtomicBool::new(false);
     let report = py.detach(|| {

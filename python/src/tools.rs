@@ -84,6 +84,7 @@ pub fn compare<'py>(
             stop: Some(stop.clone()),
             max_wall_seconds: None,
             deadline: None,
+            past_horizon: false,
         };
         run_compare(&scene, &plan, &control, &mut |_| {})
     })?;
@@ -149,6 +150,7 @@ pub fn sweep<'py>(
             stop: Some(stop.clone()),
             max_wall_seconds: None,
             deadline: None,
+            past_horizon: false,
         };
         pool.install(|| spec.run(Shard::WHOLE, &control, &|| {}))
     })?;
@@ -178,13 +180,14 @@ pub fn sweep<'py>(
             .into_pyarray(py),
     )?;
     let nan = |x: Option<f64>| x.unwrap_or(f64::NAN);
-    let numbers: [(&str, fn(&SweepRow) -> Option<f64>); 6] = [
+    let numbers: [(&str, fn(&SweepRow) -> Option<f64>); 7] = [
         ("first_impact", |r| r.first_impact),
         ("impact_period", |r| r.impact_period),
         ("exact_period", |r| r.exact_period),
         ("period_error", |r| r.period_error),
         ("energy_error", |r| r.energy_error),
         ("t_reached", |r| Some(r.t_reached)),
+        ("horizon", |r| r.horizon),
     ];
     for (key, value) in numbers {
         let column: Vec<f64> = rows.iter().map(|r| nan(value(r))).collect();

@@ -197,3 +197,29 @@ def test_samples_are_the_command_lines_bit_for_bit(name, states, cli, tmp_path):
     for k, state in enumerate(states):
         assert np.array_equal(table[:, k + 1], run.samples[state])
     assert np.array_equal(table[:, -1], run.samples["bound"])
+
+
+def test_past_the_horizon_from_python_matches_the_command_line(cli, tmp_path):
+    # The chaotic table ball (restitution 0.8, Gamma = 3.7): it stops at
+    # its horizon, and with past_horizon goes on to t = 400, every event
+    # from the horizon on a shadow, as `flicker run --past-horizon` logs.
+    scene = json.loads((MODELS / "automata" / "vibrating_table.json").read_text())
+    p = scene["parameters"]
+    p["r"], p["A"] = 0.8, 3.7 * p["g"] / p["w"] ** 2
+    scene["t_end"] = 400.0
+    stopped = flicker.run(scene)
+    assert stopped.status == "failed" and "--past-horizon" in stopped.summary["reason"]
+    run = flicker.run(scene, past_horizon=True)
+    s = run.summary
+    assert s["status"] == "completed" and s["error_bound"] is None
+    assert s["horizon"] == stopped.summary["horizon"]
+    shadow = run.events["shadow"]
+    assert shadow.dtype == np.bool_
+    assert np.array_equal(shadow, run.events["t"] >= s["horizon"])
+    assert shadow.sum() == s["shadow_events"] > 100
+    path = tmp_path / "scene.json"
+    path.write_text(json.dumps(scene))
+    done, _ = cli("run", path, "--out", tmp_path / "cli", "--quiet", "--past-horizon")
+    assert done.returncode == 0, done.stderr
+    logged = read_log(tmp_path / "cli" / "events.jsonl")
+    assert [line.get("shadow", False) for line in logged] == list(shadow)

@@ -85,6 +85,7 @@ pub fn compare_models(args: CompareModelsArgs, registry: &Registry) -> Result<Co
         stop: Some(stop.clone()),
         max_wall_seconds: None,
         deadline: None,
+        past_horizon: false,
     };
     let mut models: Vec<Model> = units.iter().map(|&n| Model::Chain(n)).collect();
     models.push(Model::Continuum(Variant::Paper));

@@ -154,6 +154,7 @@ fn scene_plane(
         stop: Some(crate::cli::setup::stop_flag()),
         max_wall_seconds: None,
         deadline: None,
+        past_horizon: false,
     };
     let (figure, report) = state_plane(&scene, &x, &y, samples, &control)
         .map_err(|e| Failure::bad_input(format!("{}: {e}", path.display())))?;

@@ -67,6 +67,12 @@ pub struct RunArgs {
         allow_negative_numbers = true
     )]
     at: Option<Vec<f64>>,
+    /// Go on past the run's horizon (where its bound can no longer decide
+    /// what happens) as a pseudo-orbit, instead of stopping there: the run
+    /// completes, states its horizon and no bound, and flags every event
+    /// from the horizon on `"shadow": true`.
+    #[arg(long = "past-horizon")]
+    past_horizon: bool,
 }
 
 /// A scene's reproducibility horizon.
@@ -121,6 +127,7 @@ pub fn run(args: RunArgs, registry: &Registry) -> Result<Code, Failure> {
         sensitivities,
         samples,
         at,
+        past_horizon,
     } = args;
     let scene_path = scene_path.as_path();
     let log_events = !no_events;
@@ -189,6 +196,7 @@ pub fn run(args: RunArgs, registry: &Registry) -> Result<Code, Failure> {
         stop: Some(crate::cli::setup::stop_flag()),
         max_wall_seconds: None,
         deadline: None,
+        past_horizon,
     };
 
     let log_path = out.join("events.jsonl");
@@ -391,6 +399,30 @@ fn print_report(
         .map(|(n, x)| format!("{n} = {x:e}"))
         .collect();
     say!("  final state: {}", state.join(", "));
+    match (o.error_bound, &o.error_estimate, o.event_time_bound) {
+        (Some(bound), _, Some(times)) => {
+            say!("  error bound: {bound:.2e} on every state component, {times:.2e} on event times")
+        }
+        (Some(bound), _, None) => say!("  error bound: {bound:.2e} on every state component"),
+        (None, Some(estimate), _) => say!(
+            "  no error bound: an estimate of {:.2e}, {}",
+            estimate.value,
+            estimate.made_by
+        ),
+        (None, None, _) => {}
+    }
+    match o.horizon {
+        Some(h) if o.shadow_events > 0 || o.error_bound.is_none() && o.error_estimate.is_none() => {
+            say!(
+                "  past its horizon at t = {h}: a pseudo-orbit from there, {} events flagged shadow, no bound",
+                o.shadow_events
+            )
+        }
+        Some(h) => say!(
+            "  horizon: t = {h} (its error reached 1e-3 of the state, or its bound could no longer decide)"
+        ),
+        None => {}
+    }
     if let Some(err) = report
         .fields
         .as_ref()

@@ -24,6 +24,7 @@
 
 use crate::engine::commuting::{Firing, Recent};
 use crate::engine::error_set::{CARRIED, ErrorSet};
+use crate::engine::horizon::{FRACTION, Horizon};
 use crate::engine::model::{HybridModel, Mode};
 use crate::engine::period_record::{EventFacts, HEADROOM, Op, PeriodRecord};
 use crate::engine::run::ErrorEstimate;
@@ -57,6 +58,9 @@ pub(crate) struct Bound {
     state_scale: f64,
     /// How many leading components the bound is about.
     bounded: usize,
+    /// The largest such component seen at any step's end or event: the
+    /// horizon's scale.
+    horizon_scale: f64,
     /// Scratch: the rate of the state at an event.
     rate: Vec<f64>,
     /// The clock component, which carries no error.
@@ -70,6 +74,9 @@ pub(crate) struct Bound {
     /// The last events, to tell whether one whose order is in doubt
     /// commutes with them.
     recent: Recent,
+    /// Where the run's horizon is, and whether it went past it (then no
+    /// error is carried).
+    horizon: Horizon,
 }
 
 /// How far errors `along` a guard's gradient move its event in time, at
@@ -152,12 +159,14 @@ impl Bound {
     /// ([`HybridModel::bounded_dimension`]), whose component `clock` (if
     /// any) is the run's time, which carries no error, and whose flows
     /// round to ulps of `rounding` at least
-    /// ([`HybridModel::exact_flow_scale`]).
+    /// ([`HybridModel::exact_flow_scale`]); `past_horizon`: a run that goes
+    /// on past its horizon (see [`Horizon`]).
     pub fn new(
         (n, bounded): (usize, usize),
         x0: &[f64],
         clock: Option<usize>,
         rounding: f64,
+        past_horizon: bool,
     ) -> Self {
         let bounded = bounded.min(n);
         Bound {
@@ -177,17 +186,20 @@ impl Bound {
                 .fold(rounding.abs(), |m: f64, (_, v)| m.max(v.abs())),
             clock,
             bounded,
+            horizon_scale: 0.0,
             rate: vec![0.0; n],
             crossing_rounding: 0.0,
             record: PeriodRecord::default(),
             recent: Recent::default(),
+            horizon: Horizon::new(past_horizon),
         }
     }
 
-    /// Whether there is no error to carry (an exact run's stays so).
+    /// Whether there is no error to carry (an exact run's stays so, and a
+    /// run's past its horizon).
     #[inline(always)]
     pub fn idle(&self) -> bool {
-        self.errors.is_empty()
+        self.errors.is_empty() || self.horizon.shadow()
     }
 
     /// Carry the errors over a stretch `tau` of an ODE flow in `mode` whose
@@ -201,6 +213,9 @@ impl Bound {
         at: impl FnMut(f64, &mut [f64]),
         rates: Rates<'_>,
     ) {
+        if self.horizon.shadow() {
+            return;
+        }
         if self.errors.tracked() {
             self.tangents
                 .ode(model, mode, (tau, rates), at, &mut self.matrix);
@@ -219,7 +234,7 @@ impl Bound {
         state: &[f64],
         tau: f64,
     ) {
-        if self.errors.tracked() && !self.errors.is_empty() {
+        if self.errors.tracked() && !self.idle() {
             self.tangents
                 .exact(model, mode, state, tau, &mut self.matrix);
             self.errors.map(&self.matrix, 0.0);
@@ -230,6 +245,9 @@ impl Bound {
     /// Add an error of half-width `jump` where the state stands: a resting
     /// state stands in for an orbit it is not exactly on.
     pub fn widen(&mut self, jump: f64) {
+        if self.horizon.shadow() {
+            return;
+        }
         self.errors.widen(jump);
         self.record.broken();
     }
@@ -245,6 +263,10 @@ impl Bound {
         state: &[f64],
         local: f64,
     ) -> f64 {
+        // Past its horizon a run goes as it computes.
+        if self.horizon.shadow() {
+            return 0.0;
+        }
         if !self.errors.tracked() && model.guards(mode)[g].affine {
             // An untracked set has one scale for every direction: what an
             // affine guard needs of its gradient is the sum of its sizes,
@@ -379,7 +401,7 @@ impl Bound {
         (t_end, depth): (f64, f64),
         method: &str,
     ) -> Result<(), String> {
-        if self.errors.is_empty() || !self.errors.tracked() {
+        if self.idle() || !self.errors.tracked() {
             self.record.broken();
             return Ok(());
         }
@@ -433,7 +455,8 @@ impl Bound {
             since => since,
         };
         if !shift.is_finite() {
-            return Err(format!(
+            self.record.broken();
+            return self.horizon.undecided(t, format!(
                 "the `{}` event at t = {} comes at zero closing speed (a graze) with an integration \
                  error of {along:.2e} in its guard: whether and when it fires cannot be told, so {method} \
                  cannot be trusted past here; tighten the method or use an exact one",
@@ -442,7 +465,8 @@ impl Bound {
             ));
         }
         if let Some(since) = since.filter(|&since| !guard.internal && doubt(since)) {
-            return Err(format!(
+            self.record.broken();
+            return self.horizon.undecided(t, format!(
                 "the `{}` event at t = {} may be off by {shift:.2e} in time (its guard by {along:.2e}, \
                  closing at {:.2e}), more than half the {since:.3e} since an earlier event whose \
                  order with it matters: the integration error so far ({:.2e} in the state) leaves the \
@@ -581,7 +605,15 @@ impl Bound {
     /// its count and final state are uncertain. One within `window` of the
     /// end (the rounding of times there) is at the end by the run's
     /// convention (applied), not uncertain.
-    pub fn at_end(&self, t: Time, next: Option<(Time, f64)>, window: f64) -> Result<(), String> {
+    pub fn at_end(
+        &mut self,
+        t: Time,
+        next: Option<(Time, f64)>,
+        window: f64,
+    ) -> Result<(), String> {
+        if self.horizon.shadow() {
+            return Ok(());
+        }
         let around = [
             self.last_event
                 .map(|last| (t.since(last), self.last_time_bound)),
@@ -592,12 +624,15 @@ impl Bound {
             .flatten()
             .find(|&(gap, error)| error > 0.0 && gap > window && gap <= error)
         {
-            Some((gap, error)) => Err(format!(
-                "an event lies {gap:.2e} from t_end = {}, within the time error of the events \
+            Some((gap, error)) => self.horizon.undecided(
+                t,
+                format!(
+                    "an event lies {gap:.2e} from t_end = {}, within the time error of the events \
                  ({error:.2e}): whether it happens before the end is uncertain, so the final state \
                  cannot be trusted; tighten the method or move t_end",
-                t.value(),
-            )),
+                    t.value(),
+                ),
+            ),
             None => Ok(()),
         }
     }
@@ -605,14 +640,61 @@ impl Bound {
     /// The bound on every state component after `events` events; `None`
     /// where the errors are not carried (see [`Bound::uncarried_estimate`]).
     pub fn state_bound(&self, events: u64) -> Option<f64> {
+        if self.horizon.shadow() {
+            return None;
+        }
         (self.errors.state_bound()).map(|carried| carried + self.roundoff(events))
+    }
+
+    /// Note the state at `t`, after `events` events (a step's end, an
+    /// event's reset): the horizon is where the error first reaches
+    /// [`FRACTION`] of the largest state component seen. Asked at every
+    /// step: the cheap questions first.
+    #[inline]
+    pub fn watch(&mut self, t: Time, state: &[f64], events: u64) {
+        if self.horizon.at().is_some() {
+            return;
+        }
+        for (i, x) in state[..self.bounded].iter().enumerate() {
+            if x.abs() > self.horizon_scale && Some(i) != self.clock {
+                self.horizon_scale = x.abs();
+            }
+        }
+        let scale = self.horizon_scale.max(self.state_scale);
+        let limit = FRACTION * scale - self.roundoff(events);
+        let reached = if self.errors.is_empty() {
+            // Round-off alone: after about 10^11 events.
+            limit <= 0.0
+        } else {
+            self.errors.exceeds(limit)
+        };
+        if reached && scale > 0.0 {
+            self.horizon.reached(t);
+        }
+    }
+
+    /// Where the run's horizon is, if it reached it.
+    pub fn horizon(&self) -> Option<f64> {
+        self.horizon.at().map(Time::value)
+    }
+
+    /// Whether the run has gone past its horizon (its events are shadows).
+    pub fn past_horizon(&self) -> bool {
+        self.horizon.shadow()
+    }
+
+    /// A graze the bound cannot decide at `t`, for the reason `why`: the
+    /// run's horizon (see [`Horizon::undecided`]).
+    pub fn undecided(&mut self, t: Time, why: String) -> Result<(), String> {
+        self.record.broken();
+        self.horizon.undecided(t, why)
     }
 
     /// What stands in for the bound where the errors are not carried: the
     /// local errors summed, not amplified by the flow or the events;
     /// `None` where a bound is.
     pub fn uncarried_estimate(&self, events: u64) -> Option<ErrorEstimate> {
-        (!self.errors.tracked()).then(|| ErrorEstimate {
+        (!self.errors.tracked() && !self.horizon.shadow()).then(|| ErrorEstimate {
             value: self.errors.estimate() + self.roundoff(events),
             made_by: format!(
                 "the steps' local errors summed, not carried through the flow or across events \
@@ -629,7 +711,7 @@ impl Bound {
     /// The bound on every event time of a run that reached `t`; `None`
     /// where the errors are not tracked.
     pub fn event_time_bound(&self, t: Time) -> Option<f64> {
-        self.errors.tracked().then(|| {
+        (self.errors.tracked() && !self.horizon.shadow()).then(|| {
             self.event_time_bound
                 + self.crossing_rounding
                 + ROUNDOFF_ULPS * f64::EPSILON * t.value().abs()

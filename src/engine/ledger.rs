@@ -29,6 +29,7 @@ pub(crate) struct Final<'a> {
     pub error_bound: Option<f64>,
     pub error_estimate: Option<ErrorEstimate>,
     pub event_time_bound: Option<f64>,
+    pub horizon: Option<f64>,
 }
 
 pub(crate) struct Ledger<'o> {
@@ -47,6 +48,8 @@ pub(crate) struct Ledger<'o> {
     named: BTreeMap<Name, u64>,
     zeno: ZenoWatch,
     settles: u64,
+    /// Events logged past the horizon (flagged `shadow`).
+    shadow_events: u64,
     /// Set once the run has settled a Zeno accumulation and gone on.
     zeno_reason: Option<String>,
     energy_initial: Option<f64>,
@@ -82,6 +85,7 @@ impl<'o> Ledger<'o> {
             named: BTreeMap::new(),
             zeno: ZenoWatch::new(options.t_end),
             settles: 0,
+            shadow_events: 0,
             zeno_reason: None,
             energy_initial,
             energy_reference: energy_initial,
@@ -307,6 +311,7 @@ impl<'o> Ledger<'o> {
             *reference += after - before;
         }
         self.audit(event.energy_after);
+        self.shadow_events += u64::from(event.shadow);
         observer
             .on_event(&event)
             .map_err(|e| End::failed(format!("could not write the event log: {e}")))?;
@@ -431,6 +436,8 @@ impl<'o> Ledger<'o> {
             flow_evaluations: last.flow_evaluations,
             error_bound: last.error_bound,
             error_estimate: last.error_estimate,
+            horizon: last.horizon,
+            shadow_events: self.shadow_events,
             event_time_bound: last.event_time_bound,
             fast_forward: self.fast_forward,
             wall_seconds: self.started.elapsed().as_secs_f64(),

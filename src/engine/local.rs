@@ -124,6 +124,7 @@ pub fn simulate_local<M: LocalModel + ?Sized, O: Observer + ?Sized>(
         error_bound: Some(0.0),
         error_estimate: None,
         event_time_bound: None,
+        horizon: None,
     };
     let guards = model.guards();
     ledger.outcome(end, last, |_, slot| guards[slot].name.clone())
@@ -248,6 +249,7 @@ impl<M: LocalModel + ?Sized> LocalRun<'_, M> {
             names_after: &[],
             after: &[],
             labels,
+            shadow: false,
         }
     }
 

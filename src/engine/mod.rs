@@ -12,6 +12,7 @@ pub mod dop853;
 pub mod dopri5;
 pub mod error_set;
 pub mod family;
+pub mod horizon;
 pub mod integrator;
 pub mod labels;
 mod ledger;

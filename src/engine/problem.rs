@@ -36,6 +36,9 @@ pub struct Limits {
     pub max_wall_seconds: Option<f64>,
     /// Set from outside (a signal handler) to interrupt the run cleanly.
     pub stop: Option<Arc<AtomicBool>>,
+    /// Go on past the horizon as a pseudo-orbit instead of stopping there
+    /// ([`Options::past_horizon`]).
+    pub past_horizon: bool,
 }
 
 impl Default for Limits {
@@ -45,6 +48,7 @@ impl Default for Limits {
             max_events: 1_000_000_000,
             max_wall_seconds: None,
             stop: None,
+            past_horizon: false,
         }
     }
 }
@@ -74,6 +78,7 @@ impl<'m, M: HybridModel + ?Sized> Problem<'m, M> {
             },
             stop: limits.stop.clone(),
             max_wall_seconds: limits.max_wall_seconds,
+            past_horizon: limits.past_horizon,
         }
     }
 

@@ -29,6 +29,10 @@ pub struct Options {
     pub stop: Option<Arc<AtomicBool>>,
     /// Stop with `failed` after this much wall time (seconds), if set.
     pub max_wall_seconds: Option<f64>,
+    /// Go on past the run's horizon as a pseudo-orbit, its events flagged
+    /// `shadow`, instead of stopping where the bound can no longer decide
+    /// what happens (see [`horizon`](crate::engine::horizon)).
+    pub past_horizon: bool,
 }
 
 impl Options {
@@ -41,6 +45,7 @@ impl Options {
             tolerances: Tolerances::default(),
             stop: None,
             max_wall_seconds: None,
+            past_horizon: false,
         }
     }
 }
@@ -127,6 +132,14 @@ pub struct Outcome {
     /// allowance of [`ROUNDOFF_ULPS`](crate::engine::bound::ROUNDOFF_ULPS) ulps of the time reached; `None`
     /// where the errors are not tracked.
     pub event_time_bound: Option<f64>,
+    /// Where the run's own error first reached 1e-3 of its state's scale,
+    /// or its bound could no longer decide what happens, whichever came
+    /// first (see [`horizon`](crate::engine::horizon)); `None` if neither
+    /// happened.
+    pub horizon: Option<f64>,
+    /// Events logged past the horizon by a run that went on past it
+    /// ([`Options::past_horizon`]), each flagged `shadow`.
+    pub shadow_events: u64,
     /// Whole periods of an exactly periodic orbit the run jumped over
     /// instead of firing their events (see
     /// [`periodic`](crate::engine::periodic)); `None` where it fired

@@ -161,6 +161,9 @@ struct Run<'m, 's, M: HybridModel + ?Sized> {
     /// The last events and the states they left, to prove the orbit
     /// periodic.
     returns: Returns,
+    /// Events logged so far (the round-off allowance's count, for the
+    /// horizon between events).
+    logged: u64,
 }
 
 impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
@@ -233,21 +236,24 @@ impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
         } else if guard.internal {
             Ok(())
         } else {
+            self.bound.watch(t, &self.after, self.logged + 1);
             match &jump.event {
                 Some(name) => ledger.count_named(name),
                 None => ledger.count(mode, slot),
             }
             let labels = model.labels(mode, slot, &before);
-            ledger.log(
-                self.event(
-                    jump.event.as_deref().unwrap_or(&guard.name),
-                    t,
-                    jump.mode,
-                    &before,
-                    &labels,
-                ),
-                observer,
-            )
+            ledger
+                .log(
+                    self.event(
+                        jump.event.as_deref().unwrap_or(&guard.name),
+                        t,
+                        jump.mode,
+                        &before,
+                        &labels,
+                    ),
+                    observer,
+                )
+                .inspect(|()| self.logged = ledger.events())
         };
         if recorded.is_err() && all_finite(&before) {
             // The run fails at the event: it reached its time, with the
@@ -419,11 +425,16 @@ impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
             tau.value(),
             (from, self.origin),
         );
+        // To the jump: the periods replayed grew the bound as firing
+        // each event would have.
+        self.logged = ledger.events();
+        self.bound.watch(self.origin, &self.state, self.logged);
     }
 
     fn renew(&mut self, t: Time) -> Result<(), End> {
         self.close_segment(t.since(self.origin));
         self.integrator.end(&mut self.state);
+        self.bound.watch(t, &self.state, self.logged);
         self.origin = t;
         self.start_segment()
     }
@@ -487,6 +498,7 @@ impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
         self.set_clock(t, &mut x);
         self.state.copy_from_slice(&x);
         self.before = x;
+        self.bound.watch(t, &self.state, self.logged);
         self.origin = t;
         self.check_guards()
     }
@@ -526,7 +538,9 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
                     Method::Auto | Method::Exact => model.exact_flow_scale(),
                     _ => 0.0,
                 },
+                options.past_horizon,
             ),
+            logged: 0,
             stepped: false,
             step_end: None,
             step_offset: 0.0,
@@ -647,6 +661,7 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
             names_after: model.state_names(mode_after),
             after: &self.after,
             labels,
+            shadow: self.bound.past_horizon(),
         }
     }
 
@@ -1061,7 +1076,10 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
                 if let Some((g, margin, uncertainty, _)) =
                     graze.filter(|&(_, _, _, at)| at <= earliest)
                 {
-                    return Err(self.undecidable(g, margin, uncertainty));
+                    let why = self.undecidable(g, margin, uncertainty);
+                    self.bound
+                        .undecided(self.origin, why)
+                        .map_err(End::failed)?;
                 }
                 self.step_end = Some(self.origin.after(h));
                 Ok(())
@@ -1259,16 +1277,17 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
         )
     }
 
-    /// A graze or near miss closer than the integration error can resolve.
-    fn undecidable(&self, g: usize, margin: f64, uncertainty: f64) -> End {
-        End::failed(format!(
+    /// A graze or near miss closer than the integration error can resolve,
+    /// in words.
+    fn undecidable(&self, g: usize, margin: f64, uncertainty: f64) -> String {
+        format!(
             "guard `{}` grazes zero near t = {:e}: its dip or near miss is {margin:.2e} deep, within the \
              integration error so far ({uncertainty:.2e}), so {} cannot tell whether it fires; \
              tighten the method or use an exact one",
             self.model.guards(self.mode)[g].name,
             self.origin.value(),
             self.integrator.name()
-        ))
+        )
     }
 
     fn predict_exact(&mut self, g: usize) -> Result<(), End> {
@@ -1414,6 +1433,7 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
             error_bound: self.bound.state_bound(ledger.events()),
             error_estimate: self.bound.uncarried_estimate(ledger.events()),
             event_time_bound: self.bound.event_time_bound(self.origin),
+            horizon: self.bound.horizon(),
             state: self.state,
         };
         ledger.outcome(end, last, |mode, slot| {

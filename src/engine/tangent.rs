@@ -1099,9 +1099,15 @@ mod tests {
         let (mut fixed, mut dynamic) = (vec![0.0; n * n], vec![0.0; n * n]);
         magnus_sized::<TRACKED>(0.3, &nodes, &mut fixed);
         magnus_dynamic(n, 0.3, &nodes, &mut dynamic);
-        let beyond_the_midpoint = farthest(&fixed, &nodes[1].iter().map(|a| 0.3 * a).collect::<Vec<_>>());
+        let beyond_the_midpoint = farthest(
+            &fixed,
+            &nodes[1].iter().map(|a| 0.3 * a).collect::<Vec<_>>(),
+        );
         assert!(beyond_the_midpoint > 1e-3, "{beyond_the_midpoint}");
-        assert!(farthest(&fixed, &dynamic) < 1e-15, "{fixed:?} vs {dynamic:?}");
+        assert!(
+            farthest(&fixed, &dynamic) < 1e-15,
+            "{fixed:?} vs {dynamic:?}"
+        );
     }
 
     #[test]

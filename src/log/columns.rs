@@ -34,6 +34,9 @@ pub struct EventColumns {
     pub energy_before: Vec<f64>,
     /// The energy after each reset.
     pub energy_after: Vec<f64>,
+    /// Whether each event comes past the run's horizon, in a run asked to
+    /// go on past it (see [`crate::engine::EventRecord::shadow`]).
+    pub shadow: Vec<bool>,
     /// Each label's values, NaN where an event has none; whether all its
     /// values are whole numbers (a unit's index).
     pub labels: Vec<LabelColumn>,
@@ -166,6 +169,7 @@ impl Observer for EventColumns {
         self.mode_after.push(after);
         self.energy_before.push(e.energy_before.unwrap_or(f64::NAN));
         self.energy_after.push(e.energy_after.unwrap_or(f64::NAN));
+        self.shadow.push(e.shadow);
         // A state carries as many values as its names (an event-local
         // model's carries none).
         let n_before = e.names_before.len().min(e.before.len());
@@ -230,6 +234,7 @@ mod tests {
             names_after: names,
             after,
             labels,
+            shadow: false,
         }
     }
 

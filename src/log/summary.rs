@@ -10,6 +10,10 @@
 //! `error_estimate` and `error_estimate_by` (where no bound is carried,
 //! what stands in for it and how it was made; else null),
 //! `event_time_bound` (the same for event times, null where not carried),
+//! `horizon` (where the run's own error reached 1e-3 of its state's scale,
+//! or its bound could no longer decide what happens; null if neither, see
+//! `engine::horizon`), `shadow_events` (events logged past the horizon by
+//! a run that went on past it, `--past-horizon`, each flagged `shadow`),
 //! `wall_seconds`, `log` (path of the event log or
 //! null); for chains, `momentum` (total, at the end) and
 //! `momentum_balance_error` (against the end load's and the wall's
@@ -59,6 +63,8 @@ pub fn summary(report: &Report, model: &str, scene: &Path, log: Option<&Path>) -
         "error_estimate": o.error_estimate.as_ref().map(|e| e.value),
         "error_estimate_by": o.error_estimate.as_ref().map(|e| e.made_by.as_str()),
         "event_time_bound": o.event_time_bound,
+        "horizon": o.horizon,
+        "shadow_events": o.shadow_events,
         "wall_seconds": o.wall_seconds,
         "log": log.map(|p| p.display().to_string()),
         "momentum": report.fields.as_ref().map(|c| c.momentum),

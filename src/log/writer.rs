@@ -114,6 +114,9 @@ impl<W: Write> Observer for JsonlWriter<W> {
                 Label::Number(x) => self.number(x),
             }
         }
+        if e.shadow {
+            self.buffer.extend_from_slice(b",\"shadow\":true");
+        }
         self.buffer.extend_from_slice(b"}\n");
         if self.buffer.len() >= CHUNK {
             self.out.write_all(&self.buffer)?;
@@ -251,12 +254,22 @@ mod tests {
                 .with("unit", Label::Count(7))
                 .with("rel_velocity", Label::Number(0.5))
                 .with("x", Label::Number(-0.25)),
+            shadow: false,
         };
         w.on_event(&event).unwrap();
+        // Past a horizon, the same event flagged last.
+        w.on_event(&EventRecord {
+            shadow: true,
+            ..event
+        })
+        .unwrap();
         w.flush().unwrap();
         let text = String::from_utf8(w.out).unwrap();
-        assert!(text.ends_with('\n'));
-        let v: serde_json::Value = serde_json::from_str(text.trim_end()).unwrap();
+        let (text, shadow) = text.split_once('\n').unwrap();
+        let flagged = shadow.strip_suffix(",\"shadow\":true}\n");
+        assert_eq!(flagged, text.strip_suffix('}'), "{shadow}");
+        assert!(!text.contains("shadow"));
+        let v: serde_json::Value = serde_json::from_str(text).unwrap();
         assert_eq!(v["seq"], 12);
         assert_eq!(v["t"], 0.1);
         assert_eq!(v["guard"], "impact");

@@ -130,6 +130,7 @@ impl Section<'_> {
             max_wall_seconds: self
                 .deadline
                 .map(|d| d.saturating_duration_since(Instant::now()).as_secs_f64()),
+            past_horizon: false,
         };
         let mut counter = Counter {
             guard: self.guard,

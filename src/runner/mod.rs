@@ -81,6 +81,8 @@ pub struct Control {
     /// `--wall`): each run gets what is left of it, and a tool that runs
     /// many begins none past it.
     pub deadline: Option<std::time::Instant>,
+    /// Runs go on past their horizon as pseudo-orbits (`--past-horizon`).
+    pub past_horizon: bool,
 }
 
 /// The instant `seconds` (a wall-clock budget, `--wall`) from now, or
@@ -144,6 +146,7 @@ impl Control {
                     Some(own.map_or(left, |own| own.min(left)))
                 }
             },
+            past_horizon: self.past_horizon,
         }
     }
 }

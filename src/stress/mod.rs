@@ -202,6 +202,7 @@ pub fn run_case(
         stop: None,
         max_wall_seconds: Some(wall_seconds),
         deadline: None,
+        past_horizon: false,
     };
     let start = Instant::now();
     let run = reference.measure(&scene, &control)?;

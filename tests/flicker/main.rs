@@ -25,6 +25,7 @@ mod forced_linear;
 mod fuzz_regressions;
 mod golden;
 mod homogenized;
+mod horizon;
 mod invariants;
 mod large_automata;
 mod lyapunov;

@@ -158,6 +158,13 @@ impl<S: Storage> Pair<S> {
         self.box_.state_bound().min(self.ellipsoid.state_bound())
     }
 
+    /// Whether some component's error may exceed `limit`: no component's
+    /// half-width in the parallelepiped exceeds the sum of its radii (its
+    /// frame is orthonormal), which settles most questions at once.
+    fn exceeds(&self, limit: f64) -> bool {
+        !(self.box_.radii_sum() <= limit) && !(self.state_bound() <= limit)
+    }
+
     fn along(&self, gradient: &[f64]) -> f64 {
         self.box_
             .along(gradient)
@@ -263,6 +270,18 @@ impl ErrorSet {
             Some(Enclosures::Fixed(pair)) => Some(pair.state_bound()),
             Some(Enclosures::Heap(pair)) => Some(pair.state_bound()),
             None => None,
+        }
+    }
+
+    /// Whether the largest error of some component may exceed `limit` (the
+    /// estimate's, where the set is not carried). Asked at every step.
+    #[inline]
+    pub fn exceeds(&self, limit: f64) -> bool {
+        match &self.enclosures {
+            _ if self.poisoned => true,
+            Some(Enclosures::Fixed(pair)) => pair.exceeds(limit),
+            Some(Enclosures::Heap(pair)) => pair.exceeds(limit),
+            None => !(self.sum <= limit),
         }
     }
 

@@ -105,6 +105,12 @@ impl<S: Storage> Parallelepiped<S> {
         self.n
     }
 
+    /// The sum of the half-widths along its directions: above the
+    /// half-width along any component.
+    pub(super) fn radii_sum(&self) -> f64 {
+        self.radii.as_ref()[..self.n].iter().sum()
+    }
+
     /// The half-width of the set along each component, the largest.
     pub(super) fn state_bound(&self) -> f64 {
         let (n, basis, radii) = (self.n, self.basis.as_ref(), self.radii.as_ref());
