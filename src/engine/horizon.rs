@@ -54,7 +54,8 @@ impl Horizon {
     }
 
     /// The run's error has reached [`FRACTION`] of its state at `t`: a
-    /// run that may goes on past it from here.
+    /// run that may go past its horizon goes on from here as a
+    /// pseudo-orbit.
     pub fn reached(&mut self, t: Time) {
         if self.at.is_none() {
             self.at = Some(t);
@@ -63,8 +64,8 @@ impl Horizon {
     }
 
     /// The bound can no longer decide what happens at `t`, for the reason
-    /// `why`: a run that may goes on past its horizon; any other stops,
-    /// its reason naming the horizon and the way past it.
+    /// `why`: a run that may go past its horizon goes on; any other
+    /// stops, its reason naming the horizon and the way past it.
     pub fn undecided(&mut self, t: Time, why: String) -> Result<(), String> {
         self.reached(t);
         if self.past {

@@ -360,11 +360,24 @@ impl<'o> Ledger<'o> {
         })
     }
 
+    /// Where the run's bound cannot order an event of guard `slot` of
+    /// `mode` (named `name`) at `t`: whether it is one of a pile-up of
+    /// that guard's events (see [`ZenoWatch::chattering`]), and if so
+    /// what was seen, in the Zeno watch's words.
+    pub fn chatters(&self, mode: Mode, slot: usize, name: &str, t: Time) -> Option<String> {
+        let seen = self.zeno.describe_chattering(mode, slot)?;
+        Some(format!(
+            "events of guard `{name}` accumulate at t = {:e} faster than the run can resolve ({seen})",
+            t.value()
+        ))
+    }
+
     /// The Zeno accumulation `what` has no resting mode: the run stops.
     pub fn unsettled(what: &str) -> End {
         End::zeno(format!(
-            "{what}; the model has no resting mode (an automaton's mode names one with `rest`), \
-             so the run stops here"
+            "{what}: the orbit chatters down onto the guard (it would come to rest there), and the \
+             model has no resting mode to go on in, so the run stops here; an automaton's mode \
+             names one with `rest` (docs/automata.md, \"Resting modes\")"
         ))
     }
 

@@ -22,7 +22,7 @@ use crate::engine::ledger::{Final, Ledger};
 use crate::engine::model::Guard;
 use crate::engine::observer::{EventRecord, Observer, SETTLE};
 use crate::engine::queue::EventQueue;
-use crate::engine::run::{Options, Outcome};
+use crate::engine::run::{ErrorEstimate, Options, Outcome};
 use crate::engine::run_loop::{End, Segments, drive};
 use crate::time::Time;
 
@@ -74,6 +74,31 @@ pub trait LocalModel {
     fn energy_scale(&self, initial_energy: f64) -> f64 {
         initial_energy.abs().max(f64::MIN_POSITIVE)
     }
+
+    /// Where the model's own error estimate first reached 1e-3 of its
+    /// state (see [`horizon`](crate::engine::horizon)), if it has: the
+    /// events from it on are flagged `shadow`. An exact model decides
+    /// every event, so it goes on past its horizon: what it computes
+    /// there is a pseudo-orbit, whose coarse-grained fields may still be
+    /// the scene's.
+    fn horizon(&self) -> Option<Time> {
+        None
+    }
+
+    /// What the model can say of its errors at the end of the run (by
+    /// default nothing: no bound, no estimate).
+    fn accuracy(&self) -> Accuracy {
+        Accuracy::default()
+    }
+}
+
+/// What an event-local model says of its own errors at the end of a run.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Accuracy {
+    /// A bound on every component of its state, where it has one.
+    pub bound: Option<f64>,
+    /// Where it has none, an estimate and how it was made.
+    pub estimate: Option<ErrorEstimate>,
 }
 
 /// What a reset did.
@@ -113,6 +138,7 @@ pub fn simulate_local<M: LocalModel + ?Sized, O: Observer + ?Sized>(
         now,
         ..
     } = run;
+    let accuracy = model.accuracy();
     let last = Final {
         t_reached: now,
         mode: 0,
@@ -121,10 +147,10 @@ pub fn simulate_local<M: LocalModel + ?Sized, O: Observer + ?Sized>(
         state: Vec::new(),
         energy: model.energy(now),
         flow_evaluations: evaluations,
-        error_bound: Some(0.0),
-        error_estimate: None,
+        error_bound: accuracy.bound,
+        error_estimate: accuracy.estimate,
         event_time_bound: None,
-        horizon: None,
+        horizon: model.horizon().map(Time::value),
     };
     let guards = model.guards();
     ledger.outcome(end, last, |_, slot| guards[slot].name.clone())
@@ -249,7 +275,7 @@ impl<M: LocalModel + ?Sized> LocalRun<'_, M> {
             names_after: &[],
             after: &[],
             labels,
-            shadow: false,
+            shadow: self.model.horizon().is_some_and(|h| t >= h),
         }
     }
 

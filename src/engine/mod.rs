@@ -41,7 +41,7 @@ pub mod zeno;
 pub use adaptive::Tolerances;
 pub use family::{Family, Promoted};
 pub use labels::{Label, Labels};
-pub use local::{Fired, LocalModel, simulate_local};
+pub use local::{Accuracy, Fired, LocalModel, simulate_local};
 pub use method::Method;
 pub use model::{Affects, Direction, Flow, Guard, HybridModel, Jump, Mode};
 pub use names::Name;

@@ -164,6 +164,9 @@ struct Run<'m, 's, M: HybridModel + ?Sized> {
     /// Events logged so far (the round-off allowance's count, for the
     /// horizon between events).
     logged: u64,
+    /// The guard whose graze the bound could not decide, when a segment
+    /// failed for it: a pile-up of its events is a Zeno point.
+    undecided_graze: Option<usize>,
 }
 
 impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
@@ -219,6 +222,10 @@ impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
         let mut after = std::mem::take(&mut self.after);
         self.set_clock(t, &mut after);
         self.after = after;
+        // A pile-up of this guard's events that the bound can no longer
+        // order is a Zeno point (the same words as the Zeno watch's): the
+        // event fires, and the run settles or stops after it.
+        let mut piled_up = None;
         let recorded = if !all_finite(&before) || !all_finite(&self.after) {
             let why = model
                 .diagnose_guard(mode, slot, &before, true)
@@ -231,7 +238,12 @@ impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
                 before,
                 self.after
             )))
-        } else if let Err(why) = self.carry_errors(slot, t, &before, jump.mode) {
+        } else if let Err(why) = self.carry_errors(slot, t, &before, jump.mode)
+            && (guard.internal || {
+                piled_up = ledger.chatters(mode, slot, &guard.name, t);
+                piled_up.is_none()
+            })
+        {
             Err(End::failed(why))
         } else if guard.internal {
             Ok(())
@@ -285,7 +297,8 @@ impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
         }
         // Internal switches are watched too: a chart that flickers at one
         // instant must not spin either.
-        if let Some(what) = ledger.zeno(mode, slot, &guard.name, t) {
+        let zeno = ledger.zeno(mode, slot, &guard.name, t);
+        if let Some(what) = piled_up.or(zeno) {
             return self.settle(what, t, ledger, observer);
         }
         let predicted = match (self.motion, jump.affects) {
@@ -356,6 +369,14 @@ impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
                 self.start_segment()
             }
         };
+        // A graze the bound cannot decide on a guard whose events pile up
+        // is the same Zeno point (the ball chatters down onto the table).
+        if predicted.is_err()
+            && let Some(g) = self.undecided_graze.take()
+            && let Some(what) = ledger.chatters(self.mode, g, &model.guards(self.mode)[g].name, t)
+        {
+            return self.settle(what, t, ledger, observer);
+        }
         predicted?;
         // An autonomous flow repeats from a repeated state (see
         // `periodic`): an exact one with nothing to carry, or steps that
@@ -541,6 +562,7 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
                 options.past_horizon,
             ),
             logged: 0,
+            undecided_graze: None,
             stepped: false,
             step_end: None,
             step_offset: 0.0,
@@ -1077,9 +1099,10 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
                     graze.filter(|&(_, _, _, at)| at <= earliest)
                 {
                     let why = self.undecidable(g, margin, uncertainty);
-                    self.bound
-                        .undecided(self.origin, why)
-                        .map_err(End::failed)?;
+                    if let Err(why) = self.bound.undecided(self.origin, why) {
+                        self.undecided_graze = Some(g);
+                        return Err(End::failed(why));
+                    }
                 }
                 self.step_end = Some(self.origin.after(h));
                 Ok(())

@@ -9,6 +9,14 @@
 //! one gives a true accumulation point (a bouncing ball); restitution one
 //! near resting contact gives intervals that are merely too small; both are
 //! caught the same way.
+//!
+//! A method with an error bound may lose the events sooner: their spacing
+//! falls below what its errors can order, and its bound cannot decide. The
+//! watch then tells a pile-up from chaos by the intervals themselves: the
+//! last [`SHRINKS`] each shrank by the same factor (to within
+//! [`RATIO_SPREAD`]), at most [`SHRINKING`], as a chattering ball's do. So
+//! every method names the same cause, in the same words
+//! ([`ZenoWatch::chattering`]).
 
 use crate::engine::model::Mode;
 use crate::time::Time;
@@ -18,6 +26,16 @@ pub const REPEATS: u32 = 8;
 
 /// Relative time resolution, `2^-40`.
 const RESOLUTION: f64 = 1.0 / (1u64 << 40) as f64;
+
+/// Consecutive shrinking intervals of one guard that make a pile-up where
+/// a run's bound can no longer order its events.
+pub const SHRINKS: u32 = 6;
+
+/// The most an interval may be of the one before to count as shrinking.
+pub const SHRINKING: f64 = 0.9;
+
+/// How far apart (as a ratio) the shrink factors of a pile-up may lie.
+pub const RATIO_SPREAD: f64 = 1.5;
 
 /// The shortest interval between events of one guard that a run reaching
 /// `t` (or `t_end`, whichever is larger) can resolve.
@@ -38,6 +56,10 @@ struct Track {
     interval: f64,
     previous_interval: f64,
     short: u32,
+    /// Consecutive intervals that shrank, and the least and largest
+    /// factor they shrank by.
+    shrinks: u32,
+    ratios: (f64, f64),
 }
 
 /// The last firing time and run of short intervals of each guard.
@@ -79,6 +101,15 @@ impl ZenoWatch {
             } else {
                 0
             };
+            let ratio = track.interval / track.previous_interval;
+            let (lo, hi) = track.ratios;
+            (track.shrinks, track.ratios) = match ratio {
+                r if !(r > 0.0 && r <= SHRINKING) => (0, (0.0, 0.0)),
+                r if track.shrinks > 0 && r.max(hi) <= RATIO_SPREAD * r.min(lo) => {
+                    (track.shrinks + 1, (r.min(lo), r.max(hi)))
+                }
+                r => (1, (r, r)),
+            };
         }
         track.last = Some(t);
         if track.short >= REPEATS {
@@ -88,6 +119,25 @@ impl ZenoWatch {
             return true;
         }
         false
+    }
+
+    /// Whether guard `slot` of `mode` is piling up (see the module's
+    /// doc): its intervals' last shrink factor, if so.
+    pub fn chattering(&self, mode: Mode, slot: usize) -> Option<f64> {
+        let track = self.tracks.get(mode)?.get(slot)?;
+        (track.shrinks >= SHRINKS).then(|| track.interval / track.previous_interval)
+    }
+
+    /// What the run's bound saw of the pile-up of guard `slot` of `mode`
+    /// (see [`ZenoWatch::chattering`]), for the run's `reason`.
+    pub fn describe_chattering(&self, mode: Mode, slot: usize) -> Option<String> {
+        let ratio = self.chattering(mode, slot)?;
+        let track = self.tracks[mode][slot];
+        let ahead = track.interval * ratio / (1.0 - ratio);
+        Some(format!(
+            "its error bound can no longer tell them apart; the last {SHRINKS} intervals \
+             shrinking by {ratio:.3} per event, so the accumulation point is about {ahead:.3e} ahead"
+        ))
     }
 
     /// What the last Zeno detection saw, for the run's `reason`.
@@ -131,6 +181,46 @@ mod tests {
             "caught late or early: dt {dt}"
         );
         assert!(watch.describe().contains("shrinking by 0.500"));
+    }
+
+    #[test]
+    fn a_steady_shrink_is_a_pile_up_and_a_wandering_one_is_not() {
+        // Intervals shrinking by 0.5 with a table's wobble of +-10%: a
+        // pile-up once SHRINKS of them have shrunk.
+        let mut watch = ZenoWatch::new(10.0);
+        let (mut t, mut dt) = (Time::new(0.0), 0.1);
+        for k in 0..=SHRINKS + 1 {
+            watch.observe(0, 0, t);
+            let seen = watch.chattering(0, 0);
+            assert_eq!(seen.is_some(), k > SHRINKS, "{k}: {seen:?}");
+            t = t.after(dt);
+            dt *= if k % 2 == 0 { 0.45 } else { 0.55 };
+        }
+        assert!(
+            watch
+                .describe_chattering(0, 0)
+                .unwrap()
+                .contains("shrinking by 0.55")
+        );
+        // Chaotic intervals: some shrink, some grow, the factors unlike.
+        let mut watch = ZenoWatch::new(100.0);
+        let mut t = Time::new(0.0);
+        for k in 0..400u64 {
+            watch.observe(0, 0, t);
+            assert_eq!(watch.chattering(0, 0), None, "{k}");
+            let wobble = (k.wrapping_mul(2654435761) % 1000) as f64 / 1000.0;
+            t = t.after(0.2 + wobble);
+        }
+        // Shrinking, but by factors far apart (a ball thrown back up by
+        // the table now and then): no pile-up.
+        let mut watch = ZenoWatch::new(10.0);
+        let (mut t, mut dt) = (Time::new(0.0), 0.1);
+        for k in 0..20 {
+            watch.observe(0, 0, t);
+            assert_eq!(watch.chattering(0, 0), None, "{k}");
+            t = t.after(dt);
+            dt *= if k % 2 == 0 { 0.3 } else { 0.85 };
+        }
     }
 
     #[test]

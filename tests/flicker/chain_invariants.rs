@@ -2,7 +2,8 @@
 //! states (proptest): every run reaches its end (chattering at the loaded
 //! end settled into resting contact, never a panic or a stop), energy and
 //! the momentum balance hold at every sample, no gap is ever found below
-//! zero, and events come in time order.
+//! zero, events come in time order, and the run states an estimate of its
+//! round-off and where its horizon is.
 
 use flicker::engine::{LocalModel, Options, Recorder, Status, simulate_local};
 use flicker::models::chain::{Chain, TaylorChain};
@@ -74,5 +75,13 @@ proptest! {
         prop_assert!(lowest > -1e-13 * unit, "a gap at {lowest:e}");
         prop_assert!(log.events.windows(2).all(|w| w[0].t <= w[1].t));
         prop_assert_eq!(model.guards().len(), chain.units + 2);
+        // What it says of its errors: an estimate (its tangent carried
+        // through every impact, cascades and the wall included), no bound,
+        // and the horizon the summary states.
+        prop_assert!(o.error_bound.is_none());
+        let estimate = o.error_estimate.as_ref().map(|e| e.value).unwrap_or(f64::NAN);
+        prop_assert!(estimate > 0.0 && estimate.is_finite(), "estimate {estimate}");
+        prop_assert_eq!(o.horizon, model.horizon().map(Time::value));
+        prop_assert!(o.horizon.is_none_or(|h| h <= 2.0));
     }
 }

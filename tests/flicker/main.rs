@@ -9,6 +9,7 @@ mod chain;
 mod chain_cli;
 mod chain_exact;
 mod chain_invariants;
+mod chattering;
 mod cli;
 mod compare;
 mod compare_models;

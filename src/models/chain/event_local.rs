@@ -51,11 +51,13 @@
 //! round-off of zero count as zero both ways, so a unit on the edge is neither
 //! captured nor released over and over.
 
-use crate::engine::{Direction, Fired, Guard, Labels, LocalModel};
+use crate::engine::bound::ROUNDOFF_ULPS;
+use crate::engine::{Accuracy, Direction, ErrorEstimate, Fired, Guard, Labels, LocalModel};
 use crate::numerics::first_crossing::{integral, search_fall};
 use crate::time::Time;
 
-use super::collide::{alone, cascade};
+use super::collide::{Step, alone, cascade_with};
+use super::tangent::{After, Tangent};
 use super::window_series::{MAX_COLUMN, Series, blocks};
 use super::{Chain, impact_labels};
 
@@ -124,6 +126,17 @@ pub struct TaylorChain {
     /// Since when the whole chain rests shut against the wall (block from
     /// unit 1), whose contact force then balances the end load.
     held_since: Option<Time>,
+    /// A tangent vector carried through the impacts: how fast round-off
+    /// grows, and the horizon (with the constraint on; a free chain's
+    /// errors do not grow).
+    tangent: Option<Tangent>,
+    /// Windows and impacts so far: the rounding a free chain's estimate
+    /// sums.
+    roundings: u64,
+    /// The state's scale (scaled gaps and velocities).
+    scale: f64,
+    /// An impact's cascade, step by step.
+    steps: Vec<Step>,
 }
 
 /// Guard name of an impact (with `rel_velocity` 0: a unit coming to rest
@@ -207,6 +220,10 @@ impl TaylorChain {
             momentum_initial: chain.mass * velocities.iter().sum::<f64>(),
             block: None,
             held_since: None,
+            tangent: chain.constraint.then(|| Tangent::new(n, scale, WINDOW)),
+            roundings: 0,
+            scale,
+            steps: Vec::new(),
             chain,
         };
         model.series.gap[1..=n].copy_from_slice(gaps);
@@ -320,6 +337,10 @@ impl TaylorChain {
         self.series.expand(self.ghost, self.block);
         self.series.open_over(1, WINDOW, &mut self.open[1..=n]);
         self.start = self.start.after(self.span);
+        self.roundings += 1;
+        if let Some(tangent) = &mut self.tangent {
+            tangent.next_window(self.block, self.start);
+        }
     }
 
     /// Resolve the impact of unit `unit` at `t` and re-expand the units
@@ -328,9 +349,11 @@ impl TaylorChain {
         let n = self.chain.units;
         let sigma = self.sigma(t);
         let (mut lo, mut hi) = (unit, unit);
+        self.roundings += 1;
         loop {
             let (r_lo, r_hi) = self.reach_around(lo, hi, sigma);
             let w_lo = self.load_window(r_lo, r_hi, sigma);
+            self.steps.clear();
             // Column of index i in the scratch series; node 0 (the wall)
             // reads zero there.
             let col = |i: usize| i + 1 - w_lo;
@@ -353,7 +376,8 @@ impl TaylorChain {
                 let mut v = std::mem::take(&mut self.scratch_nodes);
                 v.clear();
                 v.extend((r_lo - 1..=r_hi).map(|i| u_at(i, &self.scratch.vel)));
-                let (touched, wall) = cascade(r_lo, &shut, &mut v);
+                let steps = &mut self.steps;
+                let (touched, wall) = cascade_with(r_lo, &shut, &mut v, |step| steps.push(step));
                 self.scratch_shut = shut;
                 if let Some(touched) = touched.as_ref()
                     && (*touched.start() < lo || *touched.end() > hi)
@@ -379,6 +403,7 @@ impl TaylorChain {
                 ];
                 match alone(unit, nodes) {
                     Some([left, right]) => {
+                        self.steps.push(if unit == 1 { None } else { Some(0) });
                         if unit > 1 {
                             self.scratch.vel[col(unit - 1)] = left;
                         }
@@ -406,11 +431,61 @@ impl TaylorChain {
                 self.settle_end(r_lo, w_lo, t, self.shut_below);
             }
             self.store_window(r_lo, r_hi, w_lo, sigma);
+            // The tangent moves where the velocities did: the steps, taken
+            // over the cascade's nodes from `r_lo - 1` (or the lone
+            // unit's two), counted from the first touched node.
+            let first = touched.start() - 1;
+            let offset = if others_shut {
+                first + 1 - r_lo
+            } else {
+                first + 1 - unit
+            };
+            for step in self.steps.iter_mut() {
+                *step = step.map(|i| i - offset);
+            }
+            let fired =
+                (!self.steps.is_empty()).then_some((unit, (first, touched.end() + 1 - first)));
+            // Its own reach around them (see `tangent`), or the state's
+            // where that reaches the end block (which may have changed).
+            if r_hi == n {
+                self.carry_tangent(fired, (r_lo, r_hi), (w_lo, sigma), t);
+            } else if fired.is_some() {
+                let reach = Tangent::reach(touched.clone(), n);
+                self.carry_tangent(fired, reach, (w_lo, sigma), t);
+            }
             return Fired {
                 affects: self.guards_of(r_lo, r_hi),
                 labels: impact_labels(unit, Some(rel_velocity)),
             };
         }
+    }
+
+    /// Carry the tangent over a change to units `r_lo..=r_hi` at `sigma`
+    /// (at `t`; the state's window from `w_lo`, after the reset): the
+    /// impact of `unit`, if its cascade moved velocities (`self.steps`,
+    /// over `nodes`: the first and how many); then held to the end block
+    /// as it now is.
+    fn carry_tangent(
+        &mut self,
+        fired: Option<(usize, (usize, usize))>,
+        (r_lo, r_hi): (usize, usize),
+        (w_lo, sigma): (usize, f64),
+        t: Time,
+    ) {
+        let Some(tangent) = &mut self.tangent else {
+            return;
+        };
+        tangent.load(r_lo, r_hi, sigma);
+        if let Some((unit, nodes)) = fired {
+            let after = After {
+                first: w_lo,
+                gap: &self.scratch.gap[1..],
+                vel: &self.scratch.vel[1..],
+                ghost: self.ghost,
+            };
+            tangent.collide(unit, nodes, &self.steps, &after);
+        }
+        tangent.store(r_lo, r_hi, sigma, self.block, t);
     }
 
     /// The end block's first unit is pulled open: the block shrinks by it.
@@ -424,6 +499,7 @@ impl TaylorChain {
         let (r_lo, r_hi) = self.reach_around(a.saturating_sub(1).max(1), n, sigma);
         let w_lo = self.load_window(r_lo, r_hi, sigma);
         self.store_window(r_lo, r_hi, w_lo, sigma);
+        self.carry_tangent(None, (r_lo, r_hi), (w_lo, sigma), t);
         Fired {
             affects: self.guards_of(r_lo, r_hi),
             labels: impact_labels(a, None),
@@ -601,6 +677,7 @@ impl TaylorChain {
             return None;
         }
         self.store_window(r_lo, r_hi, w_lo, sigma);
+        self.carry_tangent(None, (r_lo, r_hi), (w_lo, sigma), t);
         Some(Fired {
             affects: self.guards_of(r_lo, r_hi),
             labels: impact_labels(unit, None),
@@ -681,6 +758,36 @@ impl LocalModel for TaylorChain {
             return Ok(self.release(t));
         }
         Ok(self.impact(guard + 1, t))
+    }
+
+    fn horizon(&self) -> Option<Time> {
+        self.tangent.as_ref().and_then(Tangent::horizon)
+    }
+
+    fn accuracy(&self) -> Accuracy {
+        let rounding = ROUNDOFF_ULPS * f64::EPSILON * self.scale;
+        let (value, made_by) = match &self.tangent {
+            Some(tangent) => (
+                tangent.estimate(),
+                "16 ulps of the state at each impact and window, each grown as a tangent vector \
+                 carried through every impact since grows (the leading Lyapunov vector in effect), \
+                 up to the state's scale: an estimate of how round-off grows, not a bound",
+            ),
+            None => (
+                rounding * self.roundings as f64,
+                "16 ulps of the state at each window, summed (the free chain does not amplify \
+                 them): an estimate of its round-off, not a bound",
+            ),
+        };
+        Accuracy {
+            bound: None,
+            estimate: Some(ErrorEstimate {
+                value,
+                made_by: format!(
+                    "{made_by}; of the unit gaps and the velocities over the frequency sqrt(k / m)"
+                ),
+            }),
+        }
     }
 
     fn settle(&mut self, guard: usize, t: Time) -> Option<Fired> {
