@@ -77,7 +77,8 @@ class Run:
             `(n, len(state_names))`, NaN where an event's mode has no such
             state), `energy_before`, `energy_after` (float64, NaN without an
             energy), `shadow` (bool: the event comes past the run's
-            horizon, in a run asked to go past it), and the labels the
+            horizon, in a run that goes past it: asked to, or a chain's),
+            and the labels the
             model gives (`unit` as int64, `rel_velocity`, `x`) where it has
             them. None if the run was asked for no events.
         state_names: the columns of `before` and `after`.
@@ -206,11 +207,12 @@ def run(
         t_eval: times (from 0 to t_end, any order) at which to keep the
             state, with its error bound: `Run.samples` (automata and the
             mechanism).
-        past_horizon: go on past the run's horizon (where its error bound
-            can no longer decide what happens) as a pseudo-orbit instead of
-            stopping there: the run completes, its summary states
-            `horizon` and no bound, and every event from the horizon on is
-            flagged (`events["shadow"]`).
+        past_horizon: go on past the run's horizon (where its error
+            reaches 1e-3 of its state, or its bound can no longer decide
+            what happens) as a pseudo-orbit, instead of stopping where it
+            cannot decide: the run completes, its summary states `horizon`
+            and no bound, and every event from the horizon on is flagged
+            (`events["shadow"]`).
 
     Raises:
         SceneError: the scene or an argument is refused; `field` and

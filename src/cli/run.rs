@@ -67,8 +67,9 @@ pub struct RunArgs {
         allow_negative_numbers = true
     )]
     at: Option<Vec<f64>>,
-    /// Go on past the run's horizon (where its bound can no longer decide
-    /// what happens) as a pseudo-orbit, instead of stopping there: the run
+    /// Go on past the run's horizon (where its error reaches 1e-3 of its
+    /// state, or its bound can no longer decide what happens) as a
+    /// pseudo-orbit, instead of stopping where it cannot decide: the run
     /// completes, states its horizon and no bound, and flags every event
     /// from the horizon on `"shadow": true`.
     #[arg(long = "past-horizon")]

@@ -466,6 +466,11 @@ impl Bound {
         }
         if let Some(since) = since.filter(|&since| !guard.internal && doubt(since)) {
             self.record.broken();
+            // The event fires all the same where its pile-up is a Zeno
+            // point the run settles: its saltation is carried.
+            if self.matrix.iter().all(|m| m.is_finite()) {
+                self.errors.map(&self.matrix, 0.0);
+            }
             return self.horizon.undecided(t, format!(
                 "the `{}` event at t = {} may be off by {shift:.2e} in time (its guard by {along:.2e}, \
                  closing at {:.2e}), more than half the {since:.3e} since an earlier event whose \
@@ -592,6 +597,11 @@ impl Bound {
     /// [`periodic`](crate::engine::periodic)): its last event moves with it.
     pub fn postpone(&mut self, periods: u64, tau: Span) {
         self.last_event = self.last_event.map(|t| t.after_multiple(periods, tau));
+        // The events kept to check commuting against are a jump behind:
+        // none may excuse an order in doubt past it.
+        if let Some(last) = self.last_event {
+            self.recent.restart(last);
+        }
     }
 
     /// The time error of the last event.

@@ -88,6 +88,14 @@ impl Recent {
         self.next = (self.next + 1) % KEPT;
     }
 
+    /// Forget the events kept: none is known to commute with what comes
+    /// after `at` (a run that jumped whole periods ahead to it).
+    pub fn restart(&mut self, at: Time) {
+        self.events.clear();
+        self.next = 0;
+        self.barrier = Some(at);
+    }
+
     /// The time from the latest earlier event that `e` may not commute
     /// with to `e`, looking back only while `doubt(since)` holds (an event
     /// further back is far enough); infinite where there is none.
@@ -274,6 +282,13 @@ mod tests {
         // Looking back stops where the doubt does.
         let since = recent.since_conflict(&Particles, &mut tangents, &now, |s| s < 2.0);
         assert_eq!(since, 2.5);
+        // After a jump over whole periods the kept events are a period
+        // behind: none may excuse a doubt, and the time that counts is
+        // since the jump's end.
+        let mut jumped = recent.clone();
+        jumped.restart(Time::new(100.0));
+        let since = jumped.since_conflict(&Particles, &mut tangents, &firing(100.25, 0), |_| true);
+        assert_eq!(since, 0.25);
         // A collision conflicts with the latest kept event.
         let since = recent.since_conflict(
             &Particles,

@@ -15,7 +15,13 @@
 //! errors, which in a hyperbolic system stays close to a true orbit from a
 //! nearby start (shadowing): its statistics are the attractor's, its state
 //! is not the scene's. Every event from the horizon on is flagged
-//! `shadow`, and the run states no bound.
+//! `shadow`, and the run states no bound. A pile-up of events a run
+//! going past its horizon cannot order goes on as it computes, until the
+//! Zeno watch's own resolution catches it, and is named the same way.
+//!
+//! Where the run jumps whole periods of a periodic orbit (replaying its
+//! bound over them), the horizon is looked for at the jump's end: it is
+//! dated to within the periods jumped at once.
 
 use crate::time::Time;
 

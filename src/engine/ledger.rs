@@ -363,9 +363,11 @@ impl<'o> Ledger<'o> {
     /// Where the run's bound cannot order an event of guard `slot` of
     /// `mode` (named `name`) at `t`: whether it is one of a pile-up of
     /// that guard's events (see [`ZenoWatch::chattering`]), and if so
-    /// what was seen, in the Zeno watch's words.
-    pub fn chatters(&self, mode: Mode, slot: usize, name: &str, t: Time) -> Option<String> {
+    /// what was seen, in the Zeno watch's words (and the pile-up is
+    /// spent: a later one must shrink anew).
+    pub fn chatters(&mut self, mode: Mode, slot: usize, name: &str, t: Time) -> Option<String> {
         let seen = self.zeno.describe_chattering(mode, slot)?;
+        self.zeno.forget_chattering(mode, slot);
         Some(format!(
             "events of guard `{name}` accumulate at t = {:e} faster than the run can resolve ({seen})",
             t.value()
@@ -375,9 +377,9 @@ impl<'o> Ledger<'o> {
     /// The Zeno accumulation `what` has no resting mode: the run stops.
     pub fn unsettled(what: &str) -> End {
         End::zeno(format!(
-            "{what}: the orbit chatters down onto the guard (it would come to rest there), and the \
-             model has no resting mode to go on in, so the run stops here; an automaton's mode \
-             names one with `rest` (docs/automata.md, \"Resting modes\")"
+            "{what}: the events pile up at the guard (an orbit chattering down onto it would come \
+             to rest there), and the model has no resting mode to go on in, so the run stops here; \
+             an automaton's mode names one with `rest` (docs/automata.md, \"Resting modes\")"
         ))
     }
 

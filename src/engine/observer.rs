@@ -43,9 +43,10 @@ pub struct EventRecord<'a> {
     /// What the model labels the event with (a chain's unit and closing
     /// speed, a place along a continuum), passed on as it is.
     pub labels: &'a Labels,
-    /// Whether the event comes past the run's horizon, in a run asked to
-    /// go on past it: it is an event of a pseudo-orbit (see
-    /// [`horizon`](crate::engine::horizon)).
+    /// Whether the event comes past the run's horizon, in a run that goes
+    /// on past it (asked to, `--past-horizon`, or an exact event-local
+    /// model such as the chain, which always does): it is an event of a
+    /// pseudo-orbit (see [`horizon`](crate::engine::horizon)).
     pub shadow: bool,
 }
 

@@ -29,9 +29,10 @@ pub struct Options {
     pub stop: Option<Arc<AtomicBool>>,
     /// Stop with `failed` after this much wall time (seconds), if set.
     pub max_wall_seconds: Option<f64>,
-    /// Go on past the run's horizon as a pseudo-orbit, its events flagged
-    /// `shadow`, instead of stopping where the bound can no longer decide
-    /// what happens (see [`horizon`](crate::engine::horizon)).
+    /// Go on past the run's horizon as a pseudo-orbit, carrying no bound
+    /// from there and flagging its events `shadow`, instead of stopping
+    /// where the bound can no longer decide what happens (see
+    /// [`horizon`](crate::engine::horizon)).
     pub past_horizon: bool,
 }
 
@@ -138,7 +139,8 @@ pub struct Outcome {
     /// happened.
     pub horizon: Option<f64>,
     /// Events logged past the horizon by a run that went on past it
-    /// ([`Options::past_horizon`]), each flagged `shadow`.
+    /// ([`Options::past_horizon`], or an event-local model that always
+    /// does), each flagged `shadow`.
     pub shadow_events: u64,
     /// Whole periods of an exactly periodic orbit the run jumped over
     /// instead of firing their events (see

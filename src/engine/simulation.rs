@@ -713,6 +713,7 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
         let into = format!("`{}`", self.model.mode_name(rest));
         let event = self.event(SETTLE, t, rest, &before, &Labels::NONE);
         let recorded = ledger.settled(what, &into, event, observer);
+        self.logged = ledger.events();
         self.state = before;
         recorded?;
         std::mem::swap(&mut self.state, &mut self.after);

@@ -618,8 +618,9 @@ fn exp_dense(n: usize, a: &[f64], out: &mut [f64]) {
     }
 }
 
-/// [`exp`] for the larger sizes: nalgebra's (Pade's (13, 13) approximant,
-/// scaling and squaring as Higham 2005). The row-major `a` read
+/// [`exp`] for the larger sizes: nalgebra's (Al-Mohy and Higham 2009: a
+/// Pade approximant of degree 3 to 13 as the norm needs, with scaling and
+/// squaring). The row-major `a` read
 /// column-major is its transpose, whose exponential is the transpose of
 /// `exp(a)`: written back column-major, `exp(a)` row-major.
 fn exp_dynamic(n: usize, a: &[f64], out: &mut [f64]) {

@@ -128,6 +128,14 @@ impl ZenoWatch {
         (track.shrinks >= SHRINKS).then(|| track.interval / track.previous_interval)
     }
 
+    /// The pile-up of guard `slot` of `mode` was dealt with (settled):
+    /// another must shrink anew.
+    pub fn forget_chattering(&mut self, mode: Mode, slot: usize) {
+        if let Some(track) = self.tracks.get_mut(mode).and_then(|t| t.get_mut(slot)) {
+            track.shrinks = 0;
+        }
+    }
+
     /// What the run's bound saw of the pile-up of guard `slot` of `mode`
     /// (see [`ZenoWatch::chattering`]), for the run's `reason`.
     pub fn describe_chattering(&self, mode: Mode, slot: usize) -> Option<String> {
@@ -136,7 +144,8 @@ impl ZenoWatch {
         let ahead = track.interval * ratio / (1.0 - ratio);
         Some(format!(
             "its error bound can no longer tell them apart; the last {SHRINKS} intervals \
-             shrinking by {ratio:.3} per event, so the accumulation point is about {ahead:.3e} ahead"
+             shrinking by {ratio:.3} per event, so the accumulation point is about {ahead:.3e} \
+             past the last event it could"
         ))
     }
 
@@ -202,6 +211,11 @@ mod tests {
                 .unwrap()
                 .contains("shrinking by 0.55")
         );
+        // Settled: a later pile-up must shrink anew.
+        watch.forget_chattering(0, 0);
+        assert_eq!(watch.chattering(0, 0), None);
+        watch.observe(0, 0, t);
+        assert_eq!(watch.chattering(0, 0), None);
         // Chaotic intervals: some shrink, some grow, the factors unlike.
         let mut watch = ZenoWatch::new(100.0);
         let mut t = Time::new(0.0);

@@ -8,12 +8,14 @@
 //! `zeno`, `flow_evaluations`, `error_bound` (the largest error a state
 //! component may carry; null where no bound is carried),
 //! `error_estimate` and `error_estimate_by` (where no bound is carried,
-//! what stands in for it and how it was made; else null),
+//! what stands in for it and how it was made; null where a bound is, and
+//! past the horizon of a run that went on past it),
 //! `event_time_bound` (the same for event times, null where not carried),
 //! `horizon` (where the run's own error reached 1e-3 of its state's scale,
 //! or its bound could no longer decide what happens; null if neither, see
 //! `engine::horizon`), `shadow_events` (events logged past the horizon by
-//! a run that went on past it, `--past-horizon`, each flagged `shadow`),
+//! a run that went on past it, `--past-horizon` or a chain's, each flagged
+//! `shadow`),
 //! `wall_seconds`, `log` (path of the event log or
 //! null); for chains, `momentum` (total, at the end) and
 //! `momentum_balance_error` (against the end load's and the wall's

@@ -50,7 +50,7 @@ fn names_the_chattering(reason: &str, what: &str) {
     for words in [
         "events of guard `impact` accumulate at t = ",
         "faster than the run can resolve",
-        "the orbit chatters down onto the guard",
+        "the events pile up at the guard (an orbit chattering down onto it",
         "names one with `rest`",
     ] {
         assert!(reason.contains(words), "{what}: {words:?} not in {reason}");

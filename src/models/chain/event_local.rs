@@ -536,22 +536,9 @@ impl TaylorChain {
             r_lo.saturating_sub(self.spread).max(1),
             (r_hi + self.spread).min(n),
         );
-        let count = w_hi - w_lo + 1;
-        self.scratch.reset(count);
-        let tau = &mut self.sweep[0];
-        tau.clear();
-        tau.extend(
-            self.origin[w_lo..=w_hi]
-                .iter()
-                .map(|o| (sigma - o).max(0.0)),
-        );
-        // Whole blocks: past the window, row 0 is set by the expansion.
-        tau.resize(blocks(count), 0.0);
-        let (gaps, vels) = (
-            &mut self.scratch.gap[1..=blocks(count)],
-            &mut self.scratch.vel[1..=blocks(count)],
-        );
-        self.series.values(w_lo, tau, gaps, vels);
+        let (origin, tau) = (&self.origin, &mut self.sweep[0]);
+        self.series
+            .load(&mut self.scratch, origin, (w_lo, w_hi), sigma, tau);
         w_lo
     }
 

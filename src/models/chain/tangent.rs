@@ -169,7 +169,8 @@ impl Tangent {
         if growth.is_finite() {
             self.estimate = (self.estimate * growth + self.rounding).min(self.scale);
         }
-        if self.horizon.is_none() && !(self.estimate < self.limit) {
+        // A state of no size has no horizon to reach.
+        if self.horizon.is_none() && self.limit > 0.0 && !(self.estimate < self.limit) {
             self.horizon = Some(t);
         }
     }
@@ -222,21 +223,9 @@ impl Tangent {
     pub fn load(&mut self, lo: usize, hi: usize, sigma: f64) {
         let (n, sigma) = (self.units, self.since_start(sigma));
         let (w_lo, w_hi) = (lo.saturating_sub(SPREAD).max(1), (hi + SPREAD).min(n));
-        let count = w_hi - w_lo + 1;
-        self.scratch.reset(count);
-        let tau = &mut self.sweep[0];
-        tau.clear();
-        tau.extend(
-            self.origin[w_lo..=w_hi]
-                .iter()
-                .map(|o| (sigma - o).max(0.0)),
-        );
-        tau.resize(blocks(count), 0.0);
-        let (gaps, vels) = (
-            &mut self.scratch.gap[1..=blocks(count)],
-            &mut self.scratch.vel[1..=blocks(count)],
-        );
-        self.series.values(w_lo, tau, gaps, vels);
+        let (origin, tau) = (&self.origin, &mut self.sweep[0]);
+        self.series
+            .load(&mut self.scratch, origin, (w_lo, w_hi), sigma, tau);
         let norm = self.norm_over(lo, hi, w_lo);
         self.loaded = (w_lo, norm);
     }

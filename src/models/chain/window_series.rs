@@ -347,6 +347,30 @@ impl Series {
         done
     }
 
+    /// The values at scaled time `sigma` of columns `first..=last`, each
+    /// series begun at its `origin` (by column), into order 0 of `window`
+    /// from its column 1, made to hold them (`tau` is scratch).
+    pub fn load(
+        &self,
+        window: &mut Series,
+        origin: &[f64],
+        (first, last): (usize, usize),
+        sigma: f64,
+        tau: &mut Vec<f64>,
+    ) {
+        let count = last - first + 1;
+        window.reset(count);
+        tau.clear();
+        tau.extend(origin[first..=last].iter().map(|o| (sigma - o).max(0.0)));
+        // Whole blocks: past the window, row 0 is set by the expansion.
+        tau.resize(blocks(count), 0.0);
+        let (gaps, vels) = (
+            &mut window.gap[1..=blocks(count)],
+            &mut window.vel[1..=blocks(count)],
+        );
+        self.values(first, tau, gaps, vels);
+    }
+
     /// Copy columns `from..from + count` of `source` (same order) into
     /// columns `to..` of this series, every order.
     pub fn copy_columns(&mut self, source: &Series, from: usize, to: usize, count: usize) {
