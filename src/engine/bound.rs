@@ -662,24 +662,31 @@ impl Bound {
     /// step: the cheap questions first.
     #[inline]
     pub fn watch(&mut self, t: Time, state: &[f64], events: u64) {
-        if self.horizon.at().is_some() {
+        if self.horizon.at().is_some() || !self.beyond(events) {
             return;
         }
+        // Near it: the scale is the largest state seen (a larger one only
+        // moves the limit up), this one's included.
         for (i, x) in state[..self.bounded].iter().enumerate() {
             if x.abs() > self.horizon_scale && Some(i) != self.clock {
                 self.horizon_scale = x.abs();
             }
         }
-        let scale = self.horizon_scale.max(self.state_scale);
-        let limit = FRACTION * scale - self.roundoff(events);
-        let reached = if self.errors.is_empty() {
+        if self.beyond(events) && self.horizon_scale.max(self.state_scale) > 0.0 {
+            self.horizon.reached(t);
+        }
+    }
+
+    /// Whether the errors after `events` events may exceed [`FRACTION`] of
+    /// the largest state seen so far.
+    #[inline(always)]
+    fn beyond(&self, events: u64) -> bool {
+        let limit = FRACTION * self.horizon_scale.max(self.state_scale) - self.roundoff(events);
+        if self.errors.is_empty() {
             // Round-off alone: after about 10^11 events.
             limit <= 0.0
         } else {
             self.errors.exceeds(limit)
-        };
-        if reached && scale > 0.0 {
-            self.horizon.reached(t);
         }
     }
 
