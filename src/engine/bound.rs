@@ -282,6 +282,33 @@ impl Bound {
         self.errors.along(&self.gradient) + spread(&self.gradient, local)
     }
 
+    /// How far in time the crossing of guard `g` of `mode` near `state`
+    /// may be off: the errors so far and a step's `local` error along its
+    /// gradient, over its rate there (for a sample beside the event; the
+    /// period record is not touched). Zero where no error is carried.
+    pub fn crossing_uncertainty<M: HybridModel + ?Sized>(
+        &mut self,
+        model: &M,
+        mode: Mode,
+        g: usize,
+        state: &[f64],
+        local: f64,
+    ) -> f64 {
+        if self.idle() || !self.errors.tracked() {
+            return 0.0;
+        }
+        self.gradient_of(model, mode, g, state);
+        let along = self.errors.along(&self.gradient) + spread(&self.gradient, local);
+        if along == 0.0 {
+            return 0.0;
+        }
+        self.tangents.rate(model, mode, state, &mut self.rate);
+        let closing: f64 = (self.gradient.iter().zip(&self.rate))
+            .map(|(g, f)| g * f)
+            .sum();
+        along / closing.abs()
+    }
+
     /// `sum |d g / d x_i|` of affine guard `g` of `mode`, once per mode.
     fn affine_sum<M: HybridModel + ?Sized>(
         &mut self,

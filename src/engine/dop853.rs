@@ -18,7 +18,6 @@
 #![allow(clippy::needless_range_loop)]
 
 use crate::engine::adaptive::{EmbeddedPair, StepControl, Tolerances, TrialError};
-use crate::engine::integrator::Crossing;
 use crate::engine::model::{HybridModel, Mode};
 
 /// The order of the error estimate in the step size.
@@ -290,78 +289,6 @@ impl Dop853 {
         (&self.k[END], &self.k[0])
     }
 
-    /// Sharpen a crossing found on the dense output, whose error (one order
-    /// below the step's) otherwise sets the accuracy of every event: re-take
-    /// the step from `y0` to exactly `tau` (12 evaluations), then follow the
-    /// flow from there by its second-order Taylor polynomial (two more: the
-    /// rate at `tau` and the rate one Newton step along it) and find the
-    /// guard's zero on that by secant steps, nudged forward until it has
-    /// crossed. The correction is of the size of the dense output's error,
-    /// and the polynomial's own error is cubic in it: far below round-off
-    /// at the tolerances where sharpening matters, and never worse than the
-    /// dense output it replaces. Returns the correction to `tau`, with the
-    /// state there in `x`, if it is no larger than `reach`; `None` keeps the
-    /// dense output's answer (`x` is scratch). The stages are spent: the
-    /// next step starts afresh, as after every event.
-    pub fn sharpen<M: HybridModel + ?Sized>(
-        &mut self,
-        model: &M,
-        mode: Mode,
-        y0: &[f64],
-        crossing: &Crossing,
-        x: &mut [f64],
-    ) -> Option<f64> {
-        let &Crossing {
-            tau,
-            reach,
-            guard,
-            crossed,
-            ..
-        } = crossing;
-        let h = self.dense.h;
-        let (a, b) = ((tau - 1e-4 * h).max(0.0), (tau + 1e-4 * h).min(h));
-        self.dense.eval(a, x);
-        let g_a = guard(x);
-        self.dense.eval(b, x);
-        let slope = (guard(x) - g_a) / (b - a);
-        self.control.fsal = false;
-        self.stage_at(model, mode, y0, 0);
-        self.attempt(model, mode, y0, tau);
-        // The stages are free now: k[1] takes f at tau, k[2] f one step on.
-        let start = std::mem::take(&mut self.y1);
-        let first = -guard(&start) / slope;
-        if first.is_nan() || first.abs() > 2.0 * reach {
-            // A flat or undefined slope, or a correction out of reach: the
-            // flow is not asked about states far from the crossing.
-            self.y1 = start;
-            return None;
-        }
-        self.stage_at(model, mode, &start, 1);
-        for i in 0..x.len() {
-            self.scratch[i] = start[i] + first * self.k[1][i];
-        }
-        let probe = std::mem::take(&mut self.scratch);
-        self.stage_at(model, mode, &probe, 2);
-        self.scratch = probe;
-        let (rate, later) = (&self.k[1], &self.k[2]);
-        // x(tau + s) = start + s f + s^2/2 f'f, with f'f from the two rates.
-        let mut along = |s: f64, x: &mut [f64]| {
-            for i in 0..x.len() {
-                let bend = if first == 0.0 {
-                    0.0
-                } else {
-                    (later[i] - rate[i]) / first
-                };
-                x[i] = start[i] + s * (rate[i] + 0.5 * s * bend);
-            }
-            guard(x)
-        };
-        let floor = f64::EPSILON * tau.abs().max(f64::MIN_POSITIVE);
-        let found = zero_along(&mut along, first, slope, floor, crossed, x);
-        self.y1 = start;
-        found.filter(|s| s.abs() <= reach && tau + s >= 0.0)
-    }
-
     /// `k[stage] = f(y)`.
     fn stage_at<M: HybridModel + ?Sized>(
         &mut self,
@@ -401,6 +328,18 @@ impl EmbeddedPair for Dop853 {
 
     fn control(&self) -> &StepControl {
         &self.control
+    }
+
+    fn dense_eval(&self, tau: f64, x: &mut [f64]) {
+        self.dense.eval(tau, x);
+    }
+
+    fn dense_h(&self) -> f64 {
+        self.dense.h
+    }
+
+    fn trial_end(&mut self) -> &mut Vec<f64> {
+        &mut self.y1
     }
 
     /// One trial step of size `h`, and its error.
@@ -477,47 +416,6 @@ impl EmbeddedPair for Dop853 {
         self.k.swap(0, END);
         self.control.fsal = true;
     }
-}
-
-/// The zero of `along(s)` (the guard at `s` past the dense crossing, which
-/// writes the state there into `x`) by secant steps from 0 and `first`,
-/// then moved forward until `crossed` holds. `x` ends at the returned `s`.
-fn zero_along(
-    along: &mut impl FnMut(f64, &mut [f64]) -> f64,
-    first: f64,
-    slope: f64,
-    floor: f64,
-    crossed: &dyn Fn(f64) -> bool,
-    x: &mut [f64],
-) -> Option<f64> {
-    let (mut s0, mut g0) = (0.0, along(0.0, x));
-    let (mut s1, mut g1) = (first, along(first, x));
-    for _ in 0..8 {
-        if g1 == 0.0 || g1 == g0 {
-            break;
-        }
-        let s2 = s1 - g1 * (s1 - s0) / (g1 - g0);
-        if !s2.is_finite() || s2 == s1 {
-            break;
-        }
-        (s0, g0) = (s1, g1);
-        (s1, g1) = (s2, along(s2, x));
-    }
-    // Rounding may leave the zero a hair short of crossing: step forward,
-    // doubling, from the distance the slope says is left.
-    let mut nudge = (g1 / slope).abs().max(floor);
-    for _ in 0..16 {
-        if !(s1.is_finite() && g1.is_finite()) {
-            return None;
-        }
-        if crossed(g1) {
-            return Some(s1);
-        }
-        s1 += nudge;
-        nudge *= 2.0;
-        g1 = along(s1, x);
-    }
-    None
 }
 
 #[cfg(test)]

@@ -132,6 +132,18 @@ impl EmbeddedPair for Dopri5 {
         &self.control
     }
 
+    fn dense_eval(&self, tau: f64, x: &mut [f64]) {
+        self.dense.eval(tau, x);
+    }
+
+    fn dense_h(&self) -> f64 {
+        self.dense.h
+    }
+
+    fn trial_end(&mut self) -> &mut Vec<f64> {
+        &mut self.y1
+    }
+
     fn attempt<M: HybridModel + ?Sized>(
         &mut self,
         model: &M,

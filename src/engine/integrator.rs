@@ -12,6 +12,7 @@ use crate::engine::linear::Linear;
 use crate::engine::locate::{Interpolant, Start, StepScan};
 use crate::engine::method::Method;
 use crate::engine::model::{Flow, HybridModel, Mode};
+use crate::engine::sharpen::{dense_error, sharpen};
 use crate::engine::tangent::Rates;
 use crate::engine::taylor_method::Taylor;
 use crate::engine::verlet::Verlet;
@@ -72,14 +73,30 @@ pub fn motion<M: HybridModel + ?Sized>(
 pub struct Crossing<'a> {
     /// Time of the crossing into the step, as the dense output puts it.
     pub tau: f64,
-    /// The largest correction to `tau` that is accepted.
+    /// The largest correction to `tau` that is accepted from the flow
+    /// followed past a step's end (the range of its polynomial).
     pub reach: f64,
+    /// How far the crossing may move either way and keep the events'
+    /// order (the time to the next queued event; none where one is due at
+    /// the same instant, a simultaneous event).
+    pub room: f64,
     /// The guard, as a function of the state.
     pub guard: &'a dyn Fn(&[f64]) -> f64,
     /// Whether a value of the guard counts as having crossed.
     pub crossed: &'a dyn Fn(f64) -> bool,
     /// The guard's place among its mode's guards.
     pub slot: usize,
+}
+
+/// What sharpening did to a crossing.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Sharpened {
+    /// Moved it by this much, with the state there.
+    Moved(f64),
+    /// Kept the dense output's: the state there errs by up to this much
+    /// more than the step's error (the gap to the step re-taken to it; 0
+    /// where the method's dense output is its step, NaN where unmeasured).
+    Kept(f64),
 }
 
 /// Whether `method` can run every one of `modes` of `model`, by [`motion`]'s
@@ -317,8 +334,8 @@ impl Integrator {
     }
 
     /// The correction to a crossing at `tau` into the last step where the
-    /// method's dense output is less accurate than its steps (DOP853, see
-    /// [`Dop853::sharpen`]), or where the method knows the state at the
+    /// method's dense output is less accurate than its steps (the
+    /// Runge-Kutta pairs, see [`sharpen`]), or where the method knows the state at the
     /// crossing to well below an ulp (the linear propagator: an affine
     /// guard's zero to double-double, see [`Linear::sharpen`]); `None` for
     /// the others and where sharpening declines, leaving the crossing as
@@ -330,10 +347,39 @@ impl Integrator {
         y0: &[f64],
         crossing: &Crossing,
         x: &mut [f64],
-    ) -> Option<f64> {
+    ) -> Sharpened {
         match self {
-            Integrator::Dop853(m) => m.sharpen(model, mode, y0, crossing, x),
-            Integrator::Linear(m) => m.sharpen(crossing, x),
+            Integrator::Dopri5(m) => sharpen(m, model, mode, y0, crossing, x),
+            Integrator::Dop853(m) => sharpen(m, model, mode, y0, crossing, x),
+            Integrator::Linear(m) => m
+                .sharpen(crossing, x)
+                .map_or(Sharpened::Kept(0.0), Sharpened::Moved),
+            _ => Sharpened::Kept(0.0),
+        }
+    }
+
+    /// How far the dense output `tau` into the last step (from `y0`, its
+    /// start) may be from the solution, where it is not the step itself:
+    /// for the Runge-Kutta pairs, measured by re-taking the step to `tau`
+    /// on `spare` (a copy of this integrator, whose working state it
+    /// spends; see [`dense_error`]); `None` for the methods whose dense
+    /// output is their step (a Taylor series, the propagator) or has no
+    /// such check (Stormer-Verlet).
+    pub fn dense_error<M: HybridModel + ?Sized>(
+        &self,
+        spare: &mut Integrator,
+        model: &M,
+        mode: Mode,
+        at: (&[f64], f64),
+        x: &mut [f64],
+    ) -> Option<f64> {
+        match (self, spare) {
+            (Integrator::Dopri5(m), Integrator::Dopri5(s)) => {
+                Some(dense_error(m, s, model, mode, at, x))
+            }
+            (Integrator::Dop853(m), Integrator::Dop853(s)) => {
+                Some(dense_error(m, s, model, mode, at, x))
+            }
             _ => None,
         }
     }

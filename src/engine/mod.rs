@@ -30,6 +30,7 @@ pub mod queue;
 pub mod run;
 mod run_loop;
 pub mod saltation;
+mod sharpen;
 pub mod simulation;
 pub mod tangent;
 pub mod taylor_method;

@@ -17,7 +17,7 @@
 
 use crate::engine::adaptive::StepFailure;
 use crate::engine::bound::Bound;
-use crate::engine::integrator::{Crossing, Integrator, Motion, motion};
+use crate::engine::integrator::{Crossing, Integrator, Motion, Sharpened, motion};
 use crate::engine::labels::Labels;
 use crate::engine::ledger::{Final, Ledger};
 use crate::engine::locate::{Start, scan_step};
@@ -46,7 +46,11 @@ pub struct Sample<'a> {
     pub events: u64,
     /// The bound on every state component's error there: the bound the
     /// run carried to the start of the step the sample falls in, plus
-    /// that step's own local error.
+    /// that step's own local error, or its dense output's error there
+    /// where larger (a Runge-Kutta interpolant's, measured by re-taking
+    /// the step to the sample); and, within an event's time error of it,
+    /// that event's jump (the true state may be on the reset's other
+    /// side).
     pub bound: f64,
 }
 
@@ -99,11 +103,21 @@ pub fn simulate_sampled<M: HybridModel + ?Sized, O: Observer + ?Sized>(
         ledger = ledger.rebase_at_resets();
     }
     let mut run = Run::new(model, mode, &x0, options, on_sample);
+    run.sampled = !samples.is_empty();
     let end = match refused {
         Some(reason) => End::failed(reason),
         None => drive(&mut run, &mut ledger, samples, observer),
     };
     run.outcome(end, ledger)
+}
+
+/// An event, for the samples beside it: when it fired, how uncertain that
+/// time is, and how far its reset moved the state.
+#[derive(Debug, Clone, Copy)]
+struct Beside {
+    t: Time,
+    time_error: f64,
+    jump: f64,
 }
 
 struct Run<'m, 's, M: HybridModel + ?Sized> {
@@ -130,6 +144,16 @@ struct Run<'m, 's, M: HybridModel + ?Sized> {
     /// starts, more after a marker that let the step go on (see
     /// [`Run::go_on`]).
     step_offset: f64,
+    /// What the dense output errs by at an event it placed (sharpening
+    /// declined), for the segment that closes there.
+    dense_gap: f64,
+    /// A copy of the integrator to re-take steps on (see
+    /// [`Run::flow_bound`]), made when first needed.
+    spare: Option<Box<Integrator>>,
+    /// Whether the run reports samples: then the last logged event is
+    /// kept for the samples beside it.
+    sampled: bool,
+    last_event: Option<Beside>,
     /// Whether the integrator's last step starts at the current origin.
     stepped: bool,
     /// How each guard of the current mode starts the first step from the
@@ -248,6 +272,16 @@ impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
         } else if guard.internal {
             Ok(())
         } else {
+            if self.sampled {
+                let time_error = self.bound.last_time_bound();
+                let after = std::mem::take(&mut self.after);
+                self.last_event = Some(Beside {
+                    t,
+                    time_error,
+                    jump: self.other_side((mode, &before), (jump.mode, &after), time_error),
+                });
+                self.after = after;
+            }
             self.bound.watch(t, &self.after, self.logged + 1);
             match &jump.event {
                 Some(name) => ledger.count_named(name),
@@ -465,21 +499,17 @@ impl<M: HybridModel + ?Sized> Segments for Run<'_, '_, M> {
         let mut x = std::mem::take(&mut self.before);
         self.state_at(Time::new(s).since(self.origin).max(0.0), &mut x);
         self.set_clock(Time::new(s), &mut x);
-        let step = if self.motion == Motion::Stepped {
-            self.integrator.local_error()
-        } else {
-            0.0
-        };
+        let bound = self.sample_bound(
+            Time::new(s).since(self.origin).max(0.0),
+            &x,
+            ledger.events(),
+        );
         (self.on_sample)(&Sample {
             t: s,
             mode: self.mode,
             state: &x,
             events: ledger.events(),
-            // Not known where no bound is carried.
-            bound: self
-                .bound
-                .state_bound(ledger.events())
-                .map_or(f64::NAN, |b| b + step),
+            bound,
         });
         self.before = x;
     }
@@ -566,6 +596,10 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
             stepped: false,
             step_end: None,
             step_offset: 0.0,
+            dense_gap: 0.0,
+            spare: None,
+            sampled: false,
+            last_event: None,
             starts: Vec::new(),
             fresh: false,
             simultaneous: Vec::new(),
@@ -639,6 +673,7 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
         let crossing = Crossing {
             tau: self.step_offset + tau,
             reach,
+            room: next - tau,
             guard: &guard,
             crossed: &crossed,
             slot,
@@ -647,11 +682,16 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
             .integrator
             .sharpen(model, mode, &self.state, &crossing, &mut sharp);
         let t = match correction {
-            Some(s) => {
+            Sharpened::Moved(s) => {
                 x.copy_from_slice(&sharp);
                 t.after(s)
             }
-            None => t,
+            // A re-step that blew up where the accepted step did not says
+            // nothing of the dense output.
+            Sharpened::Kept(off) => {
+                self.dense_gap = if off.is_finite() { off } else { 0.0 };
+                t
+            }
         };
         self.after = sharp;
         t
@@ -1149,7 +1189,8 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
                 // The part of the step passed leaves its share of the local
                 // error (none for an event at the step's start).
                 let h = self.integrator.h();
-                let local = self.local_error() * (tau / h).min(1.0);
+                let local =
+                    self.local_error() * (tau / h).min(1.0) + std::mem::take(&mut self.dense_gap);
                 let (step, offset) = (&self.integrator, self.step_offset);
                 let rates = step.rates(offset, tau);
                 self.bound.after_step(
@@ -1212,6 +1253,105 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
         }
         (self.before, self.rates.0, self.probe) = (x, rate, probe);
         first
+    }
+
+    /// The bound on the state `tau` past the origin (`x`), after
+    /// `events` events, NaN where none is carried.
+    fn sample_bound(&mut self, tau: f64, x: &[f64], events: u64) -> f64 {
+        self.flow_bound(tau, events) + self.beside_events(self.origin.after(tau), x)
+    }
+
+    /// Where a sample at `t` (state `x`) lies within an event's time error
+    /// of it, the true state may be on the reset's other side: the reset's
+    /// jump. For the last event, where the true one may be later; for the
+    /// next, where it may be earlier (its jump from `x`, its time error
+    /// from the errors so far along its guard).
+    fn beside_events(&mut self, t: Time, x: &[f64]) -> f64 {
+        let last = self
+            .last_event
+            .filter(|last| t.since(last.t) <= last.time_error)
+            .map_or(0.0, |last| last.jump);
+        let Some((slot, next)) = self.queue.peek() else {
+            return last;
+        };
+        let (model, mode) = (self.model, self.mode);
+        let local = if self.motion == Motion::Stepped {
+            self.local_error()
+        } else {
+            0.0
+        };
+        let time_error = self.bound.crossing_uncertainty(model, mode, slot, x, local);
+        if next.since(t) > time_error {
+            return last;
+        }
+        let mut after = std::mem::take(&mut self.probe);
+        after.copy_from_slice(x);
+        let to = model.reset(mode, slot, &mut after).mode;
+        let jump = self.other_side((mode, x), (to, &after), time_error);
+        self.probe = after;
+        last + jump
+    }
+
+    /// How far the state on one side of a reset, from `before` in one mode
+    /// to `after` in another, may be from the other side's within
+    /// `time_error` of it: the jump, and how far either flow moves in that
+    /// time (the jump itself moves with the state it is taken at; largest
+    /// bounded component, the clock's aside).
+    fn other_side(
+        &mut self,
+        before: (Mode, &[f64]),
+        after: (Mode, &[f64]),
+        time_error: f64,
+    ) -> f64 {
+        let model = self.model;
+        let bounded = model.bounded_dimension().min(before.1.len());
+        let clock = self.clock.map(|(c, _)| c);
+        let mut rates = std::mem::take(&mut self.rates);
+        let parting = if model.has_rhs(before.0) && model.has_rhs(after.0) {
+            model.rhs(before.0, before.1, &mut rates.0);
+            model.rhs(after.0, after.1, &mut rates.1);
+            time_error
+        } else {
+            rates.0.fill(0.0);
+            rates.1.fill(0.0);
+            0.0
+        };
+        let side = (0..bounded)
+            .filter(|&i| Some(i) != clock)
+            .map(|i| {
+                (after.1[i] - before.1[i]).abs() + parting * (rates.1[i].abs() + rates.0[i].abs())
+            })
+            .fold(0.0, f64::max);
+        self.rates = rates;
+        side
+    }
+
+    /// [`Run::sample_bound`] without the events beside it: the errors
+    /// carried to the origin, and a stepped flow's local error, or its
+    /// dense output's where that is larger (see
+    /// [`Integrator::dense_error`]). Both are errors over the whole step:
+    /// the carried errors' growth over part of it is within them.
+    fn flow_bound(&mut self, tau: f64, events: u64) -> f64 {
+        let Some(carried) = self.bound.state_bound(events) else {
+            return f64::NAN;
+        };
+        if self.motion != Motion::Stepped {
+            return carried;
+        }
+        let mut local = self.local_error();
+        if self.stepped && tau > 0.0 {
+            let (model, mode) = (self.model, self.mode);
+            let spare = self
+                .spare
+                .get_or_insert_with(|| Box::new(self.integrator.clone()));
+            let mut x = std::mem::take(&mut self.after);
+            let at = (self.state.as_slice(), self.step_offset + tau);
+            if let Some(dense) = self.integrator.dense_error(spare, model, mode, at, &mut x) {
+                local = local.max(dense + self.forcing_error);
+            }
+            self.after = x;
+        }
+        carried + local
     }
 
     /// The last step's local error: the method's estimate, and never less

@@ -141,6 +141,7 @@ impl Taylor {
             }
         };
         let mut rho = radius(flow_norms[0], p - 1).min(radius(flow_norms[1], p));
+        let flow_rho = rho;
         let mut limited_by = None;
         // A guard's series must converge over the step too: a flow whose
         // series ends (a polynomial, a clock) says nothing of a guard that
@@ -179,8 +180,12 @@ impl Taylor {
                     None => StepFailure::Collapsed { h },
                 });
             }
-            // The last term kept, the size of the first left out.
-            self.local_error = last * h.powi(p as i32);
+            // The last term kept, the size of the first left out; or that
+            // term as the radius puts it, where the last term kept is small
+            // by parity (an even function's odd terms vanish at its centre:
+            // x' = sin t from 0 keeps a zero last term at odd orders).
+            self.local_error =
+                (last * h.powi(p as i32)).max(scale * (h / flow_rho).powi(p as i32 + 1));
             if self.solves_the_flow(model, mode, h, allowed) {
                 break;
             }

@@ -135,7 +135,7 @@ fn relay_feedback_sticks_at_the_amplitude_its_half_swings_give() {
 /// `x0 - s (t - t0) + A (cos t0 - cos t)`, its next zero found on a fine
 /// grid and bisected; on `x = 0` it slides while `|A sin t| < 1`, and
 /// leaves where `A sin t` reaches 1 (upwards) or -1 (downwards).
-fn forced_relay(a: f64, x0: f64, t_end: f64) -> (Vec<(f64, &'static str, &'static str)>, f64) {
+pub fn forced_relay(a: f64, x0: f64, t_end: f64) -> (Vec<(f64, &'static str, &'static str)>, f64) {
     let (mut t0, mut x, mut s) = (0.0f64, x0, x0.signum());
     let mut want = Vec::new();
     let zero_after = |t0: f64, x0: f64, s: f64| -> Option<f64> {

@@ -20,6 +20,7 @@ mod convergence;
 mod engine_generic;
 mod error_bound;
 mod event_location;
+mod every_tolerance;
 mod fast_forward;
 mod filippov;
 mod forced_linear;
