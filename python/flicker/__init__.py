@@ -49,11 +49,45 @@ __all__ = [
 Scene = Union[str, "os.PathLike[str]", Dict[str, Any]]
 
 
+def _not_finite(value: Any, path: str) -> Optional[str]:
+    """The path of the first number in `value` that JSON cannot hold (NaN,
+    an infinity), or None."""
+    if isinstance(value, dict):
+        for key, item in value.items():
+            found = _not_finite(item, f"{path}.{key}" if path else str(key))
+            if found:
+                return found
+    elif isinstance(value, (list, tuple)):
+        for k, item in enumerate(value):
+            found = _not_finite(item, f"{path}[{k}]")
+            if found:
+                return found
+    elif isinstance(value, (float, np.floating)) and not np.isfinite(value):
+        return f"{path} is {value}"
+    return None
+
+
+def _plain(value: Any) -> Any:
+    """A NumPy number or array in a scene dict, as JSON writes it."""
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    raise TypeError(f"a scene holds {type(value).__name__}, which JSON cannot write")
+
+
 def _source(scene: Scene):
     """(text, path) for the native module: a dict or a JSON string is text,
     anything else a path."""
     if isinstance(scene, dict):
-        return json.dumps(scene), None
+        bad = _not_finite(scene, "")
+        if bad:
+            field, _, value = bad.partition(" is ")
+            reason = f"is {value}, which JSON cannot hold: give a finite number"
+            error = SceneError(f"flicker: field {field}: {reason}")
+            error.field, error.reason = field, reason
+            raise error
+        return json.dumps(scene, default=_plain), None
     if isinstance(scene, os.PathLike):
         return None, os.fspath(scene)
     if isinstance(scene, str):
@@ -204,9 +238,10 @@ def run(
             automata): the summary's `sensitivities`, and
             `d{state}/d{direction}`, `dt/d{direction}` among the events'
             states.
-        t_eval: times (from 0 to t_end, any order) at which to keep the
-            state, with its error bound: `Run.samples` (automata and the
-            mechanism).
+        t_eval: times (from 0 to t_end) at which to keep the state, with
+            its error bound: `Run.samples` (automata and the mechanism), a
+            row per time in the order given, repeats included (a run that
+            stops early has no rows for the times it did not reach).
         past_horizon: go on past the run's horizon (where its error
             reaches 1e-3 of its state, or its bound can no longer decide
             what happens) as a pseudo-orbit, instead of stopping where it
@@ -219,6 +254,7 @@ def run(
             `reason` say where and why.
     """
     text, path = _source(scene)
+    asked = None if t_eval is None else np.asarray(t_eval, dtype=np.float64).ravel()
     raw = _flicker.run(
         text,
         path,
@@ -230,12 +266,25 @@ def run(
         log=None if log is None else os.fspath(log),
         events=events,
         sensitivities=None if sensitivities is None else list(sensitivities),
-        t_eval=None
-        if t_eval is None
-        else [float(t) for t in np.asarray(t_eval, dtype=np.float64).ravel()],
+        t_eval=None if asked is None else [float(t) for t in asked],
         past_horizon=bool(past_horizon),
     )
-    return Run(raw)
+    run = Run(raw)
+    if asked is not None and run.samples is not None:
+        run.samples = _as_asked(run.samples, asked)
+    return run
+
+
+def _as_asked(samples: Dict[str, np.ndarray], asked: np.ndarray) -> Dict[str, np.ndarray]:
+    """The samples (taken in increasing time, each time once) in the order
+    `t_eval` asked for them, a row per time asked; the times a run that
+    stopped early did not reach are left out."""
+    taken = samples["t"]
+    at = np.searchsorted(taken, asked)
+    reached = at < len(taken)
+    reached[reached] = taken[at[reached]] == asked[reached]
+    rows = at[reached]
+    return {name: values[rows] for name, values in samples.items()}
 
 
 def check(scene: Scene) -> List[str]:

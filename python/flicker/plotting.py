@@ -55,28 +55,38 @@ def _pieces(run) -> List[Tuple[np.ndarray, dict, bool]]:
 
 def plot(run, x: Optional[str] = None, y: Optional[str] = None, ax: Any = None):
     """Draw `run`: every state over time, or `y` against `x` (a phase
-    plane). Returns the matplotlib Axes (a new figure's unless `ax`)."""
+    plane). Returns the matplotlib Axes (a new figure's unless `ax`). A run
+    without samples is drawn at its events alone (the states before each
+    reset filled, after it hollow)."""
     import matplotlib.pyplot as plt
 
-    if run.samples is None:
-        raise ValueError("this run took no samples: run it with t_eval=... to draw it")
     if (x is None) != (y is None):
         raise ValueError("give both x and y for a phase plane, or neither for states over time")
-    names = [k for k in run.samples if k not in ("t", "bound")]
+    if run.samples is None:
+        if run.events is None or len(run.events["t"]) == 0:
+            raise ValueError(
+                "this run took no samples and has no events to draw: run it with t_eval=..."
+            )
+        names = list(run.state_names)
+    else:
+        names = [k for k in run.samples if k not in ("t", "bound")]
     for axis, name in (("x", x), ("y", y)):
         if name is not None and name not in names:
             raise ValueError(f"{axis}: the run has no state {name!r} (its states: {', '.join(names)})")
     if ax is None:
         _, ax = plt.subplots()
-    pieces = _pieces(run)
     colours = {n: f"C{k}" for k, n in enumerate(names)}
+    if run.samples is None:
+        return _at_events(run, names, colours, x, y, ax)
+    pieces = _pieces(run)
+    legend = []
     if x is None:
         for k, (ts, values, sliding) in enumerate(pieces):
             for n in names:
                 ax.plot(ts, values[n], color=SLIDING if sliding else colours[n],
                         label=n if k == 0 else None)
         ax.set_xlabel("t")
-        ax.legend()
+        legend += [_key(n, color=colours[n]) for n in names]
     else:
         for ts, values, sliding in pieces:
             # A slide that holds the state (a block stuck on a fixed
@@ -84,17 +94,62 @@ def plot(run, x: Optional[str] = None, y: Optional[str] = None, ax: Any = None):
             still = sliding and np.ptp(values[x]) == 0 and np.ptp(values[y]) == 0
             ax.plot(values[x], values[y], "o" if still else "-",
                     color=SLIDING if sliding else colours[y])
+        jumped = False
         for (_, a, _), (_, b, _) in zip(pieces, pieces[1:]):
             before, after = (a[x][-1], a[y][-1]), (b[x][0], b[y][0])
             if before != after:
+                jumped = True
                 ax.plot([before[0], after[0]], [before[1], after[1]], "--", color="grey")
         ax.set_xlabel(x)
         ax.set_ylabel(y)
+        legend.append(_key("the flow", color=colours[y]))
+        if jumped:
+            legend.append(_key("a reset's jump", color="grey", linestyle="--"))
+    if any(sliding for _, _, sliding in pieces):
+        legend.append(_key("sliding on a switching surface", color=SLIDING))
     ev = run.events
     if ev is not None and len(ev["t"]) and x is None:
         # Each event a tick on the time axis.
         ax.plot(ev["t"], np.zeros_like(ev["t"]), "|", color="black", markersize=8,
                 transform=ax.get_xaxis_transform())
+        legend.append(_key("events", color="black", marker="|", linestyle="none"))
+    ax.legend(handles=legend)
+    return ax
+
+
+def _key(label: str, **style):
+    """A legend entry drawn nowhere else."""
+    from matplotlib.lines import Line2D
+
+    return Line2D([], [], label=label, **style)
+
+
+def _at_events(run, names, colours, x, y, ax):
+    """`plot` for a run without samples: each event's state before its reset
+    (filled) and after it (hollow)."""
+    ev = run.events
+    column = {n: run.state_names.index(n) for n in names}
+    before, after = ev["before"], ev["after"]
+    if x is None:
+        for n in names:
+            k = column[n]
+            ax.plot(ev["t"], before[:, k], "o", color=colours[n])
+            ax.plot(ev["t"], after[:, k], "o", mfc="none", color=colours[n])
+        ax.set_xlabel("t")
+        legend = [_key(n, color=colours[n], marker="o", linestyle="none") for n in names]
+    else:
+        i, j = column[x], column[y]
+        ax.plot(before[:, i], before[:, j], "o", color=colours[y])
+        ax.plot(after[:, i], after[:, j], "o", mfc="none", color=colours[y])
+        ax.set_xlabel(x)
+        ax.set_ylabel(y)
+        legend = []
+    legend += [
+        _key("before each reset", color="grey", marker="o", linestyle="none"),
+        _key("after it", color="grey", marker="o", mfc="none", linestyle="none"),
+    ]
+    ax.legend(handles=legend)
+    ax.set_title("at the events only (run with t_eval=... for the trajectory)")
     return ax
 
 

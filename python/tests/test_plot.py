@@ -58,8 +58,10 @@ def test_sliding_is_red_and_bad_requests_say_why():
     for line in red:
         _, v = line.get_data()
         assert np.all(np.abs(v - 0.2) <= 1e-12)
+    # Its legend says what red is.
+    assert "sliding on a switching surface" in [t.get_text() for t in ax.get_legend().get_texts()]
     with pytest.raises(ValueError, match="t_eval"):
-        flicker.run(scene).plot()
+        flicker.run(scene, events=False).plot()
     with pytest.raises(ValueError, match="no state 'w'"):
         run.plot("x", "w")
     with pytest.raises(ValueError, match="both"):
@@ -102,3 +104,24 @@ def test_a_work_precision_chart_has_a_line_per_method_through_its_runs():
         assert sorted(x) == sorted(rows["wall_seconds"][mine])
         assert sorted(y) == sorted(rows["final_error"][mine])
     assert ax.get_xscale() == ax.get_yscale() == "log"
+
+
+def test_a_run_without_samples_is_drawn_at_its_events():
+    run = flicker.run(MODELS / "automata/bouncing_ball.json", t_end=2.0)
+    ax = run.plot()
+    assert "t_eval" in ax.get_title()
+    points = ax.get_lines()
+    # Before and after each bounce, for each state.
+    assert len(points) == 2 * len(run.state_names)
+    t, y = points[0].get_data()
+    assert np.array_equal(t, run.events["t"])
+    assert np.array_equal(y, run.events["before"][:, run.state_names.index(run.state_names[0])])
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert "before each reset" in labels and "after it" in labels
+
+
+def test_the_legend_says_what_the_ticks_are():
+    run = flicker.run(MODELS / "automata/bouncing_ball.json", t_end=2.0,
+                      t_eval=np.linspace(0.0, 2.0, 101))
+    labels = [t.get_text() for t in run.plot().get_legend().get_texts()]
+    assert "events" in labels and "y" in labels

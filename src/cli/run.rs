@@ -4,6 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
 
+use crate::cli::log_size::{FIRST_NOTICE, LogSize};
 use crate::engine::Status;
 use crate::engine::method::NAMES;
 use crate::log::JsonlWriter;
@@ -205,7 +206,9 @@ pub fn run(args: RunArgs, registry: &Registry) -> Result<Code, Failure> {
     let report = if log_events {
         // Created with the first event or at the end: a run the scene
         // refuses as it starts leaves no log, and an earlier one untouched.
-        let file = LazyFile::new(&log_path);
+        let file = LogSize::new(LazyFile::new(&log_path), FIRST_NOTICE, |s| {
+            eprintln!("flicker: {s}")
+        });
         let mut observer = WithProgress::new(JsonlWriter::new(file), scene.t_end(), quiet);
         let ran = request.run(&scene, &control, &mut observer);
         observer.finish();

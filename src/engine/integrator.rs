@@ -60,9 +60,15 @@ pub fn motion<M: HybridModel + ?Sized>(
             "mode `{name}` gives no Taylor series of its flow and guards (expressions compiled from a file do, \
              unless they use abs, min or max)"
         )),
-        (_, Method::Verlet { .. }) if !model.second_order(mode) => Err(format!(
-            "mode `{name}` is not of the form q'' = a(q) (its acceleration depends on the velocity), which Stormer-Verlet needs"
-        )),
+        (_, Method::Verlet { .. }) if !model.second_order(mode) => Err(match model.clock() {
+            Some(_) => format!(
+                "mode `{name}` reads the time t (a forced flow), and Stormer-Verlet integrates only an autonomous q'' = a(q)"
+            ),
+            None => format!(
+                "mode `{name}` is not of the form q'' = a(q), which Stormer-Verlet needs: positions q then \
+                 velocities v, with q' = v and v' independent of v"
+            ),
+        }),
         _ => Ok(Motion::Stepped),
     }
 }

@@ -1054,7 +1054,7 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
             Motion::Stepped => {
                 let t_end = self.options.t_end;
                 let remaining = self.origin.until(t_end);
-                let h_min = 64.0 * f64::EPSILON * self.origin.value().abs().max(t_end);
+                let h_min = self.min_step();
                 // What is left of the run is below what a step can resolve
                 // (the guards keep how they start, for `due_at_end`).
                 self.stepped = remaining > h_min;
@@ -1136,10 +1136,10 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
                 }
                 // A graze the errors cannot decide stops the run, unless an
                 // event comes first: the step is taken again after it.
-                if let Some((g, margin, uncertainty, _)) =
+                if let Some((g, margin, uncertainty, at)) =
                     graze.filter(|&(_, _, _, at)| at <= earliest)
                 {
-                    let why = self.undecidable(g, margin, uncertainty);
+                    let why = self.undecidable(g, self.origin.after(at * h), margin, uncertainty);
                     if let Err(why) = self.bound.undecided(self.origin, why) {
                         self.undecided_graze = Some(g);
                         return Err(End::failed(why));
@@ -1441,15 +1441,16 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
         )
     }
 
-    /// A graze or near miss closer than the integration error can resolve,
-    /// in words.
-    fn undecidable(&self, g: usize, margin: f64, uncertainty: f64) -> String {
+    /// A graze or near miss at `t` closer than the integration error can
+    /// resolve, in words (the run stops where the step that finds it
+    /// starts).
+    fn undecidable(&self, g: usize, t: Time, margin: f64, uncertainty: f64) -> String {
         format!(
-            "guard `{}` grazes zero near t = {:e}: its dip or near miss is {margin:.2e} deep, within the \
+            "guard `{}` grazes zero at t = {:e}: its dip or near miss is {margin:.2e} deep, within the \
              integration error so far ({uncertainty:.2e}), so {} cannot tell whether it fires; \
              tighten the method or use an exact one",
             self.model.guards(self.mode)[g].name,
-            self.origin.value(),
+            t.value(),
             self.integrator.name()
         )
     }
@@ -1533,12 +1534,19 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
     fn step_failed(&self, failure: StepFailure) -> End {
         let t = self.origin.value();
         let what = match failure {
-            StepFailure::Collapsed { h } => format!(
-                "the step size of {} collapsed to {h:.3e} at t = {t} in mode `{}` (state {:?})",
-                self.integrator.name(),
-                self.model.mode_name(self.mode),
-                self.state
-            ),
+            StepFailure::Collapsed { h } => {
+                let what = format!(
+                    "the step size of {} collapsed to {h:.3e} at t = {t} in mode `{}` (state {:?})",
+                    self.integrator.name(),
+                    self.model.mode_name(self.mode),
+                    self.state
+                );
+                // Neither cause below is the flow's: no diagnosis of it.
+                if let Some(why) = self.collapse_not_the_flows(h) {
+                    return End::failed(format!("{what}: {why}"));
+                }
+                what
+            }
             StepFailure::GuardCollapsed { h, guard } => {
                 let why = self
                     .model
@@ -1571,6 +1579,50 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
             Some(why) => End::failed(format!("{what}: {why}")),
             None => End::failed(what),
         }
+    }
+
+    /// The shortest step the run takes: 64 ulps of the latest time it
+    /// reaches, below which a step's end cannot be told from its start.
+    fn min_step(&self) -> f64 {
+        64.0 * f64::EPSILON * self.origin.value().abs().max(self.options.t_end)
+    }
+
+    /// Where a step collapsed to `h` for a reason of the run's settings
+    /// rather than its flow, that reason: tolerances below the rounding of
+    /// a step, or a `t_end` so far that times are resolved more coarsely
+    /// than the flow needs.
+    fn collapse_not_the_flows(&self, h: f64) -> Option<String> {
+        // Taylor's method runs to machine precision (its default); a
+        // Runge-Kutta pair's estimate drowns in rounding well above it.
+        let (tolerances, floor) = match self.options.method {
+            Method::Taylor(tol) => (Some(tol), f64::EPSILON),
+            Method::Dopri5(tol) | Method::Dop853(tol) => (Some(tol), 100.0 * f64::EPSILON),
+            _ => (None, 0.0),
+        };
+        let size = self.state.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+        if let Some(tol) = tolerances
+            && tol.rtol < floor
+            && tol.atol < floor * size.max(1.0)
+        {
+            return Some(format!(
+                "rtol = {:e} and atol = {:e} ask for less error than a step's rounding leaves (about \
+                 {:.1e} of the state): loosen them to 1e-14 or more",
+                tol.rtol,
+                tol.atol,
+                f64::EPSILON,
+            ));
+        }
+        // A step far longer than the time's own rounding here (a collapse
+        // into a singularity shrinks to that) was cut by t_end's.
+        let h_min = self.min_step();
+        let resolved = 64.0 * f64::EPSILON * self.origin.value().abs().max(1.0);
+        (h >= 1e6 * resolved && h_min > h).then(|| {
+            format!(
+                "t_end = {:e} resolves times only to {h_min:.3e} (a step is at least 64 ulps of it), \
+                 coarser than the {h:.3e} this flow needs: shorten t_end, or rescale time",
+                self.options.t_end
+            )
+        })
     }
 
     /// The state `tau` after `origin`, by the current segment's flow.

@@ -173,6 +173,12 @@ fn the_table_branch_turns_back_at_its_fold_onto_the_unstable_orbit() {
         .unwrap();
     let after = &rows[at + 1..];
     assert!(!after.is_empty());
+    // The clock is the forcing's phase, in [0, T) as in brute_force.csv,
+    // on both branches (Newton leaves the unstable one's below zero).
+    for row in &rows[1..] {
+        let t: f64 = row[4].parse().unwrap();
+        assert!((0.0..2.0 * PI / W).contains(&t), "{row:?}");
+    }
     for row in after {
         let x = |k: usize| row[k].parse::<f64>().unwrap();
         let phase = (W * x(4)).rem_euclid(2.0 * PI);

@@ -33,6 +33,7 @@ mod large_automata;
 mod lyapunov;
 mod mechanism_angle;
 mod mechanism_strain;
+mod messages;
 mod observers;
 mod orbits;
 mod oscillator;

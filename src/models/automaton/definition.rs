@@ -6,7 +6,7 @@
 use serde_json::{Map, Value};
 
 use crate::engine::Direction;
-use crate::models::automaton::expr::symbolic::{constant, never_zero};
+use crate::models::automaton::expr::symbolic::{constant, never_zero, same};
 use crate::models::automaton::expr::{Ast, Scope, Tape, parse};
 use crate::scene::SceneError;
 use crate::scene::fields::{Fields, kind};
@@ -559,15 +559,55 @@ fn mode(
         None => None,
         Some(value) => Some(rest(value, &f.path("rest"), &names, modes, name)?),
     };
+    let transitions_path = f.path("transitions");
     f.finish()?;
     // A stable sort keeps file order among equal priorities.
     transitions.sort_by(|a, b| b.priority.total_cmp(&a.priority));
+    unreachable_copies(&transitions, modes, name, &transitions_path)?;
     Ok(ModeDef {
         name: name.to_string(),
         flow,
         transitions,
         rest,
     })
+}
+
+/// Refuse a transition that can never fire: one with the same guard as a
+/// transition that fires before it (by priority, then file order) at every
+/// crossing it would take, and leaves the mode or ends the run there.
+fn unreachable_copies(
+    transitions: &[Transition],
+    modes: &[&str],
+    mode: &str,
+    path: &str,
+) -> Result<(), SceneError> {
+    let here = modes.iter().position(|m| *m == mode);
+    for (k, later) in transitions.iter().enumerate() {
+        let covers = |first: &Transition| {
+            same(&first.guard.ast, &later.guard.ast)
+                && (first.direction == Direction::Either || first.direction == later.direction)
+                && (Some(first.to) != here || first.terminal)
+        };
+        if let Some(first) = transitions[..k].iter().find(|first| covers(first)) {
+            return Err(SceneError::field(
+                path,
+                format!(
+                    "transition `{}` can never fire: `{}` has the same guard, fires first at \
+                     every crossing `{}` would take (priority, then file order) and {}; give it \
+                     another guard or remove it",
+                    later.name,
+                    first.name,
+                    later.name,
+                    if first.terminal {
+                        "ends the run".to_string()
+                    } else {
+                        format!("leaves mode `{mode}`")
+                    }
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// A mode's `rest`: `to` (default the mode itself) and `reset`.

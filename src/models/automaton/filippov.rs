@@ -544,6 +544,9 @@ fn check_placement(definition: &Definition) -> Result<(), SceneError> {
             }
         }
     }
+    let variables: Vec<&str> = (definition.states.iter().map(String::as_str))
+        .chain(["t"])
+        .collect();
     let flows: Vec<&Source> = definition
         .modes
         .iter()
@@ -563,6 +566,20 @@ fn check_placement(definition: &Definition) -> Result<(), SceneError> {
                 *at,
                 "`sign` switches a flow between the regions of its surface; in a guard, a reset \
                  or an energy write what it means with transitions instead",
+            ));
+        }
+        // As a guard that never crosses zero is refused.
+        if let Some((h, at)) = signs
+            .iter()
+            .find(|(h, _)| constant(h, &variables).is_some())
+        {
+            return Err(source.error(
+                *at,
+                &format!(
+                    "`sign({})` changes with neither the state nor the time, so it switches \
+                     nothing: write its value instead (a parameter holding the sign)",
+                    text(h)
+                ),
             ));
         }
     }
