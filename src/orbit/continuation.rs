@@ -28,7 +28,9 @@
 //! ([`crate::orbit::grazing`]); the branch of impacting orbits
 //! ends there, labelled, saying on which side they exist. A corrector that
 //! meets a graze first (a section map that cannot tell whether an event
-//! fires) ends the branch too, labelling its last orbit.
+//! fires), or whose steps shrink to nothing, ends the branch too: at the
+//! graze the last three orbits' impact speeds put ahead, labelled where
+//! they locate it to 1e-9, else saying how far short it ends.
 //!
 //! [`Family::promoted`]: crate::engine::Family::promoted
 
@@ -335,7 +337,12 @@ pub fn follow(
         ..*whole
     };
     let mut watched = grazing::impact_speed(section, mode, &start.x).map(|q| (start.x[p], q));
-    let range = (plan.to - start.x[p]).abs().max(f64::MIN_POSITIVE);
+    // Every orbit's impact speed, and the orbit before `here`: where the
+    // corrector cannot come near a graze, the speeds still locate it.
+    let mut speeds: Vec<(f64, f64)> = watched.into_iter().collect();
+    let mut before_here = None;
+    let start_p = start.x[p];
+    let range = (plan.to - start_p).abs().max(f64::MIN_POSITIVE);
     let (mut ds, ds_max) = (plan.step.0 * range, plan.step.1 * range);
     let toward = (plan.to - start.x[p]).signum();
     let mut previous = DVector::zeros(k + 1);
@@ -388,7 +395,7 @@ pub fn follow(
                 let speed = grazing::impact_speed(section, mode, &next.x).map(|q| (next.x[p], q));
                 if let Some((at, orbit, state)) = watched
                     .zip(speed)
-                    .and_then(|(before, now)| graze_ahead(before, now, plan.to))
+                    .and_then(|(before, now)| graze_ahead(before, now, (start_p, plan.to)))
                     .and_then(|guess| {
                         locate_grazing(section, unknowns, p, mode, (&here, &next), guess)
                     })
@@ -405,24 +412,28 @@ pub fn follow(
                     );
                     break;
                 }
+                speeds.extend(speed);
                 watched = speed;
-                here = next;
+                before_here = Some(std::mem::replace(&mut here, next));
                 previous = t;
                 ds = (ds * 1.3).min(ds_max);
             }
-            Err(why) if why.contains("grazes") || why.contains("(a graze") => {
-                if let Some(last) = points.last_mut() {
-                    last.label = "grazing".into();
-                }
-                ended = format!("grazing: {why}");
-                break;
-            }
             Err(why) => {
+                let grazed = why.contains("grazes") || why.contains("(a graze");
                 ds *= 0.5;
-                if ds < 1e-9 * range {
-                    ended = format!("the step shrank to nothing: {why}");
-                    break;
+                if !grazed && ds >= 1e-9 * range {
+                    continue;
                 }
+                let why = if grazed {
+                    format!("the corrector met a graze: {why}")
+                } else {
+                    format!("the step shrank to nothing: {why}")
+                };
+                let last = (before_here.as_ref(), &here);
+                let range = (start_p, plan.to);
+                ended = end_near_graze(unknowns, p, &speeds, last, range, &why, &mut points)
+                    .unwrap_or(why);
+                break;
             }
         }
     }
@@ -434,17 +445,63 @@ pub fn follow(
     Branch { points, ended }
 }
 
+/// How close a graze located from the impact speeds alone must be (its
+/// two fits' distance, relative to the parameter's size) to be labelled.
+const GRAZE_ACCURACY: f64 = 1e-9;
+
+/// A branch whose corrector can go no further (`why`) where its orbits'
+/// impact speeds (`speeds`) fall towards zero: the graze they locate,
+/// labelled (its state on the secant through the last two orbits `last`)
+/// where located to [`GRAZE_ACCURACY`], else how far short of it the
+/// branch ends. `None` where the speeds put no graze ahead.
+fn end_near_graze(
+    unknowns: &Unknowns,
+    p: usize,
+    speeds: &[(f64, f64)],
+    (before, here): (Option<&Solved>, &Solved),
+    range: (f64, f64),
+    why: &str,
+    points: &mut Vec<Point>,
+) -> Option<String> {
+    let (at, accuracy) = grazing::extrapolated(speeds, range)?;
+    let &(last, speed) = speeds.last()?;
+    if accuracy > GRAZE_ACCURACY * at.abs().max(1.0) {
+        return Some(format!(
+            "the branch ends {:.2e} short of a graze its orbits' impact speeds put at {at} (to \
+             {accuracy:.1e}; the last orbit, at {last}, impacts at speed {:.2e}), too far to \
+             label: {why}",
+            (at - last).abs(),
+            speed.abs()
+        ));
+    }
+    let mut graze = point(unknowns, p, here, "grazing");
+    graze.parameter = at;
+    if let Some(before) = before {
+        let (a, b) = (&before.x, &here.x);
+        let f = (at - b[p]) / (b[p] - a[p]);
+        graze.state = a.iter().zip(b).map(|(a, b)| b + f * (b - a)).collect();
+        graze.state[p] = at;
+    }
+    points.push(graze);
+    let side = if at > last { "below" } else { "above" };
+    Some(format!(
+        "grazing at {at} (to {accuracy:.0e}, where the impact speeds of the last three orbits \
+         fall to zero; the corrector came within {:.2e} of it: {why}), and the impacting orbits \
+         exist {side} it; the branch of impacting orbits ends",
+        (at - last).abs()
+    ))
+}
+
 /// Where the impact speed, falling from `before` to `now` (parameter,
 /// speed), reaches zero, if it does within one and a half more such steps
-/// and before the branch's end `to`.
-fn graze_ahead(before: (f64, f64), now: (f64, f64), to: f64) -> Option<f64> {
+/// and within the branch's `range` (see [`grazing::extrapolated`]).
+fn graze_ahead(before: (f64, f64), now: (f64, f64), range: (f64, f64)) -> Option<f64> {
     let falling = now.1.signum() == before.1.signum() && now.1.abs() < before.1.abs();
     let zero = grazing::predicted(before, now)?;
     let step = now.0 - before.0;
     let ahead = (zero - now.0) / step;
-    // Within the branch's asked range: a graze past `--to` is not met.
-    let before_the_end = (to - zero) * step.signum() >= 0.0;
-    (falling && before_the_end && (0.0..=1.5).contains(&ahead)).then_some(zero)
+    // A graze past `--to` is not met.
+    (falling && grazing::within(zero, range) && (0.0..=1.5).contains(&ahead)).then_some(zero)
 }
 
 /// The grazing parameter near `guess`, approached from the impacting

@@ -67,9 +67,52 @@ pub fn quadratic_zero(points: &[(f64, f64); 3], guess: f64) -> Option<f64> {
     zero.is_finite().then_some(zero)
 }
 
+/// Where the impact speeds of a branch's last orbits (`speeds`, parameter
+/// and speed, in the branch's order) fall to zero, and how sure that is:
+/// the zero of the quadratic through the last three, and its distance
+/// from the line's through the last two (the quadratic's own error is
+/// smaller still). `None` unless the three fall towards zero on one side,
+/// the zero lies ahead of the last and within the branch's `range` (its
+/// start's parameter and where it is to go: past a fold a branch travels
+/// away from its end).
+pub fn extrapolated(speeds: &[(f64, f64)], range: (f64, f64)) -> Option<(f64, f64)> {
+    let &[a, b, c] = speeds.last_chunk::<3>()?;
+    let falling = a.1.signum() == b.1.signum()
+        && b.1.signum() == c.1.signum()
+        && c.1.abs() < b.1.abs()
+        && b.1.abs() < a.1.abs();
+    let line = predicted(b, c)?;
+    let zero = quadratic_zero(&[a, b, c], line)?;
+    let step = c.0 - b.0;
+    let ahead = (zero - c.0) * step.signum() >= 0.0;
+    (falling && ahead && within(zero, range)).then_some((zero, (zero - line).abs()))
+}
+
+/// Whether `p` lies between the two ends of `range`, in either order.
+pub fn within(p: f64, (a, b): (f64, f64)) -> bool {
+    a.min(b) <= p && p <= a.max(b)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn speeds_falling_to_zero_put_the_graze_ahead_and_say_how_surely() {
+        // q = (3 - p)(1 + p/10), approached from below.
+        let q = |p: f64| (3.0 - p) * (1.0 + p / 10.0);
+        let speeds: Vec<(f64, f64)> = [2.9, 2.95, 2.99].iter().map(|&p| (p, q(p))).collect();
+        let (zero, accuracy) = extrapolated(&speeds, (2.0, 4.0)).unwrap();
+        assert!((zero - 3.0).abs() < 1e-12, "{zero}");
+        assert!(accuracy > 0.0 && accuracy < 1e-3, "{accuracy}");
+        // Past a fold, going away from the end: still found in range.
+        assert!(extrapolated(&speeds, (4.0, 2.0)).is_some());
+        // Out of range, rising, or two points only: nothing.
+        assert_eq!(extrapolated(&speeds, (2.0, 2.995)), None);
+        let rising: Vec<(f64, f64)> = speeds.iter().rev().copied().collect();
+        assert_eq!(extrapolated(&rising, (0.0, 4.0)), None);
+        assert_eq!(extrapolated(&speeds[1..], (2.0, 4.0)), None);
+    }
 
     #[test]
     fn a_line_and_a_quadratic_meet_zero_where_they_should() {
