@@ -217,6 +217,68 @@ fn a_forced_relay_slides_and_leaves_where_its_forcing_reaches_the_relay() {
     }
 }
 
+/// Two blocks on springs, coupled by a spring `c`, each with dry friction
+/// `mu` on the ground: block 2 sticks at `x2 = 0.1` (its spring force
+/// `|-x2 + c (x1 - x2)| <= mu` while `|x1| <= 0.9`) while block 1 swings
+/// about `e = (c x2 -+ mu) / (1 + c)` at `w = sqrt(1 + c)`, reversing where
+/// its speed passes zero: a state on both surfaces, whose continuation is
+/// unique (every flow around carries `v1` through zero the same way), not
+/// the codimension-two slide it was once refused as. From rest on both.
+/// Likewise a state sliding on `x = 0` whose `y` passes through zero.
+#[test]
+fn a_block_that_reverses_while_another_sticks_goes_on() {
+    let through = json!({"model": "automaton", "states": ["x", "y"], "initial": {"x": 0.5, "y": 1.0},
+        "modes": {"m": {"flow": {"x": "-sign(x)", "y": "-1 + 0 * sign(y)"}}}, "t_end": 2.0});
+    let (summary, events) = run_value(&through, &[]);
+    assert_eq!(summary["status"], "completed", "{summary}");
+    events_match(
+        &events,
+        &[
+            (0.5, "slide:x", "m[x=0, y>0]"),
+            (1.0, "cross:y", "m[x=0, y<0]"),
+        ],
+        1e-12,
+        "through",
+    );
+    assert_eq!(summary["final_state"]["x"], 0.0);
+    assert!((f(&summary["final_state"]["y"]) + 1.0).abs() < 1e-12);
+    let (mu, c, x2) = (0.3_f64, 0.2_f64, 0.1_f64);
+    let scene = json!({"model": "automaton", "parameters": {"mu": mu, "c": c},
+        "states": ["x1", "v1", "x2", "v2"],
+        "initial": {"x1": 1.0, "v1": 0.0, "x2": x2, "v2": 0.0},
+        "modes": {"m": {"flow": {"x1": "v1", "v1": "-x1 + c * (x2 - x1) - mu * sign(v1)",
+                                 "x2": "v2", "v2": "-x2 + c * (x1 - x2) - mu * sign(v2)"}}},
+        "t_end": 5.5});
+    let w = (1.0 + c).sqrt();
+    let (back, forth) = ((c * x2 + mu) / (1.0 + c), (c * x2 - mu) / (1.0 + c));
+    let turn = std::f64::consts::PI / w;
+    // Back from 1 about `back` to 2 back - 1, then forth about `forth`.
+    let x_turn = 2.0 * back - 1.0;
+    let tau = 5.5 - turn;
+    let (x1, v1) = (
+        forth + (x_turn - forth) * (w * tau).cos(),
+        -(x_turn - forth) * w * (w * tau).sin(),
+    );
+    let want = [
+        (0.0, "cross:v1", "m[v1<0, v2=0]"),
+        (turn, "cross:v1", "m[v1>0, v2=0]"),
+    ];
+    for args in EXACT.iter().chain(&OTHERS) {
+        let (summary, events) = run_value(&scene, args);
+        let what = format!("{args:?}");
+        assert_eq!(summary["status"], "completed", "{what}: {summary}");
+        let (time, state) = allowance(args, &summary);
+        events_match(&events, &want, time, &what);
+        let fin = &summary["final_state"];
+        for (name, value) in [("x1", x1), ("v1", v1), ("x2", x2), ("v2", 0.0)] {
+            assert!(
+                (f(&fin[name]) - value).abs() <= state.max(1e-12),
+                "{what}: {name} {fin}"
+            );
+        }
+    }
+}
+
 #[test]
 fn what_has_no_unique_answer_stops_and_says_why() {
     // Both sides flow away from x = 0, where it starts.
@@ -231,9 +293,11 @@ fn what_has_no_unique_answer_stops_and_says_why() {
                                       "reset": {"x": "0"}, "to": "away"}]},
             "away": {"flow": {"x": "sign(x)"}}},
         "t_end": 2.0});
-    // Sliding on x = 0 when y reaches 0.
+    // Sliding on x = 0 when y reaches 0, which attracts from both sides
+    // too: sliding on both (codimension two). (Where y passes through
+    // zero, `y' = -1 + 0 sign(y)`, the run goes on: see below.)
     let corner = json!({"model": "automaton", "states": ["x", "y"], "initial": {"x": 0.5, "y": 1.0},
-        "modes": {"m": {"flow": {"x": "-sign(x)", "y": "-1 + 0 * sign(y)"}}}, "t_end": 2.0});
+        "modes": {"m": {"flow": {"x": "-sign(x)", "y": "-sign(y)"}}}, "t_end": 2.0});
     // A surface that is not finite where the run goes.
     let undefined = json!({"model": "automaton", "states": ["x"], "initial": {"x": 2.0},
         "modes": {"m": {"flow": {"x": "-1 - sign(sqrt(x - 1))"}}}, "t_end": 2.0});

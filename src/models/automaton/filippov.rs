@@ -20,10 +20,15 @@
 //!   never drifts off it. Sliding ends where one side's flow turns tangent
 //!   and then away (`L-` falling through zero, or `L+` rising through it):
 //!   `leave:v`, into that side.
+//! - **Two surfaces at once** (a second reached while sliding on one, or
+//!   a start on both): where the four regions' flows around all cross one
+//!   of them the same way (a block that reverses while another sticks),
+//!   the state passes through it and the other decides as above.
 //! - **What has no answer.** A surface both sides flow away from
-//!   (repelling: the solution is not unique) and a second surface reached
-//!   while sliding on one (codimension two) stop the run with the reason:
-//!   each is a mode of its own that says so ([`Expanded::stops`]).
+//!   (repelling: the solution is not unique) and two surfaces at once that
+//!   neither is passed through (sliding on both: codimension two) stop the
+//!   run with the reason: each is a mode of its own that says so
+//!   ([`Expanded::stops`]).
 //!
 //! A mode's own transitions apply in each of its regions and sliding
 //! modes; one that leads into a mode with surfaces enters the region the
@@ -80,6 +85,16 @@ pub enum Target {
     /// The transition's `to`, a region the state enters leaving a sliding
     /// on the surface of that region's guard `.0`, along the flow.
     Leave(usize),
+    /// Surface `surface` of family `family` reached while sliding on its
+    /// surface `sliding`: on both at once, where the flows around decide.
+    AcrossSliding {
+        /// The family.
+        family: usize,
+        /// The surface reached.
+        surface: usize,
+        /// The surface slid on.
+        sliding: usize,
+    },
 }
 
 /// A file's mode with switching surfaces, expanded.
@@ -405,7 +420,7 @@ pub fn expand(definition: &Definition) -> Result<Expanded, SceneError> {
                     });
                     sliding_targets.push(Target::Leave(crossing));
                 }
-                for (_, surface) in surface_sources.iter().enumerate().filter(|(o, _)| *o != j) {
+                for (o, surface) in surface_sources.iter().enumerate().filter(|(o, _)| *o != j) {
                     sliding_transitions.push(Transition {
                         name: event_name("cross", surface),
                         guard: surface.clone(),
@@ -416,7 +431,11 @@ pub fn expand(definition: &Definition) -> Result<Expanded, SceneError> {
                         terminal: false,
                         barrier: false,
                     });
-                    sliding_targets.push(Target::Fixed);
+                    sliding_targets.push(Target::AcrossSliding {
+                        family,
+                        surface: o,
+                        sliding: j,
+                    });
                 }
                 modes.push(ModeDef {
                     name: name_of(plus, Some(j)),
@@ -452,8 +471,9 @@ pub fn expand(definition: &Definition) -> Result<Expanded, SceneError> {
         });
         targets.push(Vec::new());
         stops.push(Some(format!(
-            "the state reaches a second switching surface of mode `{}` while it sits on one: \
-             sliding on two surfaces at once (codimension two) is not taken",
+            "the state reaches a second switching surface of mode `{}` while it sits on one, and \
+             the flows around carry it through neither: sliding on two surfaces at once \
+             (codimension two) is not taken",
             mode.name
         )));
         if let (Some(all), Some(e)) = (energy.as_mut(), energy_of) {

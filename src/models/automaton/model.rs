@@ -188,24 +188,41 @@ impl Surfaces {
     /// brought it there is called if it slid: the region of the surfaces'
     /// signs; on one surface, the side both flows carry it to, sliding
     /// where both point into it, the refusal where both point away; on two
-    /// at once, the refusal.
+    /// at once, see [`Surfaces::on_two`].
     fn pick(&self, x: &[f64], on: Option<usize>) -> (Mode, Option<&Name>) {
+        self.pick_on(x, [on, None])
+    }
+
+    /// [`Surfaces::pick`] with up to two surfaces taken as reached (a
+    /// crossing located while sliding on another).
+    fn pick_on(&self, x: &[f64], on: [Option<usize>; 2]) -> (Mode, Option<&Name>) {
         let mut bits = 0;
-        let mut zero = None;
+        let mut zeros = [None, None];
         for (j, h) in self.surfaces.iter().enumerate() {
-            let value = if on == Some(j) { 0.0 } else { h.eval1(x) };
+            let value = if on.contains(&Some(j)) {
+                0.0
+            } else {
+                h.eval1(x)
+            };
             if value < 0.0 {
                 bits |= 1 << j;
             } else if value == 0.0 {
-                if zero.is_some() {
-                    return (self.double, None);
+                match zeros {
+                    [None, _] => zeros[0] = Some(j),
+                    [Some(_), None] => zeros[1] = Some(j),
+                    _ => return (self.double, None),
                 }
-                zero = Some(j);
             }
         }
-        let Some(j) = zero else {
-            return (self.regions[bits], None);
-        };
+        match zeros {
+            [None, _] => (self.regions[bits], None),
+            [Some(j), None] => self.on_one(x, j, bits),
+            [Some(a), Some(b)] => self.on_two(x, (a, b), bits),
+        }
+    }
+
+    /// On surface `j` alone, the other surfaces' signs `bits`.
+    fn on_one(&self, x: &[f64], j: usize, bits: usize) -> (Mode, Option<&Name>) {
         let (plus, minus) = (bits & !(1 << j), bits | (1 << j));
         // Into the surface: h falling on the positive side, rising on the
         // negative (a tangent counts as in: the state stays on it).
@@ -217,6 +234,30 @@ impl Surfaces {
             (false, true) => (self.regions[plus], None),
             (false, false) => (self.repelling[j], None),
         }
+    }
+
+    /// On surfaces `a` and `b` at once: where the flows of all four regions
+    /// around cross one of them the same way (a block that reverses while
+    /// another sticks), the state passes through it to the side they carry
+    /// it to, and the other decides alone; otherwise (sliding on both, or
+    /// no one answer) the refusal.
+    fn on_two(&self, x: &[f64], (a, b): (usize, usize), bits: usize) -> (Mode, Option<&Name>) {
+        for (through, other) in [(a, b), (b, a)] {
+            let around = [0, 1 << a, 1 << b, (1 << a) | (1 << b)];
+            let rates = around.map(|signs| {
+                let region = (bits & !(1 << a) & !(1 << b)) | signs;
+                self.rates[region][through].eval1(x)
+            });
+            let side = if rates.iter().all(|&r| r > 0.0) {
+                bits & !(1 << through)
+            } else if rates.iter().all(|&r| r < 0.0) {
+                bits | (1 << through)
+            } else {
+                continue;
+            };
+            return self.on_one(x, other, side);
+        }
+        (self.double, None)
     }
 }
 
@@ -647,9 +688,20 @@ impl HybridModel for Automaton {
             Target::Fixed => (reset.to, None),
             Target::Leave(guard) => return Jump::to(reset.to).leaving(guard),
             Target::Enter(f) => self.families[f].pick(x, None),
-            Target::Across { family, surface } => {
+            Target::Across { family, surface }
+            | Target::AcrossSliding {
+                family, surface, ..
+            } => {
                 let surfaces = &self.families[family];
-                let picked = surfaces.pick(x, Some(surface));
+                let sliding = match reset.pick {
+                    Target::AcrossSliding { sliding, .. } => Some(sliding),
+                    _ => None,
+                };
+                let mut picked = surfaces.pick_on(x, [Some(surface), sliding]);
+                // Still sliding where it slid: the crossing is the event.
+                if sliding.is_some_and(|j| surfaces.sliding[j].contains(&picked.0)) {
+                    picked.1 = None;
+                }
                 // Onto the surface exactly, where it is one state (the
                 // crossing was located a rounding off it): the sliding flow
                 // then holds it there.
