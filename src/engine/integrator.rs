@@ -341,7 +341,7 @@ impl Integrator {
 
     /// The correction to a crossing at `tau` into the last step where the
     /// method's dense output is less accurate than its steps (the
-    /// Runge-Kutta pairs, see [`sharpen`]), or where the method knows the state at the
+    /// Runge-Kutta pairs, see `src/engine/sharpen.rs`), or where the method knows the state at the
     /// crossing to well below an ulp (the linear propagator: an affine
     /// guard's zero to double-double, see [`Linear::sharpen`]); `None` for
     /// the others and where sharpening declines, leaving the crossing as
@@ -368,7 +368,7 @@ impl Integrator {
     /// start) may be from the solution, where it is not the step itself:
     /// for the Runge-Kutta pairs, measured by re-taking the step to `tau`
     /// on `spare` (a copy of this integrator, whose working state it
-    /// spends; see [`dense_error`]); `None` for the methods whose dense
+    /// spends; see `src/engine/sharpen.rs`); `None` for the methods whose dense
     /// output is their step (a Taylor series, the propagator) or has no
     /// such check (Stormer-Verlet).
     pub fn dense_error<M: HybridModel + ?Sized>(
