@@ -47,40 +47,104 @@ fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
     }
 }
 
-/// Every `crate::NAME` a file's code (not its comments, not its tests)
-/// names.
-fn imports(text: &str) -> BTreeSet<String> {
-    let code = text.split("#[cfg(test)]").next().unwrap_or("");
-    let mut names = BTreeSet::new();
-    for line in code.lines() {
-        // What follows `//` is a comment (or, rarely, a string's URL: no
-        // import is lost, since none follows one on the same line).
-        let line = line.split("//").next().unwrap_or("");
-        for (at, _) in line.match_indices("crate::") {
-            let rest = &line[at + 7..];
-            // `crate::{a::X, b}` names each of `a` and `b`.
-            let heads: Vec<&str> = match rest.strip_prefix('{') {
-                Some(group) => group
-                    .split(['}', ';'])
-                    .next()
-                    .unwrap_or("")
-                    .split(',')
-                    .collect(),
-                None => vec![rest],
-            };
-            for head in heads {
-                let name: String = head
-                    .trim_start()
-                    .chars()
-                    .take_while(|c| c.is_alphanumeric() || *c == '_')
-                    .collect();
-                if !name.is_empty() {
-                    names.insert(name);
+/// A file's code: its comments and every item under `#[cfg(test)]` (a
+/// test module, or one method) taken out, the rest whole.
+fn code(text: &str) -> String {
+    // What follows `//` is a comment (or, rarely, a string's URL: no
+    // import is lost, since none follows one on the same line).
+    let mut code: String = text
+        .lines()
+        .map(|line| line.split("//").next().unwrap_or(""))
+        .collect::<Vec<_>>()
+        .join("\n");
+    while let Some(at) = code.find("#[cfg(test)]") {
+        let rest = &code[at..];
+        // The item ends at its `;` or at the brace that closes its first.
+        let end = match (rest.find(';'), rest.find('{')) {
+            (Some(semi), Some(open)) if semi < open => semi + 1,
+            (_, Some(open)) => close_of(rest, open).map_or(rest.len(), |close| close + 1),
+            (Some(semi), None) => semi + 1,
+            (None, None) => rest.len(),
+        };
+        code.replace_range(at..at + end, "");
+    }
+    code
+}
+
+/// Where the brace opened at `open` in `text` closes.
+fn close_of(text: &str, open: usize) -> Option<usize> {
+    let mut depth = 0;
+    for (i, c) in text[open..].char_indices() {
+        match c {
+            '{' => depth += 1,
+            '}' => {
+                depth -= 1;
+                if depth == 0 {
+                    return Some(open + i);
                 }
+            }
+            _ => {}
+        }
+    }
+    None
+}
+
+/// Every `crate::NAME` a file's code (not its comments, not its tests)
+/// names, `use` groups over several lines and nested included.
+fn imports(text: &str) -> BTreeSet<String> {
+    let code = code(text);
+    let mut names = BTreeSet::new();
+    for (at, _) in code.match_indices("crate::") {
+        let rest = &code[at + 7..];
+        // `crate::{a::X, b::{Y, Z}}` names each of `a` and `b`.
+        let heads: Vec<&str> = match rest.strip_prefix('{') {
+            Some(_) => {
+                let group = close_of(rest, 0).map_or(rest, |close| &rest[1..close]);
+                top_level(group)
+            }
+            None => vec![rest],
+        };
+        for head in heads {
+            let name: String = head
+                .trim_start()
+                .chars()
+                .take_while(|c| c.is_alphanumeric() || *c == '_')
+                .collect();
+            if !name.is_empty() {
+                names.insert(name);
             }
         }
     }
     names
+}
+
+/// The comma-separated parts of `group` outside its inner braces.
+fn top_level(group: &str) -> Vec<&str> {
+    let (mut parts, mut depth, mut start) = (Vec::new(), 0, 0);
+    for (i, c) in group.char_indices() {
+        match c {
+            '{' => depth += 1,
+            '}' => depth -= 1,
+            ',' if depth == 0 => {
+                parts.push(&group[start..i]);
+                start = i + 1;
+            }
+            _ => {}
+        }
+    }
+    parts.push(&group[start..]);
+    parts
+}
+
+#[test]
+fn imports_are_read_from_the_whole_file_and_across_lines() {
+    let text = "use crate::{\n    engine::X,\n    numerics::{a, b},\n};\n\
+                #[cfg(test)]\nfn only_in_tests() { crate::cli::x(); }\n\
+                // crate::plot in a comment\n\
+                fn later() { crate::time::now(); }\n\
+                #[cfg(test)]\nmod tests { use crate::session::Y; }\n";
+    let names: Vec<String> = imports(text).into_iter().collect();
+    assert_eq!(names, ["engine", "numerics", "time"]);
 }
 
 /// Which top-level module imports which, with a file that does.

@@ -217,6 +217,61 @@ fn a_forced_relay_slides_and_leaves_where_its_forcing_reaches_the_relay() {
     }
 }
 
+/// Sliding on surfaces that are no state, where Filippov's weight `a =
+/// L- / (L- - L+)` alone keeps the state on the surface (nothing holds a
+/// component there), against closed forms:
+///
+/// - `x' = 0.5 - sign(x + y)`, `y' = 0.1 - 0.5 sign(x + y)` from `(1, 0.5)`:
+///   the surface `x + y = 0` is met at `t = 1.5 / 0.9`, at `(1/6, -1/6)`;
+///   there `L+ = -0.9`, `L- = 2.1`, `a = 0.7`, and the state slides at
+///   `(0.1, -0.1)`, to `(0.4, -0.4)` at `t = 4`;
+/// - `x' = 1`, `y' = -sign(y - x^2)` from `(-1, 1.5)`, a surface whose
+///   gradient `(-2 x, 1)` moves with the state: met where `t^2 - t - 1/2 =
+///   0`, `t = (1 + sqrt 3) / 2`; it slides on the parabola (`a = (1 - 2x) /
+///   2`, `y' = 2 x`) until `L- = 1 - 2 x` falls through zero at `x = 1/2`,
+///   `t = 3/2`, and leaves below, to `(1, 3/4)` at `t = 2`.
+#[test]
+fn sliding_on_surfaces_that_are_no_state_follows_filippovs_weight() {
+    let diagonal = json!({"model": "automaton", "states": ["x", "y"], "initial": {"x": 1.0, "y": 0.5},
+        "modes": {"m": {"flow": {"x": "-sign(x + y) + 0.5", "y": "-0.5 * sign(x + y) + 0.1"}}},
+        "t_end": 4.0});
+    let parabola = json!({"model": "automaton", "states": ["x", "y"], "initial": {"x": -1.0, "y": 1.5},
+        "modes": {"m": {"flow": {"x": "1", "y": "-sign(y - x^2)"}}}, "t_end": 2.0});
+    let cases = [
+        (
+            &diagonal,
+            vec![(1.5 / 0.9, "slide:x + y", "m[x + y=0]")],
+            (0.4, -0.4),
+        ),
+        (
+            &parabola,
+            vec![
+                (
+                    (1.0 + 3f64.sqrt()) / 2.0,
+                    "slide:y - x ^ 2",
+                    "m[y - x ^ 2=0]",
+                ),
+                (1.5, "leave:y - x ^ 2", "m[y - x ^ 2<0]"),
+            ],
+            (1.0, 0.75),
+        ),
+    ];
+    for (scene, want, (x, y)) in cases {
+        for args in EXACT.iter().chain(&OTHERS) {
+            let (summary, events) = run_value(scene, args);
+            let what = format!("{args:?}");
+            assert_eq!(summary["status"], "completed", "{what}: {summary}");
+            let (time, state) = allowance(args, &summary);
+            events_match(&events, &want, time, &what);
+            let fin = &summary["final_state"];
+            for (name, value) in [("x", x), ("y", y)] {
+                let error = (f(&fin[name]) - value).abs();
+                assert!(error <= state.max(1e-12), "{what}: {name} {fin}");
+            }
+        }
+    }
+}
+
 /// Two blocks on springs, coupled by a spring `c`, each with dry friction
 /// `mu` on the ground: block 2 sticks at `x2 = 0.1` (its spring force
 /// `|-x2 + c (x1 - x2)| <= mu` while `|x1| <= 0.9`) while block 1 swings
