@@ -62,6 +62,43 @@ pub fn events_match(events: &[Value], want: &[(f64, &str, &str)], tolerance: f64
     }
 }
 
+/// How many times the error a stated bound may be (see
+/// `tests/flicker/conformance.rs`): the Runge-Kutta pairs' bounds carry
+/// their embedded estimates, today up to some 1e4 times the error.
+const LOOSENESS: f64 = 3e4;
+
+/// A run by a method that states its bounds (one of [`OTHERS`]) is held
+/// to them the other way too: each bound within [`LOOSENESS`] of the
+/// error it bounds (event times against `want`, the final state against
+/// `fin`), or of 16 ulps where the error is smaller.
+pub fn tight(
+    args: &[&str],
+    summary: &Value,
+    events: &[Value],
+    want: &[(f64, &str, &str)],
+    fin: &[(&str, f64)],
+) {
+    if EXACT.contains(&args) {
+        return;
+    }
+    let (time, state) = allowance(args, summary);
+    let t_end = f(&summary["t_reached"]).abs().max(1.0);
+    let time_error = (events.iter().zip(want))
+        .map(|(e, w)| (f(&e["t"]) - w.0).abs())
+        .fold(16.0 * f64::EPSILON * t_end, f64::max);
+    let state_error = (fin.iter())
+        .map(|(name, value)| (f(&summary["final_state"][name]) - value).abs())
+        .fold(16.0 * f64::EPSILON, f64::max);
+    assert!(
+        time <= LOOSENESS * time_error,
+        "{args:?}: event times {time_error:.2e} off, their bound {time:.2e}"
+    );
+    assert!(
+        state <= LOOSENESS * state_error,
+        "{args:?}: final state {state_error:.2e} off, its bound {state:.2e}"
+    );
+}
+
 #[test]
 fn the_friction_oscillator_turns_and_sticks_where_its_closed_form_does() {
     let first = (6.0f64 / 13.0).atan();
@@ -91,6 +128,7 @@ fn the_friction_oscillator_turns_and_sticks_where_its_closed_form_does() {
         );
         assert_eq!(f(&summary["final_state"]["v"]), 0.0, "{what}");
         assert_eq!(summary["final_mode"], "block[v=0]");
+        tight(args, &summary, &events, &want, &[("x", rest)]);
         assert_eq!(summary["events_by_guard"]["slide:v"], 1);
     }
 }
@@ -128,6 +166,7 @@ fn relay_feedback_sticks_at_the_amplitude_its_half_swings_give() {
             "{what}"
         );
         assert_eq!(f(&summary["final_state"]["v"]), 0.0, "{what}");
+        tight(args, &summary, &events, &want, &[("x", x)]);
     }
 }
 
@@ -214,6 +253,7 @@ fn a_forced_relay_slides_and_leaves_where_its_forcing_reaches_the_relay() {
             (f(&summary["final_state"]["x"]) - xe).abs() <= state.max(1e-12),
             "{what}"
         );
+        tight(args, &summary, &events, &want, &[("x", xe)]);
     }
 }
 
@@ -268,6 +308,7 @@ fn sliding_on_surfaces_that_are_no_state_follows_filippovs_weight() {
                 let error = (f(&fin[name]) - value).abs();
                 assert!(error <= state.max(1e-12), "{what}: {name} {fin}");
             }
+            tight(args, &summary, &events, &want, &[("x", x), ("y", y)]);
         }
     }
 }
@@ -331,6 +372,7 @@ fn a_block_that_reverses_while_another_sticks_goes_on() {
                 "{what}: {name} {fin}"
             );
         }
+        tight(args, &summary, &events, &want, &[("x1", x1), ("v1", v1)]);
     }
 }
 

@@ -279,7 +279,10 @@ fn keeps_its_word(
     (outcome, seen): &(Outcome, Vec<Seen>),
     (events, state): &(Vec<Event>, Vec<D>),
 ) -> Result<bool, String> {
-    let time_bound = outcome.event_time_bound.unwrap_or(f64::INFINITY);
+    // A few balls' errors are carried: a missing bound is a defect.
+    let Some(time_bound) = outcome.event_time_bound else {
+        return Err(format!("no event-time bound stated: {:?}", outcome.reason));
+    };
     let completed = outcome.status == Status::Completed;
     if !completed && outcome.reason.as_deref().unwrap_or("").is_empty() {
         return Err(format!("{:?} without a reason", outcome.status));
