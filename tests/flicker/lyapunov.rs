@@ -128,6 +128,30 @@ fn a_tent_map_in_resets_has_exponent_log_mu() {
     assert!(l[1].abs() < 1e-9, "{l:?}");
 }
 
+/// A hybrid flow in two dimensions whose single exponents its period map
+/// gives in closed form: `x' = x`, `y' = -0.3 y`, and where `x` reaches 2
+/// the reset `x -> 1`, `y -> y / 2 + 1` (a period of `T = ln 2`). Over one
+/// period the flow's tangent is `diag(2, 2^-0.3)` and the saltation
+/// matrix `[[1/2, 0], [-0.15, 1/2]]` (the reset's Jacobian `diag(0, 1/2)`
+/// corrected by the jump in the flow, `(f+ - DR f-) e_x / 2`), so the map
+/// is `[[1, 0], [-0.3, 2^-1.3]]`: exponents 0 (the flow's own direction)
+/// and `log2(2^-1.3) = -1.3` per unit time. The reset's Jacobian alone
+/// would give minus infinity for the first.
+#[test]
+fn a_hybrid_linear_flow_has_the_exponents_its_saltation_gives() {
+    let scene = json!({"model": "automaton", "states": ["x", "y"], "initial": {"x": 1.0, "y": 0.0},
+        "modes": {"m": {"flow": {"x": "x", "y": "-0.3 * y"},
+            "transitions": [{"name": "kick", "guard": "x - 2", "direction": "rising",
+                "reset": {"x": "1", "y": "0.5 * y + 1"}}]}},
+        "t_end": 2000.0});
+    let (code, found, err) = lyapunov(&scene, &["--interval", "10"]);
+    assert_eq!(code, Some(0), "{err}");
+    let l = exponents(&found.unwrap());
+    assert_eq!(l.len(), 2, "{l:?}");
+    assert!(l[0].abs() < 1e-3, "{l:?}");
+    assert!((l[1] + 1.3).abs() < 1e-3, "{l:?}");
+}
+
 /// Bad requests are refused before anything runs (exit 2, naming the
 /// flag); the continuum has no finite state; a spectrum past its wall
 /// budget stops, says so and exits 3, keeping what it measured.
