@@ -367,19 +367,23 @@ impl Integrator {
     /// How far the dense output `tau` into the last step (from `y0`, its
     /// start) may be from the solution, where it is not the step itself:
     /// for the Runge-Kutta pairs, measured by re-taking the step to `tau`
-    /// on `spare` (a copy of this integrator, whose working state it
-    /// spends; see `src/engine/sharpen.rs`); `None` for the methods whose dense
+    /// on `spare` (a copy of this integrator, made here when first needed,
+    /// whose working state it spends; see `src/engine/sharpen.rs`); `None` for the methods whose dense
     /// output is their step (a Taylor series, the propagator) or has no
     /// such check (Stormer-Verlet).
     pub fn dense_error<M: HybridModel + ?Sized>(
         &self,
-        spare: &mut Integrator,
+        spare: &mut Option<Box<Integrator>>,
         model: &M,
         mode: Mode,
         at: (&[f64], f64),
         x: &mut [f64],
     ) -> Option<f64> {
-        match (self, spare) {
+        if !matches!(self, Integrator::Dopri5(_) | Integrator::Dop853(_)) {
+            return None;
+        }
+        let spare = spare.get_or_insert_with(|| Box::new(self.clone()));
+        match (self, &mut **spare) {
             (Integrator::Dopri5(m), Integrator::Dopri5(s)) => {
                 Some(dense_error(m, s, model, mode, at, x))
             }

@@ -147,7 +147,7 @@ struct Run<'m, 's, M: HybridModel + ?Sized> {
     /// What the dense output errs by at an event it placed (sharpening
     /// declined), for the segment that closes there.
     dense_gap: f64,
-    /// A copy of the integrator to re-take steps on (see
+    /// A copy of a Runge-Kutta integrator to re-take steps on (see
     /// [`Run::flow_bound`]), made when first needed.
     spare: Option<Box<Integrator>>,
     /// Whether the run reports samples: then the last logged event is
@@ -1341,11 +1341,9 @@ impl<'m, 's, M: HybridModel + ?Sized> Run<'m, 's, M> {
         let mut local = self.local_error();
         if self.stepped && tau > 0.0 {
             let (model, mode) = (self.model, self.mode);
-            let spare = self
-                .spare
-                .get_or_insert_with(|| Box::new(self.integrator.clone()));
             let mut x = std::mem::take(&mut self.after);
             let at = (self.state.as_slice(), self.step_offset + tau);
+            let spare = &mut self.spare;
             if let Some(dense) = self.integrator.dense_error(spare, model, mode, at, &mut x) {
                 local = local.max(dense + self.forcing_error);
             }
