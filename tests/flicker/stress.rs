@@ -180,10 +180,12 @@ fn every_stress_scene_runs_each_offered_method() {
 /// each passing run's bound is (final state and event times), on every
 /// stress case and bundled automaton, against the ratios recorded in
 /// tests/golden/bound_ratios.json (`FLICKER_RECORD_GOLDEN=1` re-records).
-/// A ratio ten times its record fails: a bound that loosened that much no
-/// longer says how accurate a run is. A run that passes must have a record.
+/// A ratio twice its record fails (a bound may grow no looser than 2x
+/// without the record saying so, re-recorded with the reason in the
+/// commit); a ratio once measured must still be. A run that passes must
+/// have a record.
 #[test]
-fn bounds_stay_within_ten_times_their_recorded_ratio() {
+fn bounds_stay_within_twice_their_recorded_ratio() {
     let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/golden/bound_ratios.json");
     let mut now = serde_json::Map::new();
     for folder in ["models/stress", "models/automata"] {
@@ -217,11 +219,15 @@ fn bounds_stay_within_ten_times_their_recorded_ratio() {
             );
         };
         for key in ["state", "time"] {
-            if let (Some(was), Some(is)) = (record[key].as_f64(), ratios[key].as_f64()) {
-                assert!(
-                    is <= 10.0 * was,
+            match (record[key].as_f64(), ratios[key].as_f64()) {
+                (Some(was), Some(is)) => assert!(
+                    is <= 2.0 * was,
                     "{name}: the {key} bound is {is:.1e} times its error, recorded {was:.1e}"
-                );
+                ),
+                (Some(was), None) => {
+                    panic!("{name}: the {key} ratio, recorded {was:.1e}, is no longer measured")
+                }
+                _ => {}
             }
         }
     }
