@@ -30,6 +30,7 @@ use pyo3::types::PyDict;
 use flicker::engine::{EventRecord, Observer};
 use flicker::log::JsonlWriter;
 use flicker::log::columns::EventColumns;
+use flicker::log::size_notice::{FIRST_NOTICE, LogSize};
 use flicker::log::summary::summary;
 use flicker::runner::Control;
 use flicker::scene::solver::SolverSpec;
@@ -53,6 +54,12 @@ fn scene_error(py: Python<'_>, e: &EngineSceneError) -> PyErr {
     let _ = value.setattr("field", e.field.clone());
     let _ = value.setattr("reason", e.reason.clone());
     err
+}
+
+/// A word on standard error, as the command line gives it (a run holds
+/// no GIL to warn through).
+fn say(what: String) {
+    eprintln!("flicker: {what}");
 }
 
 /// A refusal of an override (a keyword argument), as the command line
@@ -85,7 +92,7 @@ fn load(py: Python<'_>, text: Option<&str>, path: Option<&str>) -> PyResult<(Sce
 /// The run's observers: the columns, and the log on disk where asked.
 struct Keep {
     columns: Option<EventColumns>,
-    log: Option<JsonlWriter<BufWriter<File>>>,
+    log: Option<JsonlWriter<LogSize<BufWriter<File>, fn(String)>>>,
 }
 
 impl Observer for Keep {
@@ -166,10 +173,12 @@ fn run<'py>(
     };
     let writer = match log {
         None => None,
-        Some(file) => Some(JsonlWriter::new(BufWriter::new(
-            File::create(file).map_err(|e| {
+        Some(file) => Some(JsonlWriter::new(LogSize::new(
+            BufWriter::new(File::create(file).map_err(|e| {
                 override_error(py, "log", format!("{file}: cannot be created: {e}"))
-            })?,
+            })?),
+            FIRST_NOTICE,
+            say as fn(String),
         ))),
     };
     let mut keep = Keep {

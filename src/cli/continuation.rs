@@ -86,7 +86,7 @@ pub fn continue_orbit(args: ContinueArgs, registry: &Registry) -> Result<Code, F
     }
     .on(&scene, Some(crate::cli::setup::stop_flag()))
     .map_err(|e| Failure::refused(&args.scene, e))?;
-    let (mut branch, names, p) = search
+    let (branch, names, p) = search
         .branch(
             &args.param,
             args.to,
@@ -117,17 +117,6 @@ pub fn continue_orbit(args: ContinueArgs, registry: &Registry) -> Result<Code, F
         Path::new("out").join(format!("{stem}-continuation"))
     });
     crate::cli::setup::output_folder(&out)?;
-    // A forced system's clock is written and drawn as the forcing's phase,
-    // in [0, T) as the brute-force runs' is (a branch's orbits keep it
-    // wherever Newton left it, below zero past a fold).
-    let clock = args
-        .forcing_period
-        .zip(names.iter().position(|n| *n == "t"));
-    if let Some((period, clock)) = clock {
-        for q in &mut branch.points {
-            q.state[clock] = q.state[clock].rem_euclid(period);
-        }
-    }
     let csv = out.join("continuation.csv");
     write_csv(&branch, &names, p, &csv)
         .map_err(|e| Failure::untrusted(format!("{}: cannot be written: {e}", csv.display())))?;
@@ -169,9 +158,11 @@ pub fn continue_orbit(args: ContinueArgs, registry: &Registry) -> Result<Code, F
     } else {
         Vec::new()
     };
-    // The brute-force runs' absolute times would climb the picture as a
-    // ladder.
-    if let Some((period, clock)) = clock {
+    // A forced system's clock is drawn as the forcing's phase, as the
+    // branch holds it: the brute-force runs' absolute times would climb
+    // the picture as a ladder.
+    if let (Some(period), Some(clock)) = (args.forcing_period, names.iter().position(|n| *n == "t"))
+    {
         for x in columns.iter_mut().flat_map(|c| c.states.iter_mut()) {
             x[clock] = x[clock].rem_euclid(period);
         }

@@ -29,7 +29,6 @@ pub mod compare_models;
 pub mod continuation;
 pub mod events;
 pub mod exit;
-pub mod log_size;
 pub mod lyapunov;
 pub mod orbit;
 pub mod plot;

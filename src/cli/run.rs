@@ -4,11 +4,11 @@
 use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
 
-use crate::cli::log_size::{FIRST_NOTICE, LogSize};
 use crate::engine::Status;
 use crate::engine::method::NAMES;
 use crate::log::JsonlWriter;
 use crate::log::field_files;
+use crate::log::size_notice::{FIRST_NOTICE, LogSize};
 use crate::log::summary::{summary, write_atomically};
 use crate::log::writer::LazyFile;
 use crate::runner::ensemble::EnsembleRequest;

@@ -101,7 +101,8 @@ pub enum Sharpened {
     Moved(f64),
     /// Kept the dense output's: the state there errs by up to this much
     /// more than the step's error (the gap to the step re-taken to it; 0
-    /// where the method's dense output is its step, NaN where unmeasured).
+    /// where the method's dense output is its step; not finite where the
+    /// re-taken step blew up).
     Kept(f64),
 }
 

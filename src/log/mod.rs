@@ -37,6 +37,7 @@ pub mod field_files;
 pub mod inspect;
 pub mod reader;
 pub mod samples;
+pub mod size_notice;
 pub mod summary;
 pub mod writer;
 

@@ -246,10 +246,15 @@ fn correct(
 /// A point of the branch from a solved orbit.
 fn point(unknowns: &Unknowns, p: usize, s: &Solved, label: &str) -> Point {
     let (multipliers, stable) = multipliers(&s.back, unknowns);
+    // A forced system's clock as the forcing's phase, in [0, T) as the
+    // brute-force diagram's (Newton leaves it anywhere, below zero past
+    // a fold).
+    let mut state = s.x.clone();
+    unknowns.fold_clock(&mut state);
     Point {
         parameter: s.x[p],
         period: s.back.elapsed,
-        state: s.x.clone(),
+        state,
         multipliers,
         stable,
         label: label.to_string(),
@@ -403,6 +408,7 @@ pub fn follow(
                     let mut graze = point(unknowns, p, &orbit, "grazing");
                     graze.parameter = at;
                     graze.state = state;
+                    unknowns.fold_clock(&mut graze.state);
                     on_point(&graze);
                     points.push(graze);
                     let side = if at > next.x[p] { "below" } else { "above" };
@@ -481,6 +487,7 @@ fn end_near_graze(
         let f = (at - b[p]) / (b[p] - a[p]);
         graze.state = a.iter().zip(b).map(|(a, b)| b + f * (b - a)).collect();
         graze.state[p] = at;
+        unknowns.fold_clock(&mut graze.state);
     }
     points.push(graze);
     let side = if at > last { "below" } else { "above" };

@@ -16,6 +16,13 @@ pub fn automaton(name: &str) -> String {
 
 /// Run `scene` (a path) with `args`, returning the summary and the events.
 pub fn run(scene: &str, args: &[&str]) -> (Value, Vec<Value>) {
+    let (summary, events, _) = run_kept(scene, args);
+    (summary, events)
+}
+
+/// [`run`], keeping the output folder (for the files besides the summary
+/// and the log).
+pub fn run_kept(scene: &str, args: &[&str]) -> (Value, Vec<Value>, tempfile::TempDir) {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().to_str().unwrap();
     let mut all = vec!["run", scene, "--out", out, "--quiet"];
@@ -32,7 +39,7 @@ pub fn run(scene: &str, args: &[&str]) -> (Value, Vec<Value>) {
         .lines()
         .map(|l| serde_json::from_str(l).unwrap())
         .collect();
-    (summary, events)
+    (summary, events, dir)
 }
 
 /// Write `scene` to a file and run it.

@@ -287,10 +287,8 @@ fn the_vibrating_tables_first_impact_is_found_by_every_method() {
 /// last assertion keeps it from growing while it stands.
 #[test]
 fn the_rocking_block_meets_an_outside_reference() {
-    let fixture = crate::support::read_json(
-        &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/rocking_block.json"),
-    );
-    let number = |v: &Value| v.as_str().unwrap().parse::<f64>().unwrap();
+    let fixture = crate::support::fixture("rocking_block.json");
+    let number = crate::support::digits;
     let impacts: Vec<(f64, f64)> = fixture["impacts"]
         .as_array()
         .unwrap()

@@ -291,43 +291,9 @@ fn continuation_in_the_forcing_frequency_is_refused() {
 fn the_impact_oscillator_s_branch_grazes_at_the_free_amplitude() {
     let (zeta, w) = (0.05_f64, 0.8_f64);
     let amplitude = 1.0 / ((1.0 - w * w).powi(2) + (2.0 * zeta * w).powi(2)).sqrt();
-    let mut scene =
-        crate::support::read_json(std::path::Path::new(&automaton("impact_oscillator.json")));
-    scene["parameters"]["s"] = serde_json::json!(2.0);
-    scene["t_end"] = serde_json::json!(2000.0);
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("oscillator.json");
-    std::fs::write(&path, scene.to_string()).unwrap();
-    let period = (2.0 * PI / w).to_string();
-    let done = flicker(&[
-        "continue",
-        path.to_str().unwrap(),
-        "--section",
-        "impact",
-        "--param",
-        "s",
-        "--to",
-        "3",
-        "--settle",
-        "300",
-        "--forcing-period",
-        &period,
-        "--brute-force",
-        "0",
-        "--wall",
-        "60",
-        "--out",
-        dir.path().to_str().unwrap(),
-    ]);
-    let said = String::from_utf8_lossy(&done.stdout);
-    assert_eq!(
-        done.status.code(),
-        Some(0),
-        "{said}{}",
-        String::from_utf8_lossy(&done.stderr)
-    );
+    let params = serde_json::json!({"zeta": zeta, "w": w, "r": 0.8, "s": 2.0, "A": 1.0});
+    let (said, rows) = continue_oscillator(params, ("s", 3.0), 300.0, 2000.0);
     assert!(said.contains("impacting orbits exist below"), "{said}");
-    let rows = std::fs::read_to_string(dir.path().join("continuation.csv")).unwrap();
     let graze: Vec<&str> = rows.lines().filter(|r| r.ends_with(",grazing")).collect();
     assert_eq!(graze.len(), 1, "{rows}");
     let s: f64 = graze[0].split(',').next().unwrap().parse().unwrap();
@@ -337,6 +303,63 @@ fn the_impact_oscillator_s_branch_grazes_at_the_free_amplitude() {
     );
     let last = rows.lines().last().unwrap();
     assert!(last.ends_with(",grazing"), "the branch ends there: {last}");
+}
+
+/// `flicker continue` of the forced oscillator `x'' + 2 zeta x' + x = A
+/// cos(w t)` against a stop at `s` (`impact_oscillator.json` with the
+/// forcing's amplitude a parameter) with `params`, in `(parameter, to)`
+/// after `settle`, the scene's `t_end` given: what it said (exit 0
+/// asserted) and `continuation.csv`.
+fn continue_oscillator(
+    params: serde_json::Value,
+    (param, to): (&str, f64),
+    settle: f64,
+    t_end: f64,
+) -> (String, String) {
+    let w = params["w"].as_f64().unwrap();
+    let mut scene =
+        crate::support::read_json(std::path::Path::new(&automaton("impact_oscillator.json")));
+    scene["parameters"] = params;
+    scene["modes"]["free"]["flow"]["v"] = serde_json::json!("A * cos(w * t) - 2 * zeta * v - x");
+    scene["t_end"] = serde_json::json!(t_end);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("oscillator.json");
+    std::fs::write(&path, scene.to_string()).unwrap();
+    let (period, to, settle) = (
+        (2.0 * PI / w).to_string(),
+        to.to_string(),
+        settle.to_string(),
+    );
+    let done = flicker(&[
+        "continue",
+        path.to_str().unwrap(),
+        "--section",
+        "impact",
+        "--param",
+        param,
+        "--to",
+        &to,
+        "--settle",
+        &settle,
+        "--forcing-period",
+        &period,
+        "--brute-force",
+        "0",
+        "--wall",
+        "60",
+        "--quiet",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    let said = String::from_utf8_lossy(&done.stdout).into_owned();
+    assert_eq!(
+        done.status.code(),
+        Some(0),
+        "{said}{}",
+        String::from_utf8_lossy(&done.stderr)
+    );
+    let rows = std::fs::read_to_string(dir.path().join("continuation.csv")).unwrap();
+    (said, rows)
 }
 
 /// A forced oscillator of our own, `x'' + 2 zeta x' + x = A cos(w t)`
@@ -355,46 +378,8 @@ fn a_graze_is_labelled_only_where_located_whichever_parameter_moves_it() {
         // The stop at 0.8 of the free amplitude at A = 1, or where given.
         let stop = stop.unwrap_or(0.8 * gain);
         let grazing = stop / gain;
-        let mut scene =
-            crate::support::read_json(std::path::Path::new(&automaton("impact_oscillator.json")));
-        scene["parameters"] =
-            serde_json::json!({"zeta": zeta, "w": w, "r": r, "s": stop, "A": 1.0});
-        scene["modes"]["free"]["flow"]["v"] =
-            serde_json::json!("A * cos(w * t) - 2 * zeta * v - x");
-        scene["t_end"] = serde_json::json!(5000.0);
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("oscillator.json");
-        std::fs::write(&path, scene.to_string()).unwrap();
-        let period = (2.0 * PI / w).to_string();
-        let done = flicker(&[
-            "continue",
-            path.to_str().unwrap(),
-            "--section",
-            "impact",
-            "--param",
-            "A",
-            "--to",
-            "0.5",
-            "--settle",
-            "400",
-            "--forcing-period",
-            &period,
-            "--brute-force",
-            "0",
-            "--wall",
-            "60",
-            "--quiet",
-            "--out",
-            dir.path().to_str().unwrap(),
-        ]);
-        let said = String::from_utf8_lossy(&done.stdout);
-        assert_eq!(
-            done.status.code(),
-            Some(0),
-            "{said}{}",
-            String::from_utf8_lossy(&done.stderr)
-        );
-        let rows = std::fs::read_to_string(dir.path().join("continuation.csv")).unwrap();
+        let params = serde_json::json!({"zeta": zeta, "w": w, "r": r, "s": stop, "A": 1.0});
+        let (said, rows) = continue_oscillator(params, ("A", 0.5), 400.0, 5000.0);
         let graze: Vec<&str> = rows.lines().filter(|r| r.ends_with(",grazing")).collect();
         assert_eq!(graze.len(), 1, "zeta {zeta}: {said}\n{rows}");
         let a: f64 = graze[0].split(',').next().unwrap().parse().unwrap();

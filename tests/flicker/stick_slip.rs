@@ -284,11 +284,8 @@ fn the_phase_plane_draws_each_stick_along_the_belt() {
 /// at 1e-12.
 #[test]
 fn the_belt_meets_an_outside_reference() {
-    let fixture = crate::support::read_json(
-        &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("tests/fixtures/stick_slip_belt.json"),
-    );
-    let number = |v: &Value| v.as_str().unwrap().parse::<f64>().unwrap();
+    let fixture = crate::support::fixture("stick_slip_belt.json");
+    let number = crate::support::digits;
     let want: Vec<(&str, f64, f64)> = fixture["events"]
         .as_array()
         .unwrap()

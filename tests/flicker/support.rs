@@ -49,6 +49,20 @@ pub fn models(name: &str) -> String {
     format!("{}/models/{name}", env!("CARGO_MANIFEST_DIR"))
 }
 
+/// A reference computed outside flicker, `tests/fixtures/NAME`, parsed.
+pub fn fixture(name: &str) -> Value {
+    read_json(
+        &Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/fixtures")
+            .join(name),
+    )
+}
+
+/// A fixture's number, written as a string to keep its digits.
+pub fn digits(v: &Value) -> f64 {
+    v.as_str().unwrap().parse().unwrap()
+}
+
 /// A JSON file, parsed.
 pub fn read_json(path: &Path) -> Value {
     serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()

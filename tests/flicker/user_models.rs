@@ -97,11 +97,8 @@ fn a_pendulums_section_fires_once_per_swing() {
 
 #[test]
 fn henon_heiles_crosses_its_section_as_heyoka_at_128_bits_does() {
-    let fixture = crate::support::read_json(
-        &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("tests/fixtures/henon_heiles_section.json"),
-    );
-    let number = |v: &Value| v.as_str().unwrap().parse::<f64>().unwrap();
+    let fixture = crate::support::fixture("henon_heiles_section.json");
+    let number = crate::support::digits;
     let exact: Vec<f64> = fixture["crossings"]
         .as_array()
         .unwrap()

@@ -1,8 +1,8 @@
-//! A word when the event log grows large: a run to t = 1e7 with its log
-//! once wrote 955 MB and said nothing. The log is written as the run goes
-//! (an interrupted run keeps what it did), so it is not refused; the user
-//! is told once it passes 100 MB, and again at each tenfold, what it costs
-//! and how to run without it.
+//! A word when an event log grows large (the command line's, and Python's
+//! `log=`): a run to t = 1e7 with its log once wrote 955 MB and said
+//! nothing. The log is written as the run goes (an interrupted run keeps
+//! what it did), so it is not refused; the user is told once it passes 100
+//! MB, and again at each tenfold, that it grows and how to do without it.
 
 use std::io::{self, Write};
 
@@ -36,8 +36,9 @@ impl<W: Write, S: FnMut(String)> Write for LogSize<W, S> {
         self.written += n as u64;
         if self.written >= self.next_notice {
             (self.say)(format!(
-                "the event log has passed {} MB and grows as the run goes (--no-events runs \
-                 without it; `flicker events` filters and summarises it)",
+                "the event log has passed {} MB and grows as the run goes (--no-events, or \
+                 no log= from Python, runs without it; `flicker events` filters and \
+                 summarises it)",
                 self.next_notice / 1_000_000
             ));
             while self.next_notice <= self.written {
