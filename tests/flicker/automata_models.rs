@@ -270,21 +270,18 @@ fn the_vibrating_tables_first_impact_is_found_by_every_method() {
 }
 
 /// The rocking block (`rocking_block.json`, nonlinear: no closed form)
-/// against a reference made outside flicker: its impact times and the
-/// speeds before them by quadrature in mpmath at 40 digits
-/// (`tests/fixtures/scripts/rocking_block.py`, which writes
-/// `tests/fixtures/rocking_block.json`). Taylor's method (the default)
-/// meets every impact to 1e-13 in time and 1e-14 in speed, within its
-/// stated bounds; the Runge-Kutta pairs and Stormer-Verlet complete within
-/// their bounds or stop saying why, never with another impact.
-///
-/// The bounds are far from tight here: each half-swing is a fall away
-/// from an unstable equilibrium (errors grow as e^{p t}, p = 2.7 /s), and
-/// the carried parallelepiped does not see the next impact take that back,
-/// so Taylor's time bound is 3.2e-5 against an error of 3.6e-15 (9e9
-/// times), and the pairs stop after 6-11 of the 12 impacts. A known defect
-/// of the bound (issue "Tests that fail when the physics breaks"): the
-/// last assertion keeps it from growing while it stands.
+/// against a reference made outside flicker: its impact times, the speeds
+/// before them and the state at `t_end` by quadrature in mpmath at 40
+/// digits (`tests/fixtures/scripts/rocking_block.py`, which writes
+/// `tests/fixtures/rocking_block.json`). Every method completes within
+/// its stated bounds, and the bounds are not far above the errors: within
+/// 1e3 of them for Taylor's method (round-off alone: 180 measured, for the
+/// times and the final state) and Stormer-Verlet (120), and within 3e4
+/// for the Runge-Kutta pairs, whose bounds carry their embedded estimate
+/// of the lower order (570 for dopri5, 1.4e3 for DOP853). Each half-swing
+/// is a fall away from an unstable equilibrium (errors grow as e^{p t},
+/// p = 2.7 /s, and the next impact takes that back), which bounds made of
+/// norms could not follow.
 #[test]
 fn the_rocking_block_meets_an_outside_reference() {
     let fixture = crate::support::fixture("rocking_block.json");
@@ -296,44 +293,50 @@ fn the_rocking_block_meets_an_outside_reference() {
         .map(|i| (number(&i["t"]), number(&i["speed_before"])))
         .collect();
     assert_eq!(impacts.len(), 12);
-    for args in [
-        &[][..],
-        &["--method", "dopri5", "--rtol", "1e-10", "--atol", "1e-10"],
-        &["--method", "dop853", "--rtol", "1e-12", "--atol", "1e-12"],
-        &["--method", "verlet", "--step", "1e-3"],
+    let last = [
+        number(&fixture["final"]["theta"]),
+        number(&fixture["final"]["theta_rate"]),
+    ];
+    for (args, looseness) in [
+        (&[][..], 1e3),
+        (
+            &["--method", "dopri5", "--rtol", "1e-10", "--atol", "1e-10"],
+            3e4,
+        ),
+        (
+            &["--method", "dop853", "--rtol", "1e-12", "--atol", "1e-12"],
+            3e4,
+        ),
+        (&["--method", "verlet", "--step", "1e-3"], 1e3),
     ] {
         let (summary, events) = run(&automaton("rocking_block.json"), args);
-        let completed = summary["status"] == "completed";
-        assert!(
-            completed || summary["reason"].is_string(),
-            "{args:?}: {summary}"
-        );
-        assert!(events.len() <= impacts.len(), "{args:?}: {}", events.len());
-        if completed {
-            assert_eq!(events.len(), impacts.len(), "{args:?}");
-        }
-        let time_bound = f(&summary["event_time_bound"]);
-        let mut largest = 0.0_f64;
+        assert_eq!(summary["status"], "completed", "{args:?}: {summary}");
+        assert_eq!(events.len(), impacts.len(), "{args:?}");
+        let (time_bound, bound) = (f(&summary["event_time_bound"]), f(&summary["error_bound"]));
+        let mut late = 0.0_f64;
         for (e, (t, speed)) in events.iter().zip(&impacts) {
             let off = (f(&e["t"]) - t).abs();
-            largest = largest.max(off);
+            late = late.max(off);
             assert!(off <= time_bound, "{args:?}: impact at {} vs {t}", e["t"]);
             let rate = f(&e["before"]["theta_rate"]).abs();
             assert!(
-                (rate - speed).abs() <= f(&summary["error_bound"]),
+                (rate - speed).abs() <= bound,
                 "{args:?}: speed {rate} vs {speed}"
             );
-            if args.is_empty() {
-                assert!(off < 1e-13 && (rate - speed).abs() < 1e-14, "{off:e}");
-            }
         }
-        if args.is_empty() {
-            assert!(completed, "{summary}");
-            // 9e9 today: not to grow (see above).
-            assert!(
-                time_bound < 1e11 * largest.max(1e-16),
-                "{time_bound:e} vs {largest:e}"
-            );
-        }
+        let state = &summary["final_state"];
+        let error = (f(&state["theta"]) - last[0])
+            .abs()
+            .max((f(&state["theta_rate"]) - last[1]).abs());
+        assert!(
+            error <= bound,
+            "{args:?}: final state {error:e} off, bound {bound:e}"
+        );
+        // Round-off's floor: 16 ulps of the speed, and of the time.
+        let (floor, time_floor) = (16.0 * f64::EPSILON * 0.25, 16.0 * f64::EPSILON * 10.0);
+        assert!(
+            bound <= looseness * error.max(floor) && time_bound <= looseness * late.max(time_floor),
+            "{args:?}: bounds {bound:e} and {time_bound:e} against errors {error:e} and {late:e}"
+        );
     }
 }
