@@ -101,7 +101,10 @@ fn linear_block(g: f64, b: f64, h: f64, impacts: usize) -> Vec<(f64, f64)> {
 
 /// `rocking_block_linear.json` runs on the exact linear propagator (both
 /// corners are affine) and meets the closed form: every impact time and
-/// speed to 1e-10, corners alternating.
+/// speed to 1e-10, corners alternating, the times within the stated bound
+/// (widened by the closed form's own rounding in f64, 16 ulps of each
+/// time) and the bound within 1e3 of their errors or of that rounding
+/// (round-off alone).
 #[test]
 fn the_linearised_rocking_block_meets_its_cosh_sinh_closed_form() {
     let (summary, events) = run(&automaton("rocking_block_linear.json"), &[]);
@@ -109,7 +112,15 @@ fn the_linearised_rocking_block_meets_its_cosh_sinh_closed_form() {
     assert_eq!(summary["status"], "completed", "{summary}");
     let exact = linear_block(9.81, 0.1, 1.0, events.len());
     assert!(events.len() >= 10, "{} impacts", events.len());
+    let time_bound = f(&summary["event_time_bound"]);
+    let mut largest = 0.0_f64;
     for (k, (e, (t, w))) in events.iter().zip(&exact).enumerate() {
+        let (off, rounding) = ((f(&e["t"]) - t).abs(), 16.0 * f64::EPSILON * t);
+        largest = largest.max(off.max(rounding));
+        assert!(
+            off <= time_bound + rounding,
+            "impact {k}: {off:e} off, bound {time_bound:e}"
+        );
         assert!(
             (f(&e["t"]) - t).abs() < 1e-10,
             "impact {k}: {} vs {t}",
@@ -130,6 +141,7 @@ fn the_linearised_rocking_block_meets_its_cosh_sinh_closed_form() {
             (Some(from), Some(to))
         );
     }
+    assert!(time_bound <= 1e3 * largest, "{time_bound:e} vs {largest:e}");
 }
 
 /// The nonlinear block (`sin(alpha - theta)`) against the linearised one,
