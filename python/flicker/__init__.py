@@ -14,7 +14,7 @@ results over as NumPy arrays.
     >>> run.events["before"][:, 1]   # the speed before each bounce
 
 A scene is a path, a JSON string or a dict, in the format `flicker run`
-reads (see the repository's README and docs/automata.md). A scene flicker
+reads (see the repository's docs/command_line.md and docs/automata.md). A scene flicker
 refuses raises `SceneError` (a `ValueError`); a run that cannot be trusted
 returns, with `summary["status"] == "failed"` and the reason in
 `summary["reason"]`, as the command line does. Runs release the GIL (runs

@@ -17,6 +17,7 @@ mod conformance;
 mod continuation;
 mod continuum;
 mod convergence;
+mod docs_links;
 mod engine_generic;
 mod error_bound;
 mod event_location;
