@@ -19,8 +19,8 @@ use std::time::Instant;
 use nalgebra::DMatrix;
 use serde_json::{Value, json};
 
-use crate::engine::method::{Method, tightest};
-use crate::engine::variational::Variational;
+use crate::engine::bound::variational::Variational;
+use crate::engine::step::method::{Method, tightest};
 use crate::engine::{Family, Options, Status, simulate};
 
 /// Tolerance of the runs where the flows (with their derivatives) are not

@@ -4,7 +4,7 @@
 //! respect to parameters and initial values, forward through the flows
 //! (variational equations, with the model's exact Jacobian where it gives
 //! one, central differences otherwise) and across each event by its
-//! saltation matrix ([`crate::engine::variational`]).
+//! saltation matrix ([`crate::engine::bound::variational`]).
 //!
 //! A parameter becomes a state that never changes ([`Family::promoted`]),
 //! its direction the unit vector on it plus the derivative of the initial
@@ -18,8 +18,8 @@
 
 use serde_json::{Map, Value, json};
 
-use crate::engine::method::tightest;
-use crate::engine::variational::Variational;
+use crate::engine::bound::variational::Variational;
+use crate::engine::step::method::tightest;
 use crate::engine::{
     Family, HybridModel, Method, Mode, Name, Observer, Sample, Tolerances, simulate_sampled,
 };

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
 
 use crate::engine::Status;
-use crate::engine::method::NAMES;
+use crate::engine::step::method::NAMES;
 use crate::log::JsonlWriter;
 use crate::log::field_files;
 use crate::log::size_notice::{FIRST_NOTICE, LogSize};

@@ -11,9 +11,9 @@
 //! speed, a place along a continuum) get a column each, empty where an
 //! event has none.
 
-use crate::engine::labels::Label;
-use crate::engine::names::Name;
-use crate::engine::observer::{EventRecord, Observer};
+use crate::engine::model::labels::Label;
+use crate::engine::model::names::Name;
+use crate::engine::run::observer::{EventRecord, Observer};
 
 /// Every event of a run, field by field.
 #[derive(Debug, Clone, Default)]
@@ -208,7 +208,7 @@ impl Observer for EventColumns {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::engine::labels::Labels;
+    use crate::engine::model::labels::Labels;
     use crate::names;
 
     fn event<'a>(

@@ -1,5 +1,5 @@
 //! Real roots of polynomials and brackets, for the event scan of a step's
-//! dense output (`src/engine/locate.rs`): the polynomial through equally
+//! dense output (`src/engine/step/locate.rs`): the polynomial through equally
 //! spaced samples, every real root of a low-degree polynomial on `(0, 1)`
 //! (by recursion on its derivative's), and the refinement of a bracket. The
 //! certified first crossing of a Taylor series is

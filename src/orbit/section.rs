@@ -17,8 +17,8 @@ use std::time::Instant;
 
 use nalgebra::DMatrix;
 
-use crate::engine::method::tightest;
-use crate::engine::variational::Variational;
+use crate::engine::bound::variational::Variational;
+use crate::engine::step::method::tightest;
 use crate::engine::{
     EventRecord, Family, Flow, HybridModel, Method, Mode, Observer, Options, Status, Tolerances,
     simulate,

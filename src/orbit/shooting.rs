@@ -12,7 +12,7 @@
 use nalgebra::{DMatrix, DVector};
 
 use crate::engine::Mode;
-use crate::engine::names::Name;
+use crate::engine::model::names::Name;
 use crate::orbit::section::{Return, Section};
 
 /// Newton iterations at most.

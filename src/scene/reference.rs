@@ -4,7 +4,7 @@
 use std::fmt;
 use std::sync::Arc;
 
-use crate::engine::{EventTimes, Status, zeno};
+use crate::engine::{EventTimes, Status, bound::zeno};
 use crate::runner::{Control, Report};
 use crate::scene::{Scene, SceneError};
 

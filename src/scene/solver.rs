@@ -25,7 +25,7 @@ use crate::scene::fields::Fields;
 /// The solver as written, before it is checked against the model.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct SolverSpec {
-    /// `method`: one of [`NAMES`](crate::engine::method::NAMES); `None` for the model's cheapest exact
+    /// `method`: one of [`NAMES`](crate::engine::step::method::NAMES); `None` for the model's cheapest exact
     /// description.
     pub method: Option<String>,
     /// `rtol`: relative tolerance, for `dopri5` and `dop853`.

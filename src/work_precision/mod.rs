@@ -12,7 +12,7 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
-use crate::engine::method::NAMES;
+use crate::engine::step::method::NAMES;
 use crate::engine::{EachEvent, Status};
 use crate::runner;
 use crate::scene::Reference;

@@ -20,7 +20,7 @@
 //!   the same transition back.
 //! - Situations: crossings in plain sight; one at `t = 0` (the state starts
 //!   on the surface, moving its way); one at `t_end` (fired, by the
-//!   convention of `src/engine/run_loop.rs`); two crossings a hair apart
+//!   convention of `src/engine/run/run_loop.rs`); two crossings a hair apart
 //!   (a dip below a peak, two roots inside one step); two guards on one
 //!   surface (simultaneous events: both fire, in file order, unless the
 //!   first changed the mode, whose copy of the surface counts as crossed);

@@ -50,7 +50,7 @@ fn links(text: &str) -> Vec<&str> {
         .collect()
 }
 
-/// The repository files `text` names by path (`src/engine/bound.rs`), but
+/// The repository files `text` names by path (`src/engine/bound/tracker.rs`), but
 /// placeholders (`src/engine/FILE.rs`) and patterns.
 fn named_files(text: &str) -> Vec<&str> {
     let is_path = |c: char| c.is_ascii_alphanumeric() || "_./-".contains(c);
@@ -100,12 +100,12 @@ fn the_readme_is_a_five_minute_read_that_links_every_page() {
 
 #[test]
 fn the_checks_see_what_they_look_for() {
-    let text = "see [the page](docs/a.md#part) and `src/engine/bound.rs`, \
+    let text = "see [the page](docs/a.md#part) and `src/engine/bound/tracker.rs`, \
                 src/engine/FILE.rs, [web](https://x.org) and tests/fixtures/x.json.";
     assert_eq!(links(text), ["docs/a.md"]);
     assert_eq!(
         named_files(text),
-        ["docs/a.md", "src/engine/bound.rs", "tests/fixtures/x.json"]
+        ["docs/a.md", "src/engine/bound/tracker.rs", "tests/fixtures/x.json"]
     );
     assert!(Path::new(&root()).join("README.md").exists());
 }

@@ -196,7 +196,7 @@ fn no_crossing_is_missed_or_misplaced_without_a_word() {
 }
 
 /// The linear propagator finds an affine guard's crossings on rows cached
-/// once per mode (`src/engine/affine_mode.rs`), not on the state's series:
+/// once per mode (`src/engine/step/affine_mode.rs`), not on the state's series:
 /// a guard that mixes the states and has a constant, `x - v / 2 - 0.3`
 /// on `x = cos t`, `v = -sin t`, i.e. `R cos(t - phi) - 0.3` with `R =
 /// sqrt(5) / 2` and `tan(phi) = 1 / 2`, must fire at exactly its closed

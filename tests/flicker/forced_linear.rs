@@ -1,6 +1,6 @@
 //! A flow affine in the state and driven by sines of the clock runs on the
 //! exact linear propagator, its sines carried as two more components (see
-//! `src/engine/affine_flow.rs`): checked against closed forms over long
+//! `src/engine/model/affine_flow.rs`): checked against closed forms over long
 //! runs, where the forcing's phase `w t` is large.
 
 use serde_json::{Value, json};

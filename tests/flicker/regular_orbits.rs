@@ -4,7 +4,7 @@
 //! by 1e-4 (the midpoint's exponential over long Taylor steps) or even
 //! 1e-7 splits the shear's double eigenvalue 1, and the bound then grows by
 //! a factor per period, or swings across the enclosure's frame (see
-//! `src/engine/tangent.rs`).
+//! `src/engine/bound/tangent.rs`).
 
 use crate::automata::{f, run_value};
 use serde_json::{Value, json};

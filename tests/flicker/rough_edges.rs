@@ -27,7 +27,7 @@ fn check(scene: &Value) -> Output {
 fn run_help_lists_every_method() {
     let help = flicker(&["run", "--help"]);
     let text = String::from_utf8_lossy(&help.stdout);
-    for method in flicker::engine::method::NAMES {
+    for method in flicker::engine::step::method::NAMES {
         assert!(text.contains(method), "{method} missing from:\n{text}");
     }
     let bad = flicker(&["run", "scene.json", "--method", "rk4"]);

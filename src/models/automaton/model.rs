@@ -18,7 +18,7 @@ use std::sync::Arc;
 
 use nalgebra::{DMatrix, DVector};
 
-use crate::engine::affine_flow::AffineFlow;
+use crate::engine::model::affine_flow::AffineFlow;
 use crate::engine::{Flow, Guard, HybridModel, Jump, Mode, Name};
 use crate::models::automaton::definition::{Definition, Source};
 use crate::models::automaton::expr::compiled::{CompiledFlows, CompiledTape};

@@ -3,12 +3,12 @@
 
 use std::sync::Arc;
 
-use crate::engine::integrator::{methods_for, runs};
-use crate::engine::method::cheapest;
-use crate::engine::zeno;
+use crate::engine::bound::zeno;
+use crate::engine::step::integrator::{methods_for, runs};
+use crate::engine::step::method::cheapest;
 use crate::engine::{
     EventTimes, Family, HybridModel, Method, Observer, Sample, Status, Tolerances,
-    simulate_sampled, taylor_method,
+    simulate_sampled, step::taylor_method,
 };
 use crate::models::automaton::definition::{Definition, Transition};
 use crate::models::automaton::model::Automaton;

@@ -8,7 +8,7 @@
 //! ODE is the same chain, and for the sizes a tool's dense derivatives
 //! make sense at (tens of units), as fast.
 
-use crate::engine::with_parameters::{WithParameters, positions};
+use crate::engine::model::with_parameters::{WithParameters, positions};
 use crate::engine::{Family, HybridModel, Mode, Promoted};
 use crate::models::chain::Chain;
 use crate::models::chain::scene::ChainScene;

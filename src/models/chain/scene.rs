@@ -27,7 +27,7 @@
 
 use serde_json::Value;
 
-use crate::engine::integrator::methods_for;
+use crate::engine::step::integrator::methods_for;
 use crate::engine::{Method, Observer, Tolerances};
 use crate::models::chain::Chain;
 use crate::runner::ensemble::{EnsembleReport, EnsembleRequest};

@@ -31,7 +31,7 @@
 //! (`cargo bench --bench chain`).
 
 use crate::engine::bound::ROUNDOFF_ULPS;
-use crate::engine::horizon::FRACTION;
+use crate::engine::bound::horizon::FRACTION;
 use crate::time::Time;
 
 use super::collide::Step;
@@ -436,8 +436,8 @@ impl Tangent {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::engine::saltation;
-    use crate::engine::tangent::guard_gradient;
+    use crate::engine::bound::saltation;
+    use crate::engine::bound::tangent::guard_gradient;
     use crate::engine::{HybridModel, Mode};
     use crate::models::chain::Chain;
     use crate::models::chain::collide::cascade_with;

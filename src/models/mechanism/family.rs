@@ -8,7 +8,7 @@
 //! `(eps, eps')`, so an orbit that returns on the other side is periodic
 //! in the strain ([`Family::same_motion`]).
 
-use crate::engine::with_parameters::{WithParameters, positions};
+use crate::engine::model::with_parameters::{WithParameters, positions};
 use crate::engine::{Family, HybridModel, Mode, Promoted};
 use crate::models::mechanism::angle::{self, AngleMechanism};
 use crate::models::mechanism::scene::{Formulation, Initial, MechanismScene};

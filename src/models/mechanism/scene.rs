@@ -28,8 +28,8 @@
 use std::f64::consts::FRAC_PI_2;
 
 use crate::engine::Observer;
-use crate::engine::integrator::{methods_for, runs};
-use crate::engine::zeno;
+use crate::engine::bound::zeno;
+use crate::engine::step::integrator::{methods_for, runs};
 use crate::engine::{HybridModel, Mode};
 use crate::engine::{Method, Name, Tolerances};
 use crate::models::mechanism::strain::{self, FLIGHT};

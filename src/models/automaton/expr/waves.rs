@@ -12,7 +12,7 @@
 use nalgebra::{DMatrix, DVector};
 
 use super::tape::{Fun, Op, Tape};
-use crate::engine::affine_flow::{AffineFlow, Wave};
+use crate::engine::model::affine_flow::{AffineFlow, Wave};
 
 /// The most distinct frequencies read (each adds two components to the
 /// propagator's state).

@@ -13,7 +13,7 @@
 
 use std::cell::RefCell;
 
-use crate::engine::taylor_method::MAX_ORDER;
+use crate::engine::step::taylor_method::MAX_ORDER;
 use crate::models::automaton::expr::compiled::layout::Layout;
 use crate::models::automaton::expr::compiled::machine::Code;
 use crate::models::automaton::expr::compiled::tiered::Tiered;

@@ -2,7 +2,7 @@
 //! and against closed forms.
 
 use super::*;
-use crate::engine::taylor_method::MAX_ORDER;
+use crate::engine::step::taylor_method::MAX_ORDER;
 use crate::models::automaton::expr::recurrences::Series;
 use crate::models::automaton::expr::recurrences::tests::tape;
 use crate::models::automaton::expr::tape::Op;
