@@ -105,7 +105,11 @@ fn the_checks_see_what_they_look_for() {
     assert_eq!(links(text), ["docs/a.md"]);
     assert_eq!(
         named_files(text),
-        ["docs/a.md", "src/engine/bound/tracker.rs", "tests/fixtures/x.json"]
+        [
+            "docs/a.md",
+            "src/engine/bound/tracker.rs",
+            "tests/fixtures/x.json"
+        ]
     );
     assert!(Path::new(&root()).join("README.md").exists());
 }

@@ -177,6 +177,10 @@ pub struct TrialError {
     pub norm: f64,
     /// The error's largest component, absolute.
     pub largest: f64,
+    /// The largest error a component may have in a trial that is
+    /// accepted: its tolerance, times the root of the dimension (the norm
+    /// is a root mean square).
+    pub allowed: f64,
 }
 
 impl StepControl {
@@ -250,9 +254,14 @@ impl StepControl {
             // step (x' = sin t near t = pi/2, DOP853 at rtol 1e-7), it falls
             // far below the error, which the next derivative makes (3.5
             // times it there). The error constant of the step before,
-            // where that step was held to its tolerance, stands in.
+            // where that step was held to its tolerance, stands in, up to
+            // the most this step's tolerance allows: near a singular point
+            // (the angle formulation's theta = 0) the constant of a short
+            // step there, carried to a long one past it, is not this
+            // step's error but thousands of times its tolerance.
             let scale = h.powi(self.order);
-            self.local_error = error.largest.max(self.constant * scale);
+            let held = (self.constant * scale).min(error.allowed);
+            self.local_error = error.largest.max(held);
             self.constant = if err >= MEANINGFUL && scale > 0.0 {
                 error.largest / scale
             } else {

@@ -355,7 +355,7 @@ impl EmbeddedPair for Dop853 {
         }
         let k = &self.k;
         let (mut err5, mut err3) = (0.0, 0.0);
-        let mut largest: f64 = 0.0;
+        let (mut largest, mut allowed) = (0.0_f64, 0.0_f64);
         for i in 0..y0.len() {
             let high: f64 = A[END].iter().map(|&(j, b)| b * k[j][i]).sum();
             self.y1[i] = y0[i] + h * high;
@@ -366,18 +366,22 @@ impl EmbeddedPair for Dop853 {
             err3 += (e3 / scale).powi(2);
             if i < self.control.bounded {
                 largest = largest.max(e5.abs());
+                allowed = allowed.max(scale);
             }
         }
         if self.y1.iter().any(|v| !v.is_finite()) || !(err5.is_finite() && err3.is_finite()) {
             return TrialError {
                 norm: f64::NAN,
                 largest: f64::NAN,
+                allowed: f64::NAN,
             };
         }
+        let allowed = allowed * (y0.len() as f64).sqrt();
         if err5 == 0.0 && err3 == 0.0 {
             return TrialError {
                 norm: 0.0,
                 largest: 0.0,
+                allowed,
             };
         }
         // Hairer's combination: |e5|^2 / sqrt(|e5|^2 + 0.01 |e3|^2) scales
@@ -386,6 +390,7 @@ impl EmbeddedPair for Dop853 {
         TrialError {
             norm: h * err5 / ((err5 + 0.01 * err3) * y0.len() as f64).sqrt(),
             largest: h * largest * damping,
+            allowed,
         }
     }
 

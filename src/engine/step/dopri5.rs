@@ -175,7 +175,7 @@ impl EmbeddedPair for Dopri5 {
             self.scratch = y;
         }
         let k = &self.k;
-        let (mut sum, mut largest) = (0.0, 0.0_f64);
+        let (mut sum, mut largest, mut allowed) = (0.0, 0.0_f64, 0.0_f64);
         for i in 0..y0.len() {
             let e = h
                 * (E1 * k[0][i]
@@ -188,6 +188,7 @@ impl EmbeddedPair for Dopri5 {
             sum += (e / scale).powi(2);
             if i < self.control.bounded {
                 largest = largest.max(e.abs());
+                allowed = allowed.max(scale);
             }
         }
         let blew_up = self.y1.iter().any(|v| !v.is_finite()) || k[6].iter().any(|v| !v.is_finite());
@@ -198,6 +199,7 @@ impl EmbeddedPair for Dopri5 {
                 (sum / y0.len() as f64).sqrt()
             },
             largest,
+            allowed: allowed * (y0.len() as f64).sqrt(),
         }
     }
 
