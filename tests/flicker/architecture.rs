@@ -36,7 +36,7 @@ const LAYERS: [&[&str]; 11] = [
     &["cli"],
 ];
 
-fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
+pub fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
     for entry in std::fs::read_dir(dir).unwrap() {
         let path = entry.unwrap().path();
         if path.is_dir() {
@@ -49,7 +49,7 @@ fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
 
 /// A file's code: its comments and every item under `#[cfg(test)]` (a
 /// test module, or one method) taken out, the rest whole.
-fn code(text: &str) -> String {
+pub fn code(text: &str) -> String {
     // What follows `//` is a comment (or, rarely, a string's URL: no
     // import is lost, since none follows one on the same line).
     let mut code: String = text
@@ -72,7 +72,7 @@ fn code(text: &str) -> String {
 }
 
 /// Where the brace opened at `open` in `text` closes.
-fn close_of(text: &str, open: usize) -> Option<usize> {
+pub fn close_of(text: &str, open: usize) -> Option<usize> {
     let mut depth = 0;
     for (i, c) in text[open..].char_indices() {
         match c {
@@ -119,7 +119,7 @@ fn imports(text: &str) -> BTreeSet<String> {
 }
 
 /// The comma-separated parts of `group` outside its inner braces.
-fn top_level(group: &str) -> Vec<&str> {
+pub fn top_level(group: &str) -> Vec<&str> {
     let (mut parts, mut depth, mut start) = (Vec::new(), 0, 0);
     for (i, c) in group.char_indices() {
         match c {

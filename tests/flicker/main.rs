@@ -1,6 +1,7 @@
 //! flicker's integration tests: one binary, one module per behaviour.
 
 mod architecture;
+mod architecture_inside;
 mod automata;
 mod automata_models;
 mod automata_tools;
