@@ -546,7 +546,7 @@ impl Linear {
 
     /// The truncation of one propagation's series: below 7e-21 of the
     /// state, nothing beside the step's rounding (which the engine adds:
-    /// see `STEP_ROUNDING_ULPS` in `src/engine/run/simulation.rs`) and, where
+    /// see `STEP_ROUNDING_ULPS` in `src/engine/run/simulation/bounds.rs`) and, where
     /// sines of the clock drive the flow, what their values' rounding at
     /// the step's start leaves ([`Linear::forcing_error`], which the engine
     /// adds to it).
