@@ -1,34 +1,14 @@
 //! The house inside each folder: read file by file, with every `crate::`,
 //! `super::` and `self::` path followed through the folder faces
 //! (`mod.rs` files that hand on their children's names) to the file that
-//! defines it, no files import each other in a circle, but those listed
-//! in [`KNOWN_CIRCLES`] (each to be closed; a listed circle that is gone
-//! must leave the list), and the engine's four parts point one way.
+//! defines it, no files import each other in a circle, and the engine's
+//! four parts point one way.
 //! `architecture.rs` holds the top-level modules.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 use crate::architecture::{close_of, code, rust_files, top_level};
-
-/// Circles that stand today, each a sorted list of files under `src/`:
-/// the four model kinds' scene adapters and what they run (issue "One
-/// door, four homes": the adapters move to `scenes/<kind>/`).
-const KNOWN_CIRCLES: [&[&str]; 4] = [
-    &["models/automaton/ensemble.rs", "models/automaton/scene.rs"],
-    &[
-        "models/chain/ensemble.rs",
-        "models/chain/family.rs",
-        "models/chain/run.rs",
-        "models/chain/scene.rs",
-    ],
-    &["models/continuum/run.rs", "models/continuum/scene.rs"],
-    &[
-        "models/mechanism/family.rs",
-        "models/mechanism/run.rs",
-        "models/mechanism/scene.rs",
-    ],
-];
 
 /// The engine's parts, lowest first: each imports only from those below.
 const ENGINE_PARTS: [&str; 4] = ["model", "bound", "step", "run"];
@@ -278,19 +258,9 @@ fn src() -> PathBuf {
 }
 
 #[test]
-fn no_files_import_each_other_in_a_circle_but_the_known() {
+fn no_files_import_each_other_in_a_circle() {
     let found = circles(&file_graph(&src()));
-    let known: Vec<Vec<String>> = KNOWN_CIRCLES
-        .iter()
-        .map(|c| c.iter().map(|s| s.to_string()).collect())
-        .collect();
-    let new: Vec<&Vec<String>> = found.iter().filter(|c| !known.contains(c)).collect();
-    let gone: Vec<&Vec<String>> = known.iter().filter(|c| !found.contains(c)).collect();
-    assert!(new.is_empty(), "files in a circle: {new:?}");
-    assert!(
-        gone.is_empty(),
-        "a known circle is closed: take it off the list: {gone:?}"
-    );
+    assert!(found.is_empty(), "files in a circle: {found:?}");
 }
 
 #[test]

@@ -71,6 +71,7 @@ mod family;
 pub mod filippov;
 pub mod model;
 pub mod scene;
+mod scene_model;
 
 pub use builder::{AutomatonBuilder, TransitionBuilder};
 pub use definition::Definition;

@@ -30,6 +30,7 @@ pub mod modal;
 pub mod ode;
 pub(crate) mod run;
 pub mod scene;
+mod scene_model;
 mod tangent;
 pub mod window_series;
 

@@ -24,6 +24,7 @@ pub mod hugoniot;
 pub mod rattle;
 pub(crate) mod run;
 pub mod scene;
+mod scene_model;
 
 pub use fronts::FrontTracking;
 pub use homogenized::Homogenized;

@@ -7,6 +7,7 @@ pub mod closed_form;
 pub mod family;
 pub(crate) mod run;
 pub mod scene;
+mod scene_model;
 pub mod strain;
 
 pub use angle::{AngleMechanism, Charts};

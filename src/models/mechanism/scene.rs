@@ -27,19 +27,16 @@
 
 use std::f64::consts::FRAC_PI_2;
 
-use crate::engine::Observer;
 use crate::engine::bound::zeno;
 use crate::engine::step::integrator::{methods_for, runs};
 use crate::engine::{HybridModel, Mode};
-use crate::engine::{Method, Name, Tolerances};
+use crate::engine::{Method, Tolerances};
 use crate::models::mechanism::strain::{self, FLIGHT};
-use crate::models::mechanism::{AngleMechanism, ExactOrbit, StrainMechanism, angle};
+use crate::models::mechanism::{AngleMechanism, StrainMechanism, angle};
 use crate::models::mechanism::{Charts, Mechanism, Phase};
-use crate::runner::{Control, Report, Trajectory};
-use crate::scene::Reference;
 use crate::scene::fields::{Fields, kind};
 use crate::scene::solver::{SolverSpec, check_steps};
-use crate::scene::{Scene, SceneError, SceneModel};
+use crate::scene::{Scene, SceneError};
 
 /// Which equations describe the mechanism.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -207,7 +204,7 @@ pub fn resolve_solver(
 
 /// `f` of the formulation's model and the modes a run of it may enter:
 /// what the engine's rules judge methods against.
-fn with_model<R>(
+pub(super) fn with_model<R>(
     formulation: Formulation,
     mechanism: Mechanism,
     f: impl FnOnce(&dyn HybridModel, &[Mode]) -> R,
@@ -287,119 +284,8 @@ fn initial(
     Ok(initial)
 }
 
-impl SceneModel for MechanismScene {
-    fn model(&self) -> &'static str {
-        "mechanism"
-    }
-
-    fn t_end(&self) -> f64 {
-        self.t_end
-    }
-
-    fn set_t_end(&mut self, t_end: f64) -> Result<(), SceneError> {
-        check_steps(self.method, t_end)?;
-        self.t_end = t_end;
-        Ok(())
-    }
-
-    fn solver(&self) -> &SolverSpec {
-        &self.solver
-    }
-
-    fn set_solver(&mut self, spec: SolverSpec) -> Result<(), SceneError> {
-        (self.method, self.tolerances) = resolve_solver(&spec, self.formulation, self.mechanism)?;
-        check_steps(self.method, self.t_end)?;
-        self.solver = spec;
-        Ok(())
-    }
-
-    fn methods(&self) -> Vec<&'static str> {
-        with_model(self.formulation, self.mechanism, |model, modes| {
-            methods_for(model, modes)
-        })
-    }
-
-    fn time_scale(&self) -> f64 {
-        std::f64::consts::TAU / self.mechanism.omega
-    }
-
-    fn describe(&self) -> Vec<String> {
-        let (eps, rate) = self.initial_strain;
-        let h0 = self.mechanism.energy(eps, rate);
-        let formulation = match self.formulation {
-            Formulation::Strain => "strain formulation",
-            Formulation::Angle(_) => "angle formulation",
-        };
-        vec![
-            format!("{formulation}, method {}", self.method.name()),
-            format!(
-                "eta {}, omega {}, t_end {}",
-                self.mechanism.eta, self.mechanism.omega, self.t_end
-            ),
-            format!(
-                "initial strain {eps:e}, strain rate {rate:e}, energy H0 = {h0:e}: {}",
-                regime(self.mechanism, h0, self.t_end)
-            ),
-        ]
-    }
-
-    fn run(&self, control: &Control, observer: &mut dyn Observer) -> Result<Report, SceneError> {
-        super::run::run(self, control, observer)
-    }
-
-    fn family(&self) -> Result<Box<dyn crate::engine::Family>, SceneError> {
-        Ok(Box::new(super::family::MechanismFamily::new(self)))
-    }
-
-    fn offers_samples(&self) -> bool {
-        true
-    }
-
-    fn sampled(
-        &self,
-        control: &Control,
-        times: &[f64],
-        observer: &mut dyn Observer,
-    ) -> Option<Result<Trajectory, SceneError>> {
-        Some(Trajectory::record(
-            vec![Name::new("strain"), Name::new("strain_rate")],
-            |on_sample| super::run::run_sampled(self, control, times, on_sample, observer),
-        ))
-    }
-
-    /// The closed form (46) of the strain with impacts every `T_imp`,
-    /// whatever the formulation (both describe the same `eps(t)`).
-    fn reference(&self) -> Result<Reference, SceneError> {
-        let (eps, rate) = self.initial_strain;
-        let orbit = ExactOrbit::new(self.mechanism, eps, rate);
-        let (e, r) = orbit.state_at(self.t_end);
-        Ok(Reference::new(
-            "closed form (46) of the strain, impacts every T_imp",
-            vec![e, r],
-            orbit.impacts_until(self.t_end),
-            move |k| orbit.impact_time(k),
-        ))
-    }
-
-    /// `T_imp` of an impacting orbit that impacts before `t_end`.
-    fn period(&self) -> Option<f64> {
-        let (eps, rate) = self.initial_strain;
-        let h0 = self.mechanism.energy(eps, rate);
-        let impacts = ExactOrbit::new(self.mechanism, eps, rate).impacts_until(self.t_end);
-        (h0 > 0.0 && impacts > 0).then(|| self.mechanism.impact_period(h0))
-    }
-
-    fn clone_box(&self) -> Box<dyn SceneModel> {
-        Box::new(self.clone())
-    }
-
-    fn as_any(&self) -> &dyn std::any::Any {
-        self
-    }
-}
-
 /// Which regime of docs/physics.md s.2 an orbit of energy `h0` is in.
-fn regime(m: Mechanism, h0: f64, t_end: f64) -> String {
+pub(super) fn regime(m: Mechanism, h0: f64, t_end: f64) -> String {
     let c = m.centre();
     let resolution = zeno::resolution(0.0, t_end);
     if h0 > 0.0 && m.impact_period(h0) <= resolution {
