@@ -1,5 +1,6 @@
-//! An automaton scene: the file's keys, and what it offers the tools
-//! ([`SceneModel`]). The format is in the [module doc](super).
+//! An automaton scene: the file's keys, read and checked (what it offers
+//! the tools is `scene_model.rs`). The format is in the [module
+//! doc](super).
 
 use std::sync::Arc;
 

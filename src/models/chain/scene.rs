@@ -1,5 +1,5 @@
-//! A chain scene (docs/physics.md s.4, scene units): its keys, and what it
-//! offers the tools ([`SceneModel`]).
+//! A chain scene (docs/physics.md s.4, scene units): its keys, read and
+//! checked (what it offers the tools is `scene_model.rs`).
 //!
 //! ```json
 //! {"model": "chain", "units": 200, "length": 2.0, "wave_speed": 1.0,

@@ -1,6 +1,6 @@
 //! A continuum scene, the chain scene's string without its units
-//! (docs/physics.md s.5, scene units): its keys, and what it offers the
-//! tools ([`SceneModel`]).
+//! (docs/physics.md s.5, scene units): its keys, read and checked (what it
+//! offers the tools is `scene_model.rs`).
 //!
 //! ```json
 //! {"model": "continuum", "variant": "paper", "length": 2.0, "wave_speed": 1.0,

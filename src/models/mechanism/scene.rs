@@ -1,6 +1,7 @@
-//! A mechanism scene: its keys, and what it offers the tools
-//! ([`SceneModel`]: its methods by the engine's rules, its regime for
-//! `check`, the closed form as the exact reference, the impact period).
+//! A mechanism scene: its keys, read and checked, and the helpers what it
+//! offers the tools (`scene_model.rs`: its methods by the engine's rules,
+//! its regime for `check`, the closed form as the exact reference, the
+//! impact period) is made of.
 //!
 //! ```json
 //! {"model": "mechanism", "formulation": "strain", "eta": 1.2, "omega": 1.0,
