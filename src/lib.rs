@@ -62,21 +62,15 @@
 
 #![deny(missing_docs)]
 
+pub mod analysis;
 pub mod cli;
 pub mod engine;
 pub mod log;
-pub mod lyapunov;
 pub mod models;
 pub mod numerics;
-pub mod orbit;
 pub mod plot;
 pub mod prelude;
-pub mod release_convergence;
 pub mod runner;
 pub mod scene;
-pub mod sensitivities;
 pub mod session;
-pub mod stress;
-pub mod sweep;
 pub mod time;
-pub mod work_precision;

@@ -9,11 +9,11 @@
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
+use crate::analysis::lyapunov::{self, Spectrum};
+use crate::analysis::orbit::continuation::Point;
+use crate::analysis::orbit::diagram::Column;
+use crate::analysis::orbit::{ContinuedBranch, Orbit, OrbitRequest, Watch};
 use crate::engine::{Family, Observer};
-use crate::lyapunov::{self, Spectrum};
-use crate::orbit::continuation::Point;
-use crate::orbit::diagram::Column;
-use crate::orbit::{ContinuedBranch, Orbit, OrbitRequest, Watch};
 use crate::runner::{Control, Report, Trajectory};
 use crate::scene::{Scene, SceneError};
 
@@ -32,7 +32,7 @@ impl RunRequest {
     /// (`sensitivities`, `samples`).
     pub fn check(&self, scene: &Scene) -> Result<(), SceneError> {
         if let Some(directions) = &self.sensitivities {
-            crate::sensitivities::check(scene, directions)?;
+            crate::analysis::sensitivities::check(scene, directions)?;
         }
         if self.times.is_some() && !scene.offers_samples() {
             return Err(SceneError::field(
@@ -53,12 +53,17 @@ impl RunRequest {
     ) -> Result<(Report, Option<Trajectory>), SceneError> {
         let sampled = |trajectory: Trajectory| (trajectory.report.clone(), Some(trajectory));
         match (&self.sensitivities, &self.times) {
-            (Some(directions), None) => {
-                crate::sensitivities::run(scene, directions, control, &[], &mut |_| {}, observer)
-                    .map(|report| (report, None))
-            }
+            (Some(directions), None) => crate::analysis::sensitivities::run(
+                scene,
+                directions,
+                control,
+                &[],
+                &mut |_| {},
+                observer,
+            )
+            .map(|report| (report, None)),
             (Some(directions), Some(times)) => {
-                crate::sensitivities::sampled(scene, directions, control, times, observer)
+                crate::analysis::sensitivities::sampled(scene, directions, control, times, observer)
                     .map(sampled)
             }
             (None, None) => scene.run(control, observer).map(|report| (report, None)),
@@ -196,14 +201,14 @@ pub struct Prepared<R> {
 }
 
 impl Prepared<OrbitRequest> {
-    /// The periodic orbit through the section (see [`crate::orbit::search`]).
+    /// The periodic orbit through the section (see [`crate::analysis::orbit::search`]).
     pub fn orbit(&self, watch: Watch<'_>) -> Result<Orbit, SceneError> {
-        crate::orbit::search(&*self.family, &self.request, self.t_max, watch)
+        crate::analysis::orbit::search(&*self.family, &self.request, self.t_max, watch)
     }
 
     /// The branch of orbits followed in `parameter` to `to`, at most
     /// `points` orbits, no step longer than `max_step` of the way (see
-    /// [`crate::orbit::follow`]); `on_point` hears of each orbit found.
+    /// [`crate::analysis::orbit::follow`]); `on_point` hears of each orbit found.
     pub fn branch(
         &self,
         parameter: &str,
@@ -211,7 +216,7 @@ impl Prepared<OrbitRequest> {
         steps: (usize, f64),
         on_point: &mut dyn FnMut(&Point),
     ) -> Result<ContinuedBranch, SceneError> {
-        crate::orbit::follow(
+        crate::analysis::orbit::follow(
             &*self.family,
             &self.request,
             parameter,
@@ -224,14 +229,14 @@ impl Prepared<OrbitRequest> {
 
     /// The brute-force diagram at each of `values` of `parameter`: the
     /// section's states over `events` returns after half the scene's span
-    /// (see [`crate::orbit::diagram::brute_force`]).
+    /// (see [`crate::analysis::orbit::diagram::brute_force`]).
     pub fn brute_force(
         &self,
         parameter: &str,
         values: &[f64],
         events: usize,
     ) -> Result<Vec<Column>, SceneError> {
-        crate::orbit::diagram::brute_force(
+        crate::analysis::orbit::diagram::brute_force(
             &*self.family,
             parameter,
             values,
@@ -243,7 +248,7 @@ impl Prepared<OrbitRequest> {
 }
 
 impl Prepared<lyapunov::Request> {
-    /// The spectrum (see [`crate::lyapunov::spectrum`]); `progress` hears
+    /// The spectrum (see [`crate::analysis::lyapunov::spectrum`]); `progress` hears
     /// of the time reached and the events so far.
     pub fn spectrum(&self, progress: &mut dyn FnMut(f64, u64)) -> Spectrum {
         lyapunov::spectrum(&*self.family, &self.request, progress)

@@ -8,7 +8,7 @@ fuzz_target!(|data: &[u8]| {
     let Ok(text) = std::str::from_utf8(data) else {
         return;
     };
-    let Ok(sweep) = flicker::sweep::parse_text(text, std::path::Path::new("/nonexistent"), &flicker::scene::Registry::builtin()) else {
+    let Ok(sweep) = flicker::analysis::sweep::parse_text(text, std::path::Path::new("/nonexistent"), &flicker::scene::Registry::builtin()) else {
         return;
     };
     for point in 0..sweep.points().min(4) {

@@ -153,7 +153,7 @@ fn run<'py>(
     }
     // After the method: whether it can carry the derivatives depends on it.
     if let Some(directions) = &sensitivities {
-        flicker::sensitivities::check(&scene, directions)
+        flicker::analysis::sensitivities::check(&scene, directions)
             .map_err(|e| override_error(py, "sensitivities", e.reason))?;
     }
     let times = match &t_eval {

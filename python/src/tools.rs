@@ -9,11 +9,11 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use serde_json::Value;
 
+use flicker::analysis::sweep::{Row as SweepRow, Shard, Sweep, is_sweep, parse_text};
+use flicker::analysis::work_precision::{Plan, compare as run_compare};
 use flicker::runner::Control;
 use flicker::scene::Registry;
 use flicker::session::{SearchRequest, SpectrumRequest};
-use flicker::sweep::{Row as SweepRow, Shard, Sweep, is_sweep, parse_text};
-use flicker::work_precision::{Plan, compare as run_compare};
 
 use crate::interrupt::interruptible;
 use crate::{load, override_error, scene_error};
@@ -101,7 +101,10 @@ pub fn compare<'py>(
         "status",
         PyList::new(py, rows.iter().map(|r| r.status.clone()))?,
     )?;
-    let numbers: [(&str, fn(&flicker::work_precision::Row) -> Option<f64>); 10] = [
+    let numbers: [(
+        &str,
+        fn(&flicker::analysis::work_precision::Row) -> Option<f64>,
+    ); 10] = [
         ("tolerance", |r| r.tolerance),
         ("step", |r| r.step),
         ("wall_seconds", |r| Some(r.wall_seconds)),
@@ -276,7 +279,7 @@ pub fn continuation<'py>(
     })?
     .map_err(|e| scene_error(py, &e))?;
     let out = PyDict::new(py);
-    let column = |f: &dyn Fn(&flicker::orbit::continuation::Point) -> f64| -> Vec<f64> {
+    let column = |f: &dyn Fn(&flicker::analysis::orbit::continuation::Point) -> f64| -> Vec<f64> {
         branch.points.iter().map(f).collect()
     };
     out.set_item("parameter", column(&|q| q.parameter).into_pyarray(py))?;

@@ -14,12 +14,12 @@
 
 use std::path::PathBuf;
 
-use crate::engine::Status;
-use crate::models::continuum::Variant;
-use crate::release_convergence::Release;
-use crate::release_convergence::{
+use crate::analysis::release_convergence::Release;
+use crate::analysis::release_convergence::{
     Track, chain_track, continuum_track, distance, release, without_homogenized,
 };
+use crate::engine::Status;
+use crate::models::continuum::Variant;
 use crate::runner::Control;
 use crate::scene::Registry;
 
@@ -53,7 +53,7 @@ pub fn advise(args: AdviseArgs, registry: &Registry) -> Result<Code, Failure> {
             args.scene.display()
         ))
     };
-    let units = match crate::release_convergence::release::described(&scene) {
+    let units = match crate::analysis::release_convergence::release::described(&scene) {
         Some(Release {
             units: Some(units), ..
         }) => units,

@@ -3,8 +3,8 @@
 
 use std::path::Path;
 
+use crate::analysis::sweep;
 use crate::scene::Registry;
-use crate::sweep;
 
 use crate::cli::exit::{Code, Failure};
 

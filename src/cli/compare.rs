@@ -3,8 +3,8 @@
 
 use std::path::{Path, PathBuf};
 
+use crate::analysis::work_precision::{Plan, Row, chart, compare as run_compare, write_csv};
 use crate::scene::Registry;
-use crate::work_precision::{Plan, Row, chart, compare as run_compare, write_csv};
 
 use crate::cli::exit::{Code, Failure};
 

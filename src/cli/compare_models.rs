@@ -4,12 +4,12 @@
 use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
 
+use crate::analysis::release_convergence::{
+    Model, chart, distance, files, release as release_of, run_all, without_homogenized,
+};
 use crate::engine::Status;
 use crate::log::summary::write_atomically;
 use crate::models::continuum::Variant;
-use crate::release_convergence::{
-    Model, chart, distance, files, release as release_of, run_all, without_homogenized,
-};
 use crate::runner::Control;
 use crate::scene::Registry;
 
@@ -29,7 +29,7 @@ pub struct CompareModelsArgs {
     )]
     units: Vec<usize>,
     /// Cells of the homogenized continuum.
-    #[arg(long, default_value_t = crate::release_convergence::DEFAULT_CELLS, value_name = "M")]
+    #[arg(long, default_value_t = crate::analysis::release_convergence::DEFAULT_CELLS, value_name = "M")]
     cells: usize,
     /// Sample times over [0, t_end] for the trace and the front.
     #[arg(long, default_value_t = 121, value_name = "S")]

@@ -6,9 +6,9 @@
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
+use crate::analysis::orbit::continuation::{Branch, Point};
+use crate::analysis::orbit::diagram::Column;
 use crate::engine::Name;
-use crate::orbit::continuation::{Branch, Point};
-use crate::orbit::diagram::Column;
 use crate::plot::draw::{Curve, Figure, Style};
 use crate::scene::Registry;
 use crate::session::SearchRequest;

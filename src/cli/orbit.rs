@@ -82,7 +82,7 @@ pub fn orbit(args: OrbitArgs, registry: &Registry) -> Result<Code, Failure> {
             eprintln!("  Newton iteration {k}: residual {residual:.3e}");
         }
     };
-    let watch = crate::orbit::Watch {
+    let watch = crate::analysis::orbit::Watch {
         transient: Some(&mut bar),
         newton: Some(&mut newton),
     };

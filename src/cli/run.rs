@@ -155,7 +155,7 @@ pub fn run(args: RunArgs, registry: &Registry) -> Result<Code, Failure> {
         })?;
     }
     if let Some(directions) = &sensitivities {
-        crate::sensitivities::check(&scene, directions)
+        crate::analysis::sensitivities::check(&scene, directions)
             .map_err(|e| Failure::bad_input(format!("--sensitivities: {}", e.reason)))?;
     }
     let ensemble = match ensemble.ensemble {

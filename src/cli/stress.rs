@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use crate::stress::{Verdict, cases, markdown, run_case, settings};
+use crate::analysis::stress::{Verdict, cases, markdown, run_case, settings};
 
 use crate::cli::exit::{Code, Failure};
 use crate::scene::Registry;

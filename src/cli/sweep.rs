@@ -6,7 +6,7 @@ use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use crate::sweep::{self, Shard};
+use crate::analysis::sweep::{self, Shard};
 
 use crate::cli::exit::{Code, Failure};
 use crate::scene::Registry;

@@ -21,16 +21,8 @@ const LAYERS: [&[&str]; 11] = [
     // Physics, each kind with its scene adapter and family.
     &["models"],
     &["plot"],
-    // Tools over any scene.
-    &[
-        "lyapunov",
-        "orbit",
-        "release_convergence",
-        "sensitivities",
-        "stress",
-        "sweep",
-        "work_precision",
-    ],
+    // The tools over any model, and those that measure methods and models.
+    &["analysis"],
     &["session"],
     &["prelude"],
     &["cli"],
@@ -240,10 +232,10 @@ fn every_import_points_down_and_no_circle_forms() {
 /// module without importing it; code does, in a `use` or inline.
 #[test]
 fn only_code_counts_as_an_import() {
-    let text = "//! [`x`]: crate::orbit::Orbit\nuse crate::engine::Mode;\n\
+    let text = "//! [`x`]: crate::analysis::orbit::Orbit\nuse crate::engine::Mode;\n\
                 use crate::{log::X, plot};\n\
                 fn f() { crate::models::load(p); } // crate::cli\n\
-                #[cfg(test)]\nmod tests { use crate::sweep; }\n";
+                #[cfg(test)]\nmod tests { use crate::analysis::sweep; }\n";
     let found: Vec<String> = imports(text).into_iter().collect();
     assert_eq!(found, ["engine", "log", "models", "plot"]);
 }

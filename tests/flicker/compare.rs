@@ -147,13 +147,14 @@ fn dop853_event_times_fall_with_its_tolerance() {
             "initial": {"energy": 0.1, "phase": "impact"}, "t_end": 100.0}"#,
     )
     .unwrap();
-    let plan = flicker::work_precision::Plan {
+    let plan = flicker::analysis::work_precision::Plan {
         methods: vec!["dop853".into()],
         tolerances: vec![1e-9, 1e-10, 1e-11, 1e-12, 1e-13],
         steps: None,
     };
     let (_, rows) =
-        flicker::work_precision::compare(&scene, &plan, &Default::default(), &mut |_| {}).unwrap();
+        flicker::analysis::work_precision::compare(&scene, &plan, &Default::default(), &mut |_| {})
+            .unwrap();
     let errors: Vec<f64> = rows
         .iter()
         .map(|r| r.max_event_time_error.unwrap())

@@ -4,10 +4,10 @@
 //! reading an end that moves too slowly), and scenes it cannot compare
 //! refused.
 
+use flicker::analysis::release_convergence::{Model, distance, release as release_of, run_all};
 use flicker::models as scene;
 use flicker::models::ContinuumScene;
 use flicker::models::continuum::Variant;
-use flicker::release_convergence::{Model, distance, release as release_of, run_all};
 use flicker::runner::Control;
 
 use crate::support::{flicker, models, read_json};
@@ -38,7 +38,7 @@ fn the_paper_continuum_front_runs_at_c_and_its_free_end_lags_the_chain() {
     // The chain's end is traction-free: until the wall is reached its
     // momentum is -(1.1 - 0) t, and its end falls far faster than the
     // paper's continuum (held at eps = 0, end speed 0.1).
-    let at = |track: &flicker::release_convergence::Track, t: f64| {
+    let at = |track: &flicker::analysis::release_convergence::Track, t: f64| {
         track
             .samples
             .iter()

@@ -16,7 +16,11 @@ fn regression(name: &str) -> String {
 fn a_sweep_axis_with_a_huge_count_is_refused_before_allocating() {
     // count 100997777777777798 made the sweep parser allocate exabytes.
     let text = regression("sweep_huge_count.json");
-    let error = flicker::sweep::parse_text(&text, Path::new("/nonexistent"), &Registry::builtin())
-        .unwrap_err();
+    let error = flicker::analysis::sweep::parse_text(
+        &text,
+        Path::new("/nonexistent"),
+        &Registry::builtin(),
+    )
+    .unwrap_err();
     assert!(error.to_string().contains("count"), "{error}");
 }

@@ -49,7 +49,7 @@ fn bundled(dir: &Path, under: &str, out: &mut BTreeMap<String, PathBuf>) {
 /// the summary's results.
 fn written(scene: &Path, out: &Path) -> Value {
     let text = std::fs::read_to_string(scene).unwrap();
-    let is_sweep = flicker::sweep::is_sweep(&serde_json::from_str(&text).unwrap());
+    let is_sweep = flicker::analysis::sweep::is_sweep(&serde_json::from_str(&text).unwrap());
     let mut record = Map::new();
     if is_sweep {
         let csv = out.join("sweep.csv");

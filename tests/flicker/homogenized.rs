@@ -135,7 +135,7 @@ fn a_homogenized_scene_runs_and_says_what_it_used() {
 fn against_the_traction_free_chain_it_meets_the_figures_the_issue_sets() {
     // Chain N = 200 (its own plateau within 0.2% of N = 1600's) and the
     // homogenized string on 100 cells, to just past the wave's return.
-    use flicker::release_convergence::{Model, distance, release, run_all};
+    use flicker::analysis::release_convergence::{Model, distance, release, run_all};
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("models/continuum_release_free_end.json");
     let mut release = release(&scene::load(&path).unwrap()).unwrap().string;

@@ -205,7 +205,7 @@ fn unknown_directions_are_refused() {
         .from_value(&read("mechanism.json"))
         .unwrap();
     let check = |scene: &flicker::scene::Scene, name: &str| {
-        flicker::sensitivities::check(scene, &[name.to_string()]).unwrap_err()
+        flicker::analysis::sensitivities::check(scene, &[name.to_string()]).unwrap_err()
     };
     let err = check(&scene, "etta");
     assert!(err.reason.contains("no parameter is called `etta`") && err.reason.contains("eta"));

@@ -6,8 +6,8 @@
 
 use std::path::Path;
 
+use flicker::analysis::stress::{Row, Verdict, cases, run_case, settings};
 use flicker::scene::Registry;
-use flicker::stress::{Row, Verdict, cases, run_case, settings};
 
 /// Per-run budget here; `flicker stress` uses 10 s for docs/stress.md.
 const WALL: f64 = 2.0;
@@ -234,7 +234,7 @@ fn bounds_stay_within_twice_their_recorded_ratio() {
 }
 
 /// The bundled automata, measured against their closed forms where they
-/// have one (`src/stress/closed_forms.rs`): no method is silently wrong or
+/// have one (`src/analysis/stress/closed_forms.rs`): no method is silently wrong or
 /// beyond its own bound, and the methods exact to round-off pass.
 #[test]
 fn no_automaton_is_silently_wrong_against_its_closed_form() {

@@ -11,7 +11,7 @@
 //! the zero stands still or the orbits come too near the graze for the
 //! section map (whose Jacobian grows as `1 / q`) to correct them.
 
-use crate::orbit::section::Section;
+use crate::analysis::orbit::section::Section;
 
 /// The guard's rate at `x` just after a section event in `mode`, by
 /// central differences along the flow (exact for an affine guard).

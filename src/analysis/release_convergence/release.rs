@@ -2,10 +2,10 @@
 //! scene the comparison runs every model from: a chain's string without
 //! its units, or a continuum scene itself, on the comparison's cells.
 
+use crate::analysis::release_convergence::DEFAULT_CELLS;
 use crate::models::chain::scene::ChainScene;
 use crate::models::continuum::scene::ContinuumScene;
 use crate::models::continuum::{Piece, Variant};
-use crate::release_convergence::DEFAULT_CELLS;
 use crate::scene::{Scene, SceneError};
 
 /// What a chain or continuum scene says of the release it describes.

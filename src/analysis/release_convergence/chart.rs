@@ -6,30 +6,31 @@
 
 use std::path::{Path, PathBuf};
 
+use crate::analysis::release_convergence::{Model, Track};
 use crate::models::chain::coarse::Coarse;
 use crate::models::continuum::Variant;
 use crate::plot::draw::{Curve, Figure, Style};
-use crate::release_convergence::{Model, Track};
 
 /// Draw every picture into `dir` (SVG and PNG); `reference` is the index of
 /// the densest chain in `tracks`. Returns the files written.
 pub fn draw_all(tracks: &[Track], reference: usize, dir: &Path) -> Result<Vec<PathBuf>, String> {
-    let over_time = |value: fn(&crate::release_convergence::Sample) -> Option<f64>| -> Vec<Curve> {
-        tracks
-            .iter()
-            .enumerate()
-            .map(|(i, track)| Curve {
-                label: Some(track.label.clone()),
-                points: track
-                    .samples
-                    .iter()
-                    .filter_map(|s| Some((s.t, value(s)?)))
-                    .collect(),
-                style: style(track.model, i),
-            })
-            .filter(|c| !c.points.is_empty())
-            .collect()
-    };
+    let over_time =
+        |value: fn(&crate::analysis::release_convergence::Sample) -> Option<f64>| -> Vec<Curve> {
+            tracks
+                .iter()
+                .enumerate()
+                .map(|(i, track)| Curve {
+                    label: Some(track.label.clone()),
+                    points: track
+                        .samples
+                        .iter()
+                        .filter_map(|s| Some((s.t, value(s)?)))
+                        .collect(),
+                    style: style(track.model, i),
+                })
+                .filter(|c| !c.points.is_empty())
+                .collect()
+        };
     let mut figures = vec![
         (
             "right_end".to_string(),

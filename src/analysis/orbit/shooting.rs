@@ -11,9 +11,9 @@
 
 use nalgebra::{DMatrix, DVector};
 
+use crate::analysis::orbit::section::{Return, Section};
 use crate::engine::Mode;
 use crate::engine::model::names::Name;
-use crate::orbit::section::{Return, Section};
 
 /// Newton iterations at most.
 pub const MAX_ITERATIONS: usize = 30;

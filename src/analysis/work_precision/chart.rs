@@ -6,8 +6,8 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
+use crate::analysis::work_precision::Row;
 use crate::plot::draw::PALETTE;
-use crate::work_precision::Row;
 
 /// Errors below this are drawn at it (an exact method can hit zero).
 const ERROR_FLOOR: f64 = 1e-17;

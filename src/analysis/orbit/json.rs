@@ -5,7 +5,7 @@ use std::path::Path;
 
 use serde_json::{Value, json};
 
-use crate::orbit::Orbit;
+use crate::analysis::orbit::Orbit;
 
 impl Orbit {
     /// The contents of `orbit.json`: the orbit found in `scene` through

@@ -13,7 +13,7 @@ use std::path::Path;
 
 use serde_json::{Value, json};
 
-use crate::release_convergence::{Distance, Track};
+use crate::analysis::release_convergence::{Distance, Track};
 
 fn optional(x: Option<impl ToString>) -> String {
     x.map_or(String::new(), |x| x.to_string())

@@ -25,7 +25,7 @@
 //! **Grazing**, the orbit touching a guard tangentially: the impact speed
 //! is watched along the branch, and where it falls to zero within the
 //! next step the grazing parameter is solved for directly
-//! ([`crate::orbit::grazing`]); the branch of impacting orbits
+//! ([`crate::analysis::orbit::grazing`]); the branch of impacting orbits
 //! ends there, labelled, saying on which side they exist. A corrector that
 //! meets a graze first (a section map that cannot tell whether an event
 //! fires), or whose steps shrink to nothing, ends the branch too: at the
@@ -36,10 +36,10 @@
 
 use nalgebra::{DMatrix, DVector};
 
+use crate::analysis::orbit::grazing;
+use crate::analysis::orbit::section::{Return, Section};
+use crate::analysis::orbit::shooting::{Unknowns, least_squares, multipliers};
 use crate::engine::Mode;
-use crate::orbit::grazing;
-use crate::orbit::section::{Return, Section};
-use crate::orbit::shooting::{Unknowns, least_squares, multipliers};
 
 /// Newton iterations of a corrector at most.
 const CORRECTOR_ITERATIONS: usize = 8;

@@ -9,8 +9,8 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 
+use crate::analysis::orbit::{Section, start};
 use crate::engine::Family;
-use crate::orbit::{Section, start};
 use crate::scene::SceneError;
 
 /// The section states seen at one value of the parameter.
