@@ -65,6 +65,7 @@
 pub mod analysis;
 pub mod cli;
 pub mod engine;
+pub mod expr;
 pub mod log;
 pub mod models;
 pub mod numerics;

@@ -8,12 +8,15 @@ use std::path::{Path, PathBuf};
 
 /// The layers, lowest first: a module may import from any lower layer,
 /// none from its own or a higher one.
-const LAYERS: [&[&str]; 11] = [
+const LAYERS: [&[&str]; 12] = [
     &["numerics"],
     // The run's clock, a double-double of numerics' error-free sums.
     &["time"],
     // The generic engine and the model interface the tools ask (Family).
     &["engine"],
+    // The expression compiler and its JIT: automata's flows as tapes,
+    // series and machine code.
+    &["expr"],
     // What a run returns and what controls it.
     &["runner"],
     // Scene files and what every kind of scene offers; the event log.

@@ -6,8 +6,8 @@
 use serde_json::{Map, Value};
 
 use crate::engine::Direction;
-use crate::models::automaton::expr::symbolic::{constant, never_zero, same};
-use crate::models::automaton::expr::{Ast, Scope, Tape, parse};
+use crate::expr::symbolic::{constant, never_zero, same};
+use crate::expr::{Ast, Scope, Tape, parse};
 use crate::scene::SceneError;
 use crate::scene::fields::{Fields, kind};
 
@@ -222,7 +222,7 @@ impl Definition {
         names: &[String],
         field: &str,
     ) -> Result<(Definition, Vec<Vec<f64>>), SceneError> {
-        use crate::models::automaton::expr::derivative::jacobian;
+        use crate::expr::derivative::jacobian;
         let known: Vec<&str> = self.parameters.iter().map(|(p, _)| p.as_str()).collect();
         let mut promoted = self.clone();
         let mut slopes = Vec::new();
@@ -455,7 +455,7 @@ fn initial(
     states: &[String],
     parameters: &[(String, f64)],
 ) -> Result<Vec<(f64, Source)>, SceneError> {
-    use crate::models::automaton::expr::{Scope, Tape};
+    use crate::expr::{Scope, Tape};
     let path = f.path("initial");
     let map = object(f.required("initial")?, &path)?;
     let names: Vec<&str> = states.iter().map(String::as_str).collect();

@@ -36,11 +36,11 @@
 //! applied on the spot). So does the start.
 
 use crate::engine::Direction;
-use crate::models::automaton::definition::{Definition, ModeDef, Rest, Source, Transition};
-use crate::models::automaton::expr::Ast;
-use crate::models::automaton::expr::symbolic::{
+use crate::expr::Ast;
+use crate::expr::symbolic::{
     add, constant, derivative, div, fix_signs, mul, same, sign_arguments, sub, text,
 };
+use crate::models::automaton::definition::{Definition, ModeDef, Rest, Source, Transition};
 use crate::scene::SceneError;
 
 /// The most switching surfaces one mode's flow may read (`2^4` regions).

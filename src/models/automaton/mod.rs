@@ -66,7 +66,6 @@
 pub mod builder;
 pub mod definition;
 pub mod ensemble;
-pub mod expr;
 mod family;
 pub mod filippov;
 pub mod model;

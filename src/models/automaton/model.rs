@@ -20,11 +20,11 @@ use nalgebra::{DMatrix, DVector};
 
 use crate::engine::model::affine_flow::AffineFlow;
 use crate::engine::{Flow, Guard, HybridModel, Jump, Mode, Name};
+use crate::expr::compiled::{CompiledFlows, CompiledTape};
+use crate::expr::derivative::{jacobian, jacobian_into, jacobian_tape};
+use crate::expr::recurrences::Series;
+use crate::expr::{Ast, Scope, Tape, waves};
 use crate::models::automaton::definition::{Definition, Source};
-use crate::models::automaton::expr::compiled::{CompiledFlows, CompiledTape};
-use crate::models::automaton::expr::derivative::{jacobian, jacobian_into, jacobian_tape};
-use crate::models::automaton::expr::recurrences::Series;
-use crate::models::automaton::expr::{Ast, Scope, Tape, waves};
 use crate::models::automaton::filippov::{self, Target};
 use crate::scene::SceneError;
 
@@ -84,7 +84,7 @@ struct CompiledMode {
     rough: Option<String>,
 }
 
-/// A mode's tapes compiled (see [`crate::models::automaton::expr::compiled`]),
+/// A mode's tapes compiled (see [`crate::expr::compiled`]),
 /// each once a run has asked for it often enough to repay it.
 #[derive(Debug, Default)]
 struct ModeCode {
@@ -399,8 +399,7 @@ impl Automaton {
             let second_order = !clock
                 && n % 2 == 0
                 && (0..half).all(|i| {
-                    flow.ops[flow.outputs[i] as usize]
-                        == crate::models::automaton::expr::Op::Input((half + i) as u32)
+                    flow.ops[flow.outputs[i] as usize] == crate::expr::Op::Input((half + i) as u32)
                 })
                 && (half..n).all(|i| (half..n).all(|j| !flow.depends_on(i, j as u32)));
             let rough = if flow.smooth() {

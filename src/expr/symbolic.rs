@@ -9,8 +9,8 @@
 //! `1 * a`), which keeps the derivatives of the usual surfaces (a state, a
 //! state minus a constant) as small as a hand would write them.
 
-use crate::models::automaton::expr::Ast;
-use crate::models::automaton::expr::parse::Binary;
+use crate::expr::Ast;
+use crate::expr::parse::Binary;
 
 /// `a + b`.
 pub fn add(a: Ast, b: Ast) -> Ast {
@@ -413,14 +413,14 @@ pub fn text(ast: &Ast) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::models::automaton::expr::parse;
+    use crate::expr::parse;
 
     fn eval(ast: &Ast, x: f64) -> f64 {
-        let scope = crate::models::automaton::expr::Scope {
+        let scope = crate::expr::Scope {
             inputs: vec!["x".into()],
             constants: vec![("c".into(), 0.7)],
         };
-        let tape = crate::models::automaton::expr::Tape::compile(&[ast], &scope).unwrap();
+        let tape = crate::expr::Tape::compile(&[ast], &scope).unwrap();
         tape.eval1(&[x])
     }
 

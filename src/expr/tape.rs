@@ -15,7 +15,7 @@ use std::cell::RefCell;
 
 use rustc_hash::FxHashMap;
 
-use crate::models::automaton::expr::parse::{Ast, Binary};
+use crate::expr::parse::{Ast, Binary};
 
 /// A function of one argument.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -618,7 +618,7 @@ fn prune(ops: Vec<Op>, outputs: Vec<Reg>) -> Tape {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::models::automaton::expr::parse::parse;
+    use crate::expr::parse::parse;
 
     fn scope() -> Scope {
         Scope {

@@ -14,9 +14,9 @@ use std::cell::RefCell;
 
 use nalgebra::DMatrix;
 
-use crate::models::automaton::expr::Ast;
-use crate::models::automaton::expr::symbolic::derivative;
-use crate::models::automaton::expr::tape::{Fun, Fun2, Op, Reg, Scope, Tape};
+use crate::expr::Ast;
+use crate::expr::symbolic::derivative;
+use crate::expr::tape::{Fun, Fun2, Op, Reg, Scope, Tape};
 
 /// The Jacobian (outputs x `n` inputs) of `tape` at `x`.
 pub fn jacobian(tape: &Tape, x: &[f64]) -> DMatrix<f64> {
@@ -167,8 +167,8 @@ fn slopes(f: Fun2, a: f64, b: f64, fab: f64) -> (f64, f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::models::automaton::expr::parse::parse;
-    use crate::models::automaton::expr::tape::Scope;
+    use crate::expr::parse::parse;
+    use crate::expr::tape::Scope;
 
     /// Every function's derivative against a central difference.
     #[test]

@@ -6,10 +6,10 @@
 
 use std::cell::RefCell;
 
-use crate::models::automaton::expr::compiled::layout::Layout;
-use crate::models::automaton::expr::compiled::machine::Code;
-use crate::models::automaton::expr::compiled::tiered::Tiered;
-use crate::models::automaton::expr::tape::{Op, Tape};
+use crate::expr::compiled::layout::Layout;
+use crate::expr::compiled::machine::Code;
+use crate::expr::compiled::tiered::Tiered;
+use crate::expr::tape::{Op, Tape};
 
 /// A tape's evaluation, compiled once warmed up (see `tiered.rs`). It
 /// belongs to one tape: the one each [`CompiledTape::eval`] is given.
@@ -126,14 +126,14 @@ fn lower(_: &Tape, _: &Layout) -> Option<Code> {
 /// `f(a)`, `f` the `kind`-th of the tape's functions of one argument.
 #[cfg(target_arch = "x86_64")]
 extern "sysv64" fn call(kind: u32, a: f64, _: *mut f64, _: *mut f64) -> f64 {
-    use crate::models::automaton::expr::tape::FUNS;
+    use crate::expr::tape::FUNS;
     FUNS[kind as usize].1.apply(a)
 }
 
 /// `f(a, b)`, `f` the `kind`-th of the tape's functions of two.
 #[cfg(target_arch = "x86_64")]
 extern "sysv64" fn call2(kind: u32, a: f64, b: f64, _: *mut f64, _: *mut f64) -> f64 {
-    use crate::models::automaton::expr::tape::FUNS2;
+    use crate::expr::tape::FUNS2;
     FUNS2[kind as usize].1.apply(a, b)
 }
 
@@ -145,9 +145,9 @@ extern "sysv64" fn pow(_: u32, a: f64, b: f64, _: *mut f64, _: *mut f64) -> f64 
 
 #[cfg(target_arch = "x86_64")]
 fn lower(tape: &Tape, layout: &Layout) -> Option<Code> {
-    use crate::models::automaton::expr::compiled::layout::Place;
-    use crate::models::automaton::expr::compiled::machine::Emitter;
-    use crate::models::automaton::expr::tape::{FUNS, FUNS2};
+    use crate::expr::compiled::layout::Place;
+    use crate::expr::compiled::machine::Emitter;
+    use crate::expr::tape::{FUNS, FUNS2};
 
     let mut e = Emitter::new(layout.extents(tape.outputs.len()))?;
     let anywhere = layout.output(0);

@@ -9,15 +9,15 @@
 //! calling Rust's own (the interpreter's), its higher orders by its
 //! recurrence.
 //!
-//! [`Series::flow`]: crate::models::automaton::expr::recurrences::Series::flow
+//! [`Series::flow`]: crate::expr::recurrences::Series::flow
 
 use std::cell::RefCell;
 
 use crate::engine::step::taylor_method::MAX_ORDER;
-use crate::models::automaton::expr::compiled::layout::Layout;
-use crate::models::automaton::expr::compiled::machine::Code;
-use crate::models::automaton::expr::compiled::tiered::Tiered;
-use crate::models::automaton::expr::tape::{Op, Reg, Tape};
+use crate::expr::compiled::layout::Layout;
+use crate::expr::compiled::machine::Code;
+use crate::expr::compiled::tiered::Tiered;
+use crate::expr::tape::{Op, Reg, Tape};
 
 /// A flow's series at each order, compiled once warmed up (see
 /// `tiered.rs`; a run asks for one order, a sweep over tolerances for a
@@ -75,7 +75,7 @@ impl CompiledFlow {
     /// [`Series::flow`]); `None` where the tape, its size or the processor
     /// is not one this compiles.
     ///
-    /// [`Series::flow`]: crate::models::automaton::expr::recurrences::Series::flow
+    /// [`Series::flow`]: crate::expr::recurrences::Series::flow
     pub fn new(tape: &Tape, order: usize) -> Option<CompiledFlow> {
         let states = tape.outputs.len();
         let inputs_in_range = tape.ops.iter().all(|op| match op {
@@ -100,7 +100,7 @@ impl CompiledFlow {
     /// The series from `x0` into `out`, laid out as [`Series::flow`]
     /// writes it (`out[i * (order + 1) + k]`).
     ///
-    /// [`Series::flow`]: crate::models::automaton::expr::recurrences::Series::flow
+    /// [`Series::flow`]: crate::expr::recurrences::Series::flow
     pub fn flow(&self, x0: &[f64], out: &mut [f64]) {
         let w = self.width;
         assert!(
@@ -220,9 +220,9 @@ extern "sysv64" fn origin(kind: u32, a: f64, value: *mut f64, partner: *mut f64)
 /// not compile.
 #[cfg(target_arch = "x86_64")]
 fn lower(tape: &Tape, layout: &Layout, order: usize) -> Option<Code> {
-    use crate::models::automaton::expr::compiled::layout::Base;
-    use crate::models::automaton::expr::compiled::machine::Emitter;
-    use crate::models::automaton::expr::tape::Fun;
+    use crate::expr::compiled::layout::Base;
+    use crate::expr::compiled::machine::Emitter;
+    use crate::expr::tape::Fun;
 
     let mut e = Emitter::new(layout.extents(0))?;
     let constant = |r: u32| matches!(tape.ops[r as usize], Op::Const(_));

@@ -3,9 +3,9 @@
 
 use super::*;
 use crate::engine::step::taylor_method::MAX_ORDER;
-use crate::models::automaton::expr::recurrences::Series;
-use crate::models::automaton::expr::recurrences::tests::tape;
-use crate::models::automaton::expr::tape::Op;
+use crate::expr::recurrences::Series;
+use crate::expr::recurrences::tests::tape;
+use crate::expr::tape::Op;
 
 /// Both series of `texts` from `x0`, bit for bit, at a few orders.
 fn same_as_interpreted(texts: &[&str], inputs: &[&str], x0: &[f64]) {
@@ -367,7 +367,7 @@ proptest! {
 /// here apart from the interpreter's recurrences (`recurrences.rs`) and the
 /// compiled code: the reference the interpreter's series are held to.
 mod reference {
-    use crate::models::automaton::expr::parse::{Ast, Binary};
+    use crate::expr::parse::{Ast, Binary};
     use twofloat::TwoFloat as D;
 
     fn times(a: &[D], b: &[D]) -> Vec<D> {
@@ -503,7 +503,7 @@ proptest! {
         prop_assume!(series.iter().all(|c| c.is_finite()));
         let asts: Vec<_> = texts
             .iter()
-            .map(|t| crate::models::automaton::expr::parse::parse(t).unwrap())
+            .map(|t| crate::expr::parse::parse(t).unwrap())
             .collect();
         let reference = reference::flow(&asts, &names, &x0, order);
         for (i, want) in reference.iter().enumerate() {

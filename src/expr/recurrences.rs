@@ -18,7 +18,7 @@
 //! method that trusts a whole step to one series must not take them (see
 //! [`Tape::smooth`]).
 
-use crate::models::automaton::expr::tape::{Fun, Fun2, Op, Reg, Tape};
+use crate::expr::tape::{Fun, Fun2, Op, Reg, Tape};
 
 /// Scratch for the series of one tape.
 #[derive(Debug, Clone, Default)]
@@ -499,8 +499,8 @@ fn constant(tape: &Tape, r: u32) -> bool {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
-    use crate::models::automaton::expr::parse::parse;
-    use crate::models::automaton::expr::tape::Scope;
+    use crate::expr::parse::parse;
+    use crate::expr::tape::Scope;
 
     /// The tape of `texts` over `inputs`, with a constant `c = 0.3`.
     pub(crate) fn tape(texts: &[&str], inputs: &[&str]) -> Tape {

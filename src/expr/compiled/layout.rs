@@ -13,7 +13,7 @@
 //!   then zeros), the integers up to `width` that the recurrences divide
 //!   and weigh by, and `-1`.
 
-use crate::models::automaton::expr::tape::{Op, Reg, Tape};
+use crate::expr::tape::{Op, Reg, Tape};
 
 /// One of the buffers the compiled code is given.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

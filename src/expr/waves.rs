@@ -181,8 +181,8 @@ pub fn driven(flow: &Tape, n: usize, clock: usize) -> Option<AffineFlow> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::models::automaton::expr::parse::parse;
-    use crate::models::automaton::expr::{Ast, Scope};
+    use crate::expr::parse::parse;
+    use crate::expr::{Ast, Scope};
 
     /// `texts` as the flow of `[x, v, t]`, the clock last.
     fn flow(texts: &[&str]) -> Tape {

@@ -39,7 +39,7 @@ mod x64 {
     use dynasmrt::x64::Assembler;
     use dynasmrt::{AssemblyOffset, DynasmApi, ExecutableBuffer, dynasm};
 
-    use crate::models::automaton::expr::compiled::layout::{Base, Place};
+    use crate::expr::compiled::layout::{Base, Place};
 
     /// Compiled code: one function of three buffers.
     pub struct Code {
