@@ -6,7 +6,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
 use flicker::log::columns::EventColumns;
-use flicker::runner::{FieldOutputs, Profile, TraceRow, Trajectory};
+use flicker::session::{FieldOutputs, Profile, TraceRow, Trajectory};
 
 /// The events as a dict: `seq` (uint64), `t`, `energy_before`,
 /// `energy_after` (float64), `guard`, `mode_before`, `mode_after` (uint32

@@ -27,15 +27,14 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use flicker::engine::{EventRecord, Observer};
 use flicker::log::JsonlWriter;
 use flicker::log::columns::EventColumns;
 use flicker::log::size_notice::{FIRST_NOTICE, LogSize};
 use flicker::log::summary::summary;
-use flicker::runner::Control;
-use flicker::scene::solver::SolverSpec;
-use flicker::scene::{Registry, Scene, SceneError as EngineSceneError};
-use flicker::session::RunRequest;
+use flicker::session::{
+    Ask, EventRecord, Observer, Registry, RunRequest, Samples, Scene,
+    SceneError as EngineSceneError, SolverSpec, Status,
+};
 
 create_exception!(
     _flicker,
@@ -134,43 +133,34 @@ fn run<'py>(
     t_eval: Option<Vec<f64>>,
     past_horizon: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let (mut scene, label) = load(py, text, path)?;
-    if let Some(t) = t_end {
-        scene
-            .set_t_end(t)
-            .map_err(|e| override_error(py, "t_end", e.reason))?;
-    }
-    let solver = SolverSpec {
-        method,
-        rtol,
-        atol,
-        step,
+    let (scene, label) = load(py, text, path)?;
+    let request = RunRequest {
+        t_end,
+        solver: SolverSpec {
+            method,
+            rtol,
+            atol,
+            step,
+        },
+        sensitivities,
+        samples: t_eval.map(Samples::At),
+        ensemble: None,
+        past_horizon,
     };
-    if solver != SolverSpec::default() {
-        scene
-            .override_solver(&solver)
-            .map_err(|e| override_error(py, "method/rtol/atol/step", e.to_string()))?;
-    }
-    // After the method: whether it can carry the derivatives depends on it.
-    if let Some(directions) = &sensitivities {
-        flicker::analysis::sensitivities::check(&scene, directions)
-            .map_err(|e| override_error(py, "sensitivities", e.reason))?;
-    }
-    let times = match &t_eval {
-        None => None,
-        Some(at) => {
-            let times = flicker::log::samples::times(None, Some(at), scene.t_end())
-                .map_err(|why| override_error(py, "t_eval", why))?;
-            if !scene.offers_samples() {
-                return Err(override_error(
-                    py,
-                    "t_eval",
-                    format!("a {} scene offers no samples of its state", scene.model()),
-                ));
+    let run = request
+        .prepare(scene)
+        .map_err(|refused| match refused.ask {
+            Ask::Solver => override_error(py, "method/rtol/atol/step", refused.error.to_string()),
+            ask => {
+                let keyword = match ask {
+                    Ask::TEnd => "t_end",
+                    Ask::Sensitivities => "sensitivities",
+                    Ask::Ensemble => "ensemble",
+                    Ask::Samples | Ask::Solver => "t_eval",
+                };
+                override_error(py, keyword, refused.error.reason)
             }
-            Some(times)
-        }
-    };
+        })?;
     let writer = match log {
         None => None,
         Some(file) => Some(JsonlWriter::new(LogSize::new(
@@ -186,25 +176,16 @@ fn run<'py>(
         log: writer,
     };
     let stop = Arc::new(AtomicBool::new(false));
-    let control = Control {
-        stop: Some(stop.clone()),
-        max_wall_seconds: None,
-        deadline: None,
-        past_horizon,
-    };
+    let control = run.control(Some(stop.clone()));
     let done = AtomicBool::new(false);
     let report = py.detach(|| {
         std::thread::scope(|s| {
             // The worker says it is done and wakes the caller (a wake-up
             // given before the caller waits is kept for it).
             let caller = std::thread::current();
-            let (scene, control, keep, finished) = (&scene, &control, &mut keep, &done);
-            let request = RunRequest {
-                sensitivities: sensitivities.clone(),
-                times: times.clone(),
-            };
+            let (run, control, keep, finished) = (&run, &control, &mut keep, &done);
             let worker = s.spawn(move || {
-                let report = request.run(scene, control, keep);
+                let report = run.run(control, keep);
                 finished.store(true, Ordering::Release);
                 caller.unpark();
                 report
@@ -232,12 +213,12 @@ fn run<'py>(
     if let Some(writer) = &mut keep.log
         && let Err(e) = writer.flush()
     {
-        report.outcome.status = flicker::engine::Status::Failed;
+        report.outcome.status = Status::Failed;
         report.outcome.reason = Some(format!("could not write the event log: {e}"));
     }
     let summary = summary(
         &report,
-        scene.model(),
+        run.scene().model(),
         Path::new(&label),
         log.map(Path::new),
     );

@@ -9,57 +9,39 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use serde_json::Value;
 
-use flicker::analysis::sweep::{Row as SweepRow, Shard, Sweep, is_sweep, parse_text};
-use flicker::analysis::work_precision::{Plan, compare as run_compare};
-use flicker::runner::Control;
-use flicker::scene::Registry;
-use flicker::session::{SearchRequest, SpectrumRequest};
+use flicker::session::{
+    CompareRequest, CompareRow, Control, Input, Point, Registry, SearchRequest, Source,
+    SpectrumRequest, Sweep, SweepRow, SweepRun,
+};
 
 use crate::interrupt::interruptible;
 use crate::{load, override_error, scene_error};
 
-/// The sweep given as JSON text or a file, if it is one (an object with
-/// `scene` and `grid`); its `scene` path is read beside the file, or from
-/// the working folder.
-fn as_sweep(py: Python<'_>, text: Option<&str>, path: Option<&str>) -> PyResult<Option<Sweep>> {
-    let (text, folder) = match (path, text) {
-        (Some(path), _) => match std::fs::read_to_string(path) {
-            Ok(text) => (
-                text,
-                Path::new(path)
-                    .parent()
-                    .map(Path::to_path_buf)
-                    .unwrap_or_default(),
-            ),
-            // Unreadable: the scene's own error says so.
-            Err(_) => return Ok(None),
-        },
-        (None, Some(text)) => (text.to_string(), PathBuf::new()),
-        (None, None) => return Ok(None),
-    };
-    match serde_json::from_str::<Value>(&text) {
-        Ok(value) if is_sweep(&value) => {
-            let parsed = parse_text(&text, &folder, &Registry::builtin());
-            let parsed = match path {
-                Some(p) => parsed.map_err(|e| e.in_path(Path::new(p))),
-                None => parsed,
-            };
-            parsed.map(Some).map_err(|e| scene_error(py, &e))
+/// The scene or sweep given as JSON text or a file, and the label its
+/// messages name it by.
+fn read(py: Python<'_>, text: Option<&str>, path: Option<&str>) -> PyResult<(Input, String)> {
+    let (source, label) = match (path, text) {
+        (Some(path), _) => (Source::Path(Path::new(path)), path),
+        (None, Some(text)) => (Source::Text(text), "<scene>"),
+        (None, None) => {
+            return Err(override_error(
+                py,
+                "scene",
+                "give a path, a JSON string or a dict".into(),
+            ));
         }
-        _ => Ok(None),
-    }
+    };
+    flicker::session::read(&Registry::builtin(), source)
+        .map(|input| (input, label.to_string()))
+        .map_err(|e| scene_error(py, &e))
 }
 
 /// What `flicker check` prints of a scene or a sweep, a line each.
 #[pyfunction]
 #[pyo3(signature = (text=None, path=None))]
 pub fn check(py: Python<'_>, text: Option<&str>, path: Option<&str>) -> PyResult<Vec<String>> {
-    let label = path.unwrap_or("<scene>");
-    if let Some(sweep) = as_sweep(py, text, path)? {
-        return Ok(sweep.check_lines(label));
-    }
-    let (scene, label) = load(py, text, path)?;
-    Ok(scene.check_lines(&label))
+    let (input, label) = read(py, text, path)?;
+    Ok(input.check_lines(&label))
 }
 
 /// `flicker compare`: each method of the plan against the exact answer.
@@ -77,16 +59,20 @@ pub fn compare<'py>(
     steps: Option<Vec<f64>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (scene, _) = load(py, text, path)?;
-    let plan = Plan::new(&scene, methods, tolerances, steps)
+    let asked = CompareRequest {
+        methods,
+        tolerances,
+        steps,
+    };
+    let comparison = asked
+        .on(scene)
         .map_err(|e| override_error(py, e.field.as_deref().unwrap_or("methods"), e.reason))?;
     let compared = interruptible(py, |stop| {
         let control = Control {
             stop: Some(stop.clone()),
-            max_wall_seconds: None,
-            deadline: None,
-            past_horizon: false,
+            ..Control::default()
         };
-        run_compare(&scene, &plan, &control, &mut |_| {})
+        comparison.run(&control, &mut |_| {})
     })?;
     let (reference, rows) = compared.map_err(|e| scene_error(py, &e))?;
     let out = PyDict::new(py);
@@ -101,10 +87,7 @@ pub fn compare<'py>(
         "status",
         PyList::new(py, rows.iter().map(|r| r.status.clone()))?,
     )?;
-    let numbers: [(
-        &str,
-        fn(&flicker::analysis::work_precision::Row) -> Option<f64>,
-    ); 10] = [
+    let numbers: [(&str, fn(&CompareRow) -> Option<f64>); 10] = [
         ("tolerance", |r| r.tolerance),
         ("step", |r| r.step),
         ("wall_seconds", |r| Some(r.wall_seconds)),
@@ -136,26 +119,24 @@ pub fn sweep<'py>(
     path: Option<&str>,
     threads: Option<usize>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let Some(spec) = as_sweep(py, text, path)? else {
-        // Not a sweep: say why as a file that is not one would.
-        return Err(match load(py, text, path) {
-            Err(e) => e,
-            Ok(_) => override_error(
+    let spec: Sweep = match read(py, text, path)?.0 {
+        Input::Sweep(spec) => spec,
+        Input::Scene(_) => {
+            return Err(override_error(
                 py,
                 "grid",
                 "a sweep is an object with `scene` and `grid`; this is a scene".into(),
-            ),
-        });
+            ));
+        }
     };
-    let pool = rayon_pool(threads).map_err(|e| override_error(py, "threads", e))?;
+    let points = SweepRun::new(&spec, None, threads)
+        .map_err(|e| override_error(py, e.field.as_deref().unwrap_or("threads"), e.reason))?;
     let rows = interruptible(py, |stop| {
         let control = Control {
             stop: Some(stop.clone()),
-            max_wall_seconds: None,
-            deadline: None,
-            past_horizon: false,
+            ..Control::default()
         };
-        pool.install(|| spec.run(Shard::WHOLE, &control, &|| {}))
+        points.run(&control, &|| {})
     })?;
     let out = PyDict::new(py);
     let header = spec.header();
@@ -197,14 +178,6 @@ pub fn sweep<'py>(
         out.set_item(key, column.into_pyarray(py))?;
     }
     Ok(out)
-}
-
-/// A pool of `threads` threads (default: one per core).
-fn rayon_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, String> {
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(threads.unwrap_or(0))
-        .build()
-        .map_err(|e| e.to_string())
 }
 
 /// The search as asked (see [`SearchRequest`]).
@@ -279,9 +252,7 @@ pub fn continuation<'py>(
     })?
     .map_err(|e| scene_error(py, &e))?;
     let out = PyDict::new(py);
-    let column = |f: &dyn Fn(&flicker::analysis::orbit::continuation::Point) -> f64| -> Vec<f64> {
-        branch.points.iter().map(f).collect()
-    };
+    let column = |f: &dyn Fn(&Point) -> f64| -> Vec<f64> { branch.points.iter().map(f).collect() };
     out.set_item("parameter", column(&|q| q.parameter).into_pyarray(py))?;
     out.set_item("period", column(&|q| q.period).into_pyarray(py))?;
     for (i, name) in names.iter().enumerate().filter(|(i, _)| *i != p) {

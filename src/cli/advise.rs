@@ -3,7 +3,7 @@
 //! from measured runs.
 //!
 //! The chain is run at a probe size (the scene's N, at most
-//! [`PROBE_UNITS`]) and each continuum beside it; each continuum's
+//! [`PROBE_UNITS`](crate::session::PROBE_UNITS)) and each continuum beside it; each continuum's
 //! distance from the probe is measured (the loaded end's displacement
 //! until the reflected wave is back and over the whole run, and the
 //! front's speed). The
@@ -14,22 +14,9 @@
 
 use std::path::PathBuf;
 
-use crate::analysis::release_convergence::Release;
-use crate::analysis::release_convergence::{
-    Track, chain_track, continuum_track, distance, release, without_homogenized,
-};
-use crate::engine::Status;
-use crate::models::continuum::Variant;
-use crate::runner::Control;
-use crate::scene::Registry;
+use crate::session::{NotProbed, Registry, Status};
 
 use crate::cli::exit::{Code, Failure};
-
-/// Largest chain run to probe a scene.
-pub const PROBE_UNITS: usize = 400;
-
-/// Times the models are compared at.
-const SAMPLES: usize = 121;
 
 /// `flicker advise`'s arguments.
 #[derive(Debug, clap::Args)]
@@ -47,40 +34,22 @@ pub struct AdviseArgs {
 /// which to run. Returns [`Code::Untrusted`] if a run stopped early.
 pub fn advise(args: AdviseArgs, registry: &Registry) -> Result<Code, Failure> {
     let scene = registry.load(&args.scene).map_err(Failure::bad_input)?;
-    let not_a_chain = || {
-        Failure::bad_input(format!(
+    let probed = crate::session::probe(&scene, args.tolerance).map_err(|e| match e {
+        NotProbed::NotAChain => Failure::bad_input(format!(
             "{}: advise weighs a chain scene against its continua; this is not a chain scene",
             args.scene.display()
-        ))
-    };
-    let units = match crate::analysis::release_convergence::release::described(&scene) {
-        Some(Release {
-            units: Some(units), ..
-        }) => units,
-        _ => return Err(not_a_chain()),
-    };
-    if !(args.tolerance.is_finite() && args.tolerance > 0.0) {
-        return Err(Failure::bad_input("--tolerance: a number > 0"));
+        )),
+        NotProbed::Refused(e) if e.field.as_deref() == Some("tolerance") => {
+            Failure::bad_input(format!("--tolerance: {}", e.reason))
+        }
+        NotProbed::Refused(e) => Failure::bad_input(e.in_path(&args.scene)),
+        NotProbed::Failed(why) => Failure::bad_input(why),
+    })?;
+    if let Some(why) = &probed.left_out {
+        say!("{why}");
     }
-    let mut release = release(&scene)
-        .map_err(|e| Failure::bad_input(e.in_path(&args.scene)))?
-        .string;
-    release.samples = SAMPLES;
-    let probe = units.min(PROBE_UNITS);
-    // One after another, so that each is timed alone.
-    let control = Control::default();
-    let mut runs = vec![
-        chain_track(&release, probe, &control),
-        continuum_track(&release, Variant::Paper, &control),
-    ];
-    match without_homogenized(&release) {
-        None => runs.push(continuum_track(&release, Variant::Homogenized, &control)),
-        Some(why) => say!("{why}"),
-    }
-    let tracks: Vec<Track> = runs
-        .into_iter()
-        .collect::<Result<_, _>>()
-        .map_err(Failure::bad_input)?;
+    let (units, probe) = (probed.units, probed.probe);
+    let tracks = &probed.measured.tracks;
     if let Some(t) = tracks.iter().find(|t| t.status != Status::Completed) {
         say!(
             "{} stopped: {}",
@@ -108,8 +77,8 @@ pub fn advise(args: AdviseArgs, registry: &Registry) -> Result<Code, Failure> {
         }
     );
     let mut best: Option<(&str, f64)> = None;
-    for track in &tracks[1..] {
-        let d = distance(track, reference);
+    let distances = &probed.measured.distances;
+    for (track, d) in tracks.iter().zip(distances).skip(1) {
         let within = d.right_end <= args.tolerance;
         let ratio = chain_seconds / track.wall_seconds.max(1e-6);
         say!(
@@ -122,7 +91,7 @@ pub fn advise(args: AdviseArgs, registry: &Registry) -> Result<Code, Failure> {
             if within { "within" } else { "outside" },
             args.tolerance,
             d.front_speed.map_or("-".into(), |s| format!("{s:.3}")),
-            distance(reference, reference)
+            distances[0]
                 .front_speed
                 .map_or("-".into(), |s| format!("{s:.3}")),
             if ratio >= 1.0 {

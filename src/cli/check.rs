@@ -3,8 +3,7 @@
 
 use std::path::Path;
 
-use crate::analysis::sweep;
-use crate::scene::Registry;
+use crate::session::{Registry, Source};
 
 use crate::cli::exit::{Code, Failure};
 
@@ -12,27 +11,9 @@ use crate::cli::exit::{Code, Failure};
 /// it describes, and return [`Code::Ok`]; an invalid one is bad input.
 pub fn check(registry: &Registry, path: &Path) -> Result<Code, Failure> {
     let label = path.display().to_string();
-    let lines = if is_sweep(path) {
-        sweep::load(path, registry)
-            .map_err(Failure::bad_input)?
-            .check_lines(&label)
-    } else {
-        registry
-            .load(path)
-            .map_err(Failure::bad_input)?
-            .check_lines(&label)
-    };
-    for line in lines {
+    let input = crate::session::read(registry, Source::Path(path)).map_err(Failure::bad_input)?;
+    for line in input.check_lines(&label) {
         say!("{line}");
     }
     Ok(Code::Ok)
-}
-
-/// Whether `path` holds a sweep rather than a scene; an unreadable file is
-/// left to the scene's own errors.
-fn is_sweep(path: &Path) -> bool {
-    std::fs::read_to_string(path)
-        .ok()
-        .and_then(|text| serde_json::from_str::<serde_json::Value>(&text).ok())
-        .is_some_and(|v| sweep::is_sweep(&v))
 }

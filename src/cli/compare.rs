@@ -3,8 +3,10 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::analysis::work_precision::{Plan, Row, chart, compare as run_compare, write_csv};
-use crate::scene::Registry;
+use crate::session::{
+    CompareRequest, CompareRow as Row, Control, Registry, compare_chart as chart,
+    write_compare_csv as write_csv,
+};
 
 use crate::cli::exit::{Code, Failure};
 
@@ -24,7 +26,12 @@ pub fn compare(
 ) -> Result<Code, Failure> {
     let deadline = crate::cli::setup::deadline(wall)?;
     let scene = registry.load(scene_path).map_err(Failure::bad_input)?;
-    let plan = Plan::new(&scene, methods, tolerances, steps).map_err(|e| {
+    let asked = CompareRequest {
+        methods,
+        tolerances,
+        steps,
+    };
+    let comparison = asked.on(scene).map_err(|e| {
         Failure::bad_input(format!("--{}: {}", e.field.unwrap_or_default(), e.reason))
     })?;
     let out = out.unwrap_or_else(|| {
@@ -38,26 +45,25 @@ pub fn compare(
         "method", "tol", "step", "seconds", "evals", "events", "error"
     );
     let stop = crate::cli::setup::stop_flag();
-    let control = crate::runner::Control {
+    let control = Control {
         stop: Some(stop.clone()),
         deadline,
         ..Default::default()
     };
-    let (reference, rows) = run_compare(&scene, &plan, &control, &mut |row| {
-        eprintln!("{}", line(row))
-    })
-    .map_err(|e| {
-        if control.interrupted() {
-            Failure {
-                code: Code::Interrupted,
-                message: e.in_path(scene_path).to_string(),
+    let (reference, rows) = comparison
+        .run(&control, &mut |row| eprintln!("{}", line(row)))
+        .map_err(|e| {
+            if control.interrupted() {
+                Failure {
+                    code: Code::Interrupted,
+                    message: e.in_path(scene_path).to_string(),
+                }
+            } else if e.untrusted {
+                Failure::untrusted(e.in_path(scene_path).to_string())
+            } else {
+                Failure::bad_input(e.in_path(scene_path))
             }
-        } else if e.untrusted {
-            Failure::untrusted(e.in_path(scene_path).to_string())
-        } else {
-            Failure::bad_input(e.in_path(scene_path))
-        }
-    })?;
+        })?;
     crate::cli::setup::output_folder(&out)?;
     let csv = out.join("compare.csv");
     write_csv(&rows, &csv).map_err(|e| Failure::untrusted(format!("{}: {e}", csv.display())))?;

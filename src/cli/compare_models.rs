@@ -4,14 +4,10 @@
 use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
 
-use crate::analysis::release_convergence::{
-    Model, chart, distance, files, release as release_of, run_all, without_homogenized,
-};
-use crate::engine::Status;
 use crate::log::summary::write_atomically;
-use crate::models::continuum::Variant;
-use crate::runner::Control;
-use crate::scene::Registry;
+use crate::session::{
+    Control, ModelsRequest, Registry, Status, release_chart as chart, release_files as files,
+};
 
 use crate::cli::exit::{Code, Failure};
 
@@ -29,7 +25,7 @@ pub struct CompareModelsArgs {
     )]
     units: Vec<usize>,
     /// Cells of the homogenized continuum.
-    #[arg(long, default_value_t = crate::analysis::release_convergence::DEFAULT_CELLS, value_name = "M")]
+    #[arg(long, default_value_t = crate::session::DEFAULT_CELLS, value_name = "M")]
     cells: usize,
     /// Sample times over [0, t_end] for the trace and the front.
     #[arg(long, default_value_t = 121, value_name = "S")]
@@ -49,30 +45,24 @@ pub struct CompareModelsArgs {
 pub fn compare_models(args: CompareModelsArgs, registry: &Registry) -> Result<Code, Failure> {
     let CompareModelsArgs {
         scene: path,
-        mut units,
+        units,
         cells,
         samples,
         out,
     } = args;
     let scene = registry.load(&path).map_err(Failure::bad_input)?;
-    let mut release = release_of(&scene)
-        .map_err(|e| Failure::bad_input(e.in_path(&path)))?
-        .string;
-    let most = crate::models::continuum::scene::MAX_FINITE_VOLUMES;
-    if !(2..=most).contains(&cells) {
-        return Err(Failure::bad_input(format!("--cells: from 2 to {most}")));
-    }
-    release.resolution = cells;
-    units.sort_unstable();
-    units.dedup();
-    if units.is_empty() || units[0] == 0 || *units.last().unwrap() > 100_000 {
-        return Err(Failure::bad_input(
-            "--units: give chain sizes from 1 to 100000",
-        ));
-    }
-    if !(3..=100_000).contains(&samples) {
-        return Err(Failure::bad_input("--samples: from 3 to 100000"));
-    }
+    let asked = ModelsRequest {
+        units,
+        cells,
+        samples,
+    };
+    let models = asked.on(&scene).map_err(|e| match e.field.as_deref() {
+        Some("cells") => Failure::bad_input(format!("--cells: {}", e.reason)),
+        Some("units") => Failure::bad_input(format!("--units: {}", e.reason)),
+        Some("samples") => Failure::bad_input(format!("--samples: {}", e.reason)),
+        _ => Failure::bad_input(e.in_path(&path)),
+    })?;
+    let units = &models.units;
     let out = out.unwrap_or_else(|| {
         let stem = path
             .file_stem()
@@ -87,11 +77,8 @@ pub fn compare_models(args: CompareModelsArgs, registry: &Registry) -> Result<Co
         deadline: None,
         past_horizon: false,
     };
-    let mut models: Vec<Model> = units.iter().map(|&n| Model::Chain(n)).collect();
-    models.push(Model::Continuum(Variant::Paper));
-    match without_homogenized(&release) {
-        None => models.push(Model::Continuum(Variant::Homogenized)),
-        Some(why) => say!("{why}"),
+    if let Some(why) = &models.left_out {
+        say!("{why}");
     }
     eprintln!(
         "running {} chains (N = {}) and the continua to t = {}",
@@ -101,10 +88,11 @@ pub fn compare_models(args: CompareModelsArgs, registry: &Registry) -> Result<Co
             .map(|n| n.to_string())
             .collect::<Vec<_>>()
             .join(", "),
-        release.t_end
+        models.t_end()
     );
-    release.samples = samples;
-    let tracks = run_all(&release, &models, &control).map_err(Failure::bad_input)?;
+    let measured = models.run(&control).map_err(Failure::bad_input)?;
+    let (tracks, reference, distances) =
+        (&measured.tracks, measured.reference, &measured.distances);
     if let Some(t) = tracks.iter().find(|t| t.status != Status::Completed) {
         let code = Code::stopped(stop.load(Ordering::Relaxed));
         say!(
@@ -114,20 +102,15 @@ pub fn compare_models(args: CompareModelsArgs, registry: &Registry) -> Result<Co
         );
         return Ok(code);
     }
-    let reference = units.len() - 1;
-    let distances: Vec<_> = tracks
-        .iter()
-        .map(|t| distance(t, &tracks[reference]))
-        .collect();
     let untrusted = |e: String| Failure::untrusted(format!("{}: {e}", out.display()));
-    files::write_csvs(&tracks, &out).map_err(|e| untrusted(e.to_string()))?;
+    files::write_csvs(tracks, &out).map_err(|e| untrusted(e.to_string()))?;
     let summary_path = out.join("compare_models.json");
     write_atomically(
         &summary_path,
-        &files::summary(&tracks, &tracks[reference], &distances),
+        &files::summary(tracks, &tracks[reference], distances),
     )
     .map_err(|e| untrusted(e.to_string()))?;
-    let pictures = chart::draw_all(&tracks, reference, &out).map_err(untrusted)?;
+    let pictures = chart::draw_all(tracks, reference, &out).map_err(untrusted)?;
     let returned = distances[reference]
         .returned
         .map_or("the end".to_string(), |t| format!("t = {t:.3}"));
@@ -149,7 +132,7 @@ pub fn compare_models(args: CompareModelsArgs, registry: &Registry) -> Result<Co
         "strain",
         "hidden"
     );
-    for (t, d) in tracks.iter().zip(&distances) {
+    for (t, d) in tracks.iter().zip(distances) {
         let opt = |x: Option<f64>, p: usize| x.map_or("-".into(), |x| format!("{x:.p$}"));
         say!(
             "{:<24} {:>8.3} {:>10} {:>7} {:>8} {:>8} {:>8.4} {:>8.4} {:>8.4} {:>8.1e}",

@@ -6,12 +6,8 @@
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
-use crate::analysis::orbit::continuation::{Branch, Point};
-use crate::analysis::orbit::diagram::Column;
-use crate::engine::Name;
 use crate::plot::draw::{Curve, Figure, Style};
-use crate::scene::Registry;
-use crate::session::SearchRequest;
+use crate::session::{Branch, Column, Name, Point, Registry, SearchRequest};
 
 use crate::cli::exit::{Code, Failure};
 

@@ -1,8 +1,7 @@
 //! Exit codes, in one place: what each means, and which a run's status
 //! or a tool's stop gives.
 
-use crate::engine::Status;
-use crate::scene::SceneError;
+use crate::session::{SceneError, Status};
 
 /// What the process tells its caller.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

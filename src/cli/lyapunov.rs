@@ -5,14 +5,11 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::analysis::lyapunov::Spectrum;
 use crate::cli::exit::{Code, Failure};
 use crate::cli::progress::WithProgress;
-use crate::engine::Observer;
 use crate::log::summary::write_atomically;
 use crate::plot::draw::{Curve, Figure, Style};
-use crate::scene::Registry;
-use crate::session::SpectrumRequest;
+use crate::session::{Observer, Registry, Spectrum, SpectrumRequest};
 
 /// `flicker lyapunov`'s arguments.
 #[derive(Debug, clap::Args)]

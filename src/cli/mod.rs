@@ -43,7 +43,7 @@ use std::path::PathBuf;
 
 use clap::{Parser, Subcommand};
 
-use crate::scene::Registry;
+use crate::session::Registry;
 
 use crate::cli::exit::{Code, Failure};
 

@@ -6,8 +6,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use crate::log::summary::write_atomically;
-use crate::scene::Registry;
-use crate::session::SearchRequest;
+use crate::session::{Registry, SearchRequest};
 
 use crate::cli::exit::{Code, Failure};
 use crate::cli::progress::WithProgress;
@@ -82,7 +81,7 @@ pub fn orbit(args: OrbitArgs, registry: &Registry) -> Result<Code, Failure> {
             eprintln!("  Newton iteration {k}: residual {residual:.3e}");
         }
     };
-    let watch = crate::analysis::orbit::Watch {
+    let watch = crate::session::Watch {
         transient: Some(&mut bar),
         newton: Some(&mut newton),
     };

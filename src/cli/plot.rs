@@ -4,11 +4,9 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::models::mechanism::Mechanism;
-use crate::plot::phase::{Plane, Portrait};
-use crate::plot::plane::{DEFAULT_SAMPLES, state_plane};
-use crate::runner::Control;
-use crate::scene::Registry;
+use crate::plot::phase::Plane;
+use crate::plot::plane::DEFAULT_SAMPLES;
+use crate::session::{Control, Registry};
 
 use crate::cli::exit::{Code, Failure};
 
@@ -116,7 +114,7 @@ pub fn plot(command: PlotCommand, registry: &Registry) -> Result<Code, Failure> 
         (None, Plane::Linear { .. }) => 1.0,
         (None, _) => return Err(Failure::bad_input("--eta: needed for this plane")),
     };
-    let portrait = Portrait::new(Mechanism { eta, omega }, plane);
+    let portrait = crate::session::mechanism_portrait(eta, omega, plane);
     portrait
         .figure
         .draw(&out)
@@ -156,7 +154,7 @@ fn scene_plane(
         deadline: None,
         past_horizon: false,
     };
-    let (figure, report) = state_plane(&scene, &x, &y, samples, &control)
+    let (figure, report) = crate::session::state_plane(&scene, (&x, &y), samples, &control)
         .map_err(|e| Failure::bad_input(format!("{}: {e}", path.display())))?;
     figure
         .draw(out)

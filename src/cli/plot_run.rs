@@ -68,11 +68,11 @@ pub fn plot_run(dir: &Path) -> Result<Vec<PathBuf>, String> {
     }
     let compare = dir.join("compare.csv");
     if compare.exists() {
-        let rows = crate::analysis::work_precision::read_csv(&compare)
+        let rows = crate::session::read_compare_csv(&compare)
             .map_err(|e| format!("{}: {e}", compare.display()))?;
         for name in ["compare.svg", "compare.png"] {
             let path = dir.join(name);
-            crate::analysis::work_precision::chart::draw(&rows, "work-precision", &path)?;
+            crate::session::compare_chart::draw(&rows, "work-precision", &path)?;
             written.push(path);
         }
     }

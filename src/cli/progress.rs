@@ -5,7 +5,7 @@
 use std::io::IsTerminal;
 use std::time::Instant;
 
-use crate::engine::{EventRecord, Observer};
+use crate::session::{EventRecord, Observer};
 use indicatif::{ProgressBar, ProgressStyle};
 
 /// Steps of the bar over `[0, t_end]`.

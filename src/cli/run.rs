@@ -4,18 +4,15 @@
 use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
 
-use crate::engine::Status;
-use crate::engine::step::method::NAMES;
 use crate::log::JsonlWriter;
 use crate::log::field_files;
 use crate::log::size_notice::{FIRST_NOTICE, LogSize};
 use crate::log::summary::{summary, write_atomically};
 use crate::log::writer::LazyFile;
-use crate::runner::ensemble::EnsembleRequest;
-use crate::runner::{Control, Report, Trajectory};
-use crate::scene::solver::SolverSpec;
-use crate::scene::{Registry, Scene};
-use crate::session::RunRequest;
+use crate::session::{
+    Ask, EnsembleRequest, METHODS, Registry, Report, RunRequest, Samples, Scene, SolverSpec,
+    Status, Trajectory,
+};
 
 use crate::cli::exit::{Code, Failure};
 use crate::cli::progress::WithProgress;
@@ -99,7 +96,7 @@ pub struct EnsembleFlags {
 pub struct SolverFlags {
     /// Method (default: the scene's, else the cheapest exact description of
     /// the model).
-    #[arg(long, value_name = "M", value_parser = clap::builder::PossibleValuesParser::new(NAMES))]
+    #[arg(long, value_name = "M", value_parser = clap::builder::PossibleValuesParser::new(METHODS))]
     method: Option<String>,
     /// Relative tolerance (taylor, dopri5, dop853).
     #[arg(long, value_name = "R", allow_negative_numbers = true)]
@@ -133,73 +130,49 @@ pub fn run(args: RunArgs, registry: &Registry) -> Result<Code, Failure> {
     } = args;
     let scene_path = scene_path.as_path();
     let log_events = !no_events;
-    let solver = SolverSpec {
-        method: solver.method,
-        rtol: solver.rtol,
-        atol: solver.atol,
-        step: solver.step,
-    };
-    // Everything is checked before any file is touched: bad input loses nothing.
-    let mut scene = registry.load(scene_path).map_err(Failure::bad_input)?;
-    if let Some(t) = t_end {
-        scene
-            .set_t_end(t)
-            .map_err(|e| Failure::bad_input(format!("--t-end: {}", e.reason)))?;
-    }
-    if solver != SolverSpec::default() {
-        scene.override_solver(&solver).map_err(|e| {
-            Failure::bad_input(format!(
-                "--method/--rtol/--atol/--step: {}",
-                e.in_path(scene_path)
-            ))
-        })?;
-    }
-    if let Some(directions) = &sensitivities {
-        crate::analysis::sensitivities::check(&scene, directions)
-            .map_err(|e| Failure::bad_input(format!("--sensitivities: {}", e.reason)))?;
-    }
-    let ensemble = match ensemble.ensemble {
-        None => None,
-        Some(copies) => {
-            let request = EnsembleRequest {
-                copies,
-                perturb: ensemble.perturb,
-                seed: ensemble.seed,
-            };
-            scene
-                .check_ensemble(&request)
-                .map_err(|e| Failure::bad_input(format!("--ensemble: {}", e.reason)))?;
-            Some(request)
-        }
-    };
-    let times =
-        crate::log::samples::times(samples, at.as_deref(), scene.t_end()).map_err(|why| {
-            let flag = if samples.is_some() {
-                "--samples"
-            } else {
-                "--at"
-            };
-            Failure::bad_input(format!("{flag}: {why}"))
-        })?;
-    let times = (samples.is_some() || at.is_some()).then_some(times);
-    if times.is_some() && !scene.offers_samples() {
-        return Err(Failure::bad_input(format!(
-            "--samples/--at: a {} scene offers no samples of its state",
-            scene.model()
-        )));
-    }
     let request = RunRequest {
+        t_end,
+        solver: SolverSpec {
+            method: solver.method,
+            rtol: solver.rtol,
+            atol: solver.atol,
+            step: solver.step,
+        },
         sensitivities,
-        times,
-    };
-    let out = out.unwrap_or_else(|| default_out(scene_path));
-    crate::cli::setup::output_folder(&out)?;
-    let control = Control {
-        stop: Some(crate::cli::setup::stop_flag()),
-        max_wall_seconds: None,
-        deadline: None,
+        samples: match (samples, at) {
+            (Some(n), _) => Some(Samples::Count(n)),
+            (None, Some(at)) => Some(Samples::At(at)),
+            (None, None) => None,
+        },
+        ensemble: ensemble.ensemble.map(|copies| EnsembleRequest {
+            copies,
+            perturb: ensemble.perturb,
+            seed: ensemble.seed,
+        }),
         past_horizon,
     };
+    // Everything is checked before any file is touched: bad input loses nothing.
+    let scene = registry.load(scene_path).map_err(Failure::bad_input)?;
+    let run = request.prepare(scene).map_err(|refused| {
+        let flag = match refused.ask {
+            Ask::TEnd => "--t-end",
+            Ask::Solver => {
+                return Failure::bad_input(format!(
+                    "--method/--rtol/--atol/--step: {}",
+                    refused.error.in_path(scene_path)
+                ));
+            }
+            Ask::Sensitivities => "--sensitivities",
+            Ask::Ensemble => "--ensemble",
+            Ask::Samples if samples.is_some() => "--samples",
+            Ask::Samples => "--at",
+        };
+        Failure::bad_input(format!("{flag}: {}", refused.error.reason))
+    })?;
+    let scene = run.scene();
+    let out = out.unwrap_or_else(|| default_out(scene_path));
+    crate::cli::setup::output_folder(&out)?;
+    let control = run.control(Some(crate::cli::setup::stop_flag()));
 
     let log_path = out.join("events.jsonl");
     let states;
@@ -210,7 +183,7 @@ pub fn run(args: RunArgs, registry: &Registry) -> Result<Code, Failure> {
             eprintln!("flicker: {s}")
         });
         let mut observer = WithProgress::new(JsonlWriter::new(file), scene.t_end(), quiet);
-        let ran = request.run(&scene, &control, &mut observer);
+        let ran = run.run(&control, &mut observer);
         observer.finish();
         let (mut report, sampled) = ran.map_err(|e| Failure::bad_input(e.in_path(scene_path)))?;
         states = sampled;
@@ -234,7 +207,7 @@ pub fn run(args: RunArgs, registry: &Registry) -> Result<Code, Failure> {
         report
     } else {
         let mut observer = WithProgress::new((), scene.t_end(), quiet);
-        let ran = request.run(&scene, &control, &mut observer);
+        let ran = run.run(&control, &mut observer);
         observer.finish();
         let (report, sampled) = ran.map_err(|e| Failure::bad_input(e.in_path(scene_path)))?;
         states = sampled;
@@ -277,9 +250,14 @@ pub fn run(args: RunArgs, registry: &Registry) -> Result<Code, Failure> {
     // The copies run only after a run that completed: an interrupted or
     // failed run says so by itself.
     let completed = report.outcome.status == Status::Completed;
-    if let (Some(request), true) = (&ensemble, completed) {
+    let ensemble = if completed {
+        run.ensemble(&control)
+    } else {
+        None
+    };
+    if let Some(found) = ensemble {
         let path = out.join("ensemble.csv");
-        let found = scene.ensemble(request, &control).and_then(|found| {
+        let found = found.and_then(|found| {
             found
                 .write_csv(&path)
                 .map(|()| found)
@@ -306,7 +284,7 @@ pub fn run(args: RunArgs, registry: &Registry) -> Result<Code, Failure> {
             summary_path.display()
         ))
     })?;
-    print_report(&report, &scene, &summary_path, log, &written);
+    print_report(&report, scene, &summary_path, log, &written);
     if plot {
         let drawn = crate::cli::plot_run::plot_run(&out).map_err(Failure::untrusted)?;
         let names: Vec<String> = drawn.iter().map(|p| p.display().to_string()).collect();

@@ -29,5 +29,5 @@ pub fn stop_flag() -> Arc<AtomicBool> {
 
 /// The instant `seconds` (`--wall`) from now, checked finite and positive.
 pub fn deadline(seconds: f64) -> Result<Option<std::time::Instant>, Failure> {
-    crate::runner::deadline_in(seconds).map_err(|why| Failure::bad_input(format!("--wall: {why}")))
+    crate::session::deadline_in(seconds).map_err(|why| Failure::bad_input(format!("--wall: {why}")))
 }

@@ -3,10 +3,8 @@
 
 use std::path::Path;
 
-use crate::analysis::stress::{Verdict, cases, markdown, run_case, settings};
-
 use crate::cli::exit::{Code, Failure};
-use crate::scene::Registry;
+use crate::session::{Registry, Verdict, stress_markdown as markdown};
 
 /// Run `flicker stress`: run every stress scene in `dir` with every method
 /// it offers, each within `wall_seconds`, printing one line per run (and
@@ -18,23 +16,16 @@ pub fn stress(
     wall_seconds: f64,
     as_markdown: bool,
 ) -> Result<Code, Failure> {
-    if !(wall_seconds.is_finite() && wall_seconds > 0.0) {
-        return Err(Failure::bad_input(
-            "--wall: must be a number of seconds > 0",
-        ));
-    }
-    let cases = cases(dir, registry).map_err(Failure::bad_input)?;
-    let mut rows = Vec::new();
-    for (name, scene) in &cases {
-        for setting in settings(scene) {
-            let row = run_case(name, scene, &setting, wall_seconds).map_err(Failure::bad_input)?;
-            eprintln!(
-                "{:<16} {:<7} {:.2} s  {:?}",
-                row.case, row.method, row.wall_seconds, row.verdict
-            );
-            rows.push(row);
-        }
-    }
+    let rows = crate::session::stress(registry, dir, wall_seconds, &mut |row| {
+        eprintln!(
+            "{:<16} {:<7} {:.2} s  {:?}",
+            row.case, row.method, row.wall_seconds, row.verdict
+        )
+    })
+    .map_err(|e| match e.field.as_deref() {
+        Some("wall") => Failure::bad_input(format!("--wall: {}", e.reason)),
+        _ => Failure::bad_input(e),
+    })?;
     if as_markdown {
         say_raw!("{}", markdown(&rows));
     }

@@ -6,10 +6,8 @@ use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use crate::analysis::sweep::{self, Shard};
-
 use crate::cli::exit::{Code, Failure};
-use crate::scene::Registry;
+use crate::session::{Control, Registry, Shard, SweepRun};
 
 /// Run `flicker sweep`: run the points of the sweep in `file` (all, or one
 /// `shard` given as `I/N`) on `threads` threads (default: one per core)
@@ -25,17 +23,15 @@ pub fn sweep(
     (wall, quiet): (f64, bool),
 ) -> Result<Code, Failure> {
     let deadline = crate::cli::setup::deadline(wall)?;
-    let spec = sweep::load(file, registry).map_err(Failure::bad_input)?;
-    let shard = match shard {
-        Some(text) => {
-            Shard::parse(&text).map_err(|e| Failure::bad_input(format!("--shard: {e}")))?
-        }
-        None => Shard::WHOLE,
-    };
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads.unwrap_or(0))
-        .build()
-        .map_err(|e| Failure::bad_input(format!("--threads: {e}")))?;
+    let spec = crate::session::load(registry, file).map_err(Failure::bad_input)?;
+    let points = SweepRun::new(&spec, shard.as_deref(), threads).map_err(|e| {
+        Failure::bad_input(format!(
+            "--{}: {}",
+            e.field.as_deref().unwrap_or("shard"),
+            e.reason
+        ))
+    })?;
+    let shard = points.shard();
     let out = out.unwrap_or_else(|| {
         let stem = file
             .file_stem()
@@ -56,19 +52,18 @@ pub fn sweep(
         })?;
     }
     let started = Instant::now();
-    let control = crate::runner::Control {
+    let control = Control {
         stop: Some(crate::cli::setup::stop_flag()),
         deadline,
         ..Default::default()
     };
-    let total = (shard.index..spec.points()).step_by(shard.count).count();
-    let bar = Points::new(total, quiet);
-    let rows = pool.install(|| spec.run(shard, &control, &|| bar.tick()));
+    let bar = Points::new(points.points(), quiet);
+    let rows = points.run(&control, &|| bar.tick());
     bar.finish();
     let seconds = started.elapsed().as_secs_f64();
     let file = File::create(&out)
         .map_err(|e| Failure::bad_input(format!("{}: cannot be created: {e}", out.display())))?;
-    sweep::write_csv(&spec, &rows, &mut BufWriter::new(file))
+    crate::session::write_sweep_csv(&spec, &rows, &mut BufWriter::new(file))
         .map_err(|e| Failure::untrusted(format!("{}: {e}", out.display())))?;
     let failed = rows
         .iter()
@@ -78,7 +73,7 @@ pub fn sweep(
         "{} points of {} in {seconds:.3} s on {} threads ({failed} not completed); wrote {}",
         rows.len(),
         spec.points(),
-        pool.current_num_threads(),
+        points.threads(),
         out.display()
     );
     if control.stopped() {
@@ -97,8 +92,8 @@ pub fn merge(
     shards: &[PathBuf],
     out: &Path,
 ) -> Result<Code, Failure> {
-    let spec = sweep::load(file, registry).map_err(Failure::bad_input)?;
-    let text = sweep::merge(&spec, shards).map_err(Failure::bad_input)?;
+    let spec = crate::session::load(registry, file).map_err(Failure::bad_input)?;
+    let text = crate::session::merge(&spec, shards).map_err(Failure::bad_input)?;
     std::fs::write(out, text)
         .map_err(|e| Failure::untrusted(format!("{}: cannot be written: {e}", out.display())))?;
     say!("merged {} shards into {}", shards.len(), out.display());

@@ -87,10 +87,20 @@ pub fn close_of(text: &str, open: usize) -> Option<usize> {
 /// Every `crate::NAME` a file's code (not its comments, not its tests)
 /// names, `use` groups over several lines and nested included.
 fn imports(text: &str) -> BTreeSet<String> {
+    named_after("crate::", text)
+}
+
+/// Every `NAME` that follows `prefix` (`crate::`, `flicker::`) in a file's
+/// code, read as [`imports`] reads `crate::`.
+pub fn named_after(prefix: &str, text: &str) -> BTreeSet<String> {
     let code = code(text);
     let mut names = BTreeSet::new();
-    for (at, _) in code.match_indices("crate::") {
-        let rest = &code[at + 7..];
+    for (at, _) in code.match_indices(prefix) {
+        // `flicker::` is also the tail of `_flicker::`: only a path's head counts.
+        if code[..at].ends_with(|c: char| c.is_alphanumeric() || c == '_') {
+            continue;
+        }
+        let rest = &code[at + prefix.len()..];
         // `crate::{a::X, b::{Y, Z}}` names each of `a` and `b`.
         let heads: Vec<&str> = match rest.strip_prefix('{') {
             Some(_) => {

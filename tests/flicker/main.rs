@@ -37,6 +37,7 @@ mod mechanism_angle;
 mod mechanism_strain;
 mod messages;
 mod observers;
+mod one_door;
 mod orbits;
 mod oscillator;
 mod phase;

@@ -22,13 +22,11 @@ fn run(scene: &Value, directions: &[&str]) -> (Report, Recorder) {
     let request = RunRequest {
         sensitivities: (!directions.is_empty())
             .then(|| directions.iter().map(|s| s.to_string()).collect()),
-        times: None,
+        ..RunRequest::default()
     };
-    request.check(&scene).unwrap();
+    let run = request.prepare(scene).unwrap();
     let mut events = Recorder::default();
-    let (report, _) = request
-        .run(&scene, &Control::default(), &mut events)
-        .unwrap();
+    let (report, _) = run.run(&Control::default(), &mut events).unwrap();
     assert_eq!(
         report.outcome.status.as_str(),
         "completed",
@@ -165,11 +163,13 @@ fn bounce_times_and_the_zeno_point_move_with_the_restitution_as_the_closed_form(
     let registry_scene = Registry::builtin().from_value(&scene).unwrap();
     let request = RunRequest {
         sensitivities: Some(vec!["e".to_string(), "initial.y".to_string()]),
-        times: None,
+        ..RunRequest::default()
     };
     let mut events = Recorder::default();
     request
-        .run(&registry_scene, &Control::default(), &mut events)
+        .prepare(registry_scene)
+        .unwrap()
+        .run(&Control::default(), &mut events)
         .unwrap();
     let n = events.events[0].after.len();
     let (de, dy) = (n - 2, n - 1);

@@ -83,13 +83,13 @@ fn the_mechanism_s_impacting_orbit_has_the_closed_form_period_in_both_formulatio
 
 /// The run with derivatives along `directions`: its summary's
 /// sensitivities.
-fn sensitivities(scene: &Scene, directions: &[&str]) -> Value {
+fn sensitivities(scene: Scene, directions: &[&str]) -> Value {
     let request = RunRequest {
         sensitivities: Some(directions.iter().map(|s| s.to_string()).collect()),
-        times: None,
+        ..RunRequest::default()
     };
-    request.check(scene).unwrap();
-    let (report, _) = request.run(scene, &Control::default(), &mut ()).unwrap();
+    let run = request.prepare(scene).unwrap();
+    let (report, _) = run.run(&Control::default(), &mut ()).unwrap();
     assert_eq!(report.outcome.status.as_str(), "completed");
     report.sensitivities.unwrap()
 }
@@ -103,7 +103,7 @@ fn the_mechanism_s_sensitivities_meet_differences_of_the_closed_form() {
     let mut text = read_json(std::path::Path::new(&models("mechanism_impacting.json")));
     text["t_end"] = json!(50.0);
     let scene = Registry::builtin().from_value(&text).unwrap();
-    let s = sensitivities(&scene, &["eta", "initial.strain"]);
+    let s = sensitivities(scene, &["eta", "initial.strain"]);
     let at = |eta: f64, d_strain: f64| {
         let m = Mechanism { eta, omega: 1.0 };
         let (e, r) = m.state_with_energy(0.05, Phase::Apex).unwrap();
@@ -136,7 +136,7 @@ fn a_chain_s_sensitivities_meet_differences_of_plain_runs() {
         chain
     };
     let scene = Registry::builtin().from_value(&chain(1.3)).unwrap();
-    let s = sensitivities(&scene, &["initial.y_4", "load"]);
+    let s = sensitivities(scene, &["initial.y_4", "load"]);
     let plain = |load: f64, dy4: f64| {
         let scene = Registry::builtin().from_value(&chain(load)).unwrap();
         let family = scene.family().unwrap();
