@@ -35,10 +35,10 @@ use std::time::Instant;
 use serde_json::{Value, json};
 
 use flicker::engine::HybridModel;
+use flicker::engine::Limits;
 use flicker::log::JsonlWriter;
 use flicker::models::automaton::AutomatonBuilder;
 use flicker::models::mechanism::{ExactOrbit, Mechanism};
-use flicker::runner::Control;
 use flicker::scene::Registry;
 
 mod timing;
@@ -58,7 +58,7 @@ fn run(parameters: Value, initial: Value, t_end: f64, method: &str) -> (f64, f64
     scene["t_end"] = json!(t_end);
     scene["solver"] = json!({"method": method});
     let scene = Registry::builtin().from_value(&scene).unwrap();
-    let report = scene.run(&Control::default(), &mut ()).unwrap();
+    let report = scene.run(&Limits::default(), &mut ()).unwrap();
     let o = report.outcome;
     assert_eq!(o.status.as_str(), "completed", "{:?}", o.reason);
     (
@@ -131,7 +131,7 @@ fn main() {
         .unwrap();
     let (exact_seconds, exact_impacts) = median_of(5, || {
         builtin
-            .run(&Control::default(), &mut ())
+            .run(&Limits::default(), &mut ())
             .unwrap()
             .outcome
             .events
@@ -162,7 +162,7 @@ fn main() {
         median_of(5, || {
             let file = std::io::BufWriter::new(std::fs::File::create(&log).unwrap());
             let mut writer = JsonlWriter::new(file);
-            let report = scene.run(&Control::default(), &mut writer).unwrap();
+            let report = scene.run(&Limits::default(), &mut writer).unwrap();
             writer.flush().unwrap();
             report.outcome.events
         })
@@ -187,7 +187,7 @@ fn main() {
     let timed = |scene: Value| {
         let scene = Registry::builtin().from_value(&scene).unwrap();
         median_of(7, || {
-            let report = scene.run(&Control::default(), &mut ()).unwrap();
+            let report = scene.run(&Limits::default(), &mut ()).unwrap();
             assert_eq!(
                 report.outcome.status.as_str(),
                 "completed",

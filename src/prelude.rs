@@ -10,7 +10,7 @@
 //!   ended; events to an [`Observer`] (a [`Recorder`] keeps them, each an
 //!   [`EventRecord`]);
 //! - scenes: [`Registry`] (the crate's own kinds:
-//!   [`Registry::builtin`]), [`Scene`], run under a [`Control`] as a
+//!   [`Registry::builtin`]), [`Scene`], run under a [`Limits`] as a
 //!   [`RunRequest`] asks;
 //! - tools on any model: its [`Family`].
 
@@ -19,6 +19,5 @@ pub use crate::engine::{
     Observer, Options, Outcome, Problem, Recorder, Status, Tolerances, simulate, simulate_sampled,
 };
 pub use crate::names;
-pub use crate::runner::Control;
 pub use crate::scene::{Registry, Scene};
 pub use crate::session::RunRequest;

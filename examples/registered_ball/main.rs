@@ -15,8 +15,9 @@
 //! cargo run --release --example registered_ball -- schema
 //! ```
 
+use flicker::engine::Limits;
 use flicker::engine::{Method, Name, Observer, Options, Tolerances, simulate};
-use flicker::runner::{Control, Report};
+use flicker::runner::Report;
 use flicker::scene::fields::Fields;
 use flicker::scene::solver::SolverSpec;
 use flicker::scene::{Kind, Registry, Scene, SceneError, SceneModel};
@@ -103,13 +104,13 @@ impl SceneModel for BallScene {
             format!("first bounce at t = {first:e}, bounces pile up at t = {zeno:e}"),
         ]
     }
-    fn run(&self, control: &Control, observer: &mut dyn Observer) -> Result<Report, SceneError> {
+    fn run(&self, limits: &Limits, observer: &mut dyn Observer) -> Result<Report, SceneError> {
         let ball = BouncingBall {
             gravity: self.gravity,
             restitution: self.restitution,
         };
         let options: Options =
-            control.options(self.t_end, 1_000_000, Method::Auto, Tolerances::default());
+            limits.options(self.t_end, 1_000_000, Method::Auto, Tolerances::default());
         let outcome = simulate(&ball, FLYING, &[self.height, 0.0], &options, observer);
         let final_state = vec![
             (Name::new("height"), outcome.final_state[0]),

@@ -176,16 +176,16 @@ fn run<'py>(
         log: writer,
     };
     let stop = Arc::new(AtomicBool::new(false));
-    let control = run.control(Some(stop.clone()));
+    let limits = run.limits(Some(stop.clone()));
     let done = AtomicBool::new(false);
     let report = py.detach(|| {
         std::thread::scope(|s| {
             // The worker says it is done and wakes the caller (a wake-up
             // given before the caller waits is kept for it).
             let caller = std::thread::current();
-            let (run, control, keep, finished) = (&run, &control, &mut keep, &done);
+            let (run, limits, keep, finished) = (&run, &limits, &mut keep, &done);
             let worker = s.spawn(move || {
-                let report = run.run(control, keep);
+                let report = run.run(limits, keep);
                 finished.store(true, Ordering::Release);
                 caller.unpark();
                 report

@@ -2,15 +2,14 @@
 //! results as lists and NumPy columns instead of printed lines and CSV
 //! files. Long ones release the GIL and stop on Ctrl-C ([`interruptible`]).
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use numpy::IntoPyArray;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
-use serde_json::Value;
 
 use flicker::session::{
-    CompareRequest, CompareRow, Control, Input, Point, Registry, SearchRequest, Source,
+    CompareRequest, CompareRow, Input, Limits, Point, Registry, SearchRequest, Source,
     SpectrumRequest, Sweep, SweepRow, SweepRun,
 };
 
@@ -68,11 +67,11 @@ pub fn compare<'py>(
         .on(scene)
         .map_err(|e| override_error(py, e.field.as_deref().unwrap_or("methods"), e.reason))?;
     let compared = interruptible(py, |stop| {
-        let control = Control {
+        let limits = Limits {
             stop: Some(stop.clone()),
-            ..Control::default()
+            ..Limits::default()
         };
-        comparison.run(&control, &mut |_| {})
+        comparison.run(&limits, &mut |_| {})
     })?;
     let (reference, rows) = compared.map_err(|e| scene_error(py, &e))?;
     let out = PyDict::new(py);
@@ -132,11 +131,11 @@ pub fn sweep<'py>(
     let points = SweepRun::new(&spec, None, threads)
         .map_err(|e| override_error(py, e.field.as_deref().unwrap_or("threads"), e.reason))?;
     let rows = interruptible(py, |stop| {
-        let control = Control {
+        let limits = Limits {
             stop: Some(stop.clone()),
-            ..Control::default()
+            ..Limits::default()
         };
-        points.run(&control, &|| {})
+        points.run(&limits, &|| {})
     })?;
     let out = PyDict::new(py);
     let header = spec.header();

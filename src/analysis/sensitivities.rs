@@ -18,12 +18,13 @@
 
 use serde_json::{Map, Value, json};
 
+use crate::engine::Limits;
 use crate::engine::bound::variational::Variational;
 use crate::engine::step::method::tightest;
 use crate::engine::{
     Family, HybridModel, Method, Mode, Name, Observer, Sample, Tolerances, simulate_sampled,
 };
-use crate::runner::{Control, Report};
+use crate::runner::Report;
 use crate::scene::{Scene, SceneError};
 
 /// Tolerance of DOP853 where the scene names no method.
@@ -243,12 +244,12 @@ fn directions(family: &dyn Family, names: &[String]) -> Result<Vec<Direction>, S
 }
 
 /// The run of `scene` from its start with the derivatives along `names`,
-/// by its method (`Auto`: see the module doc) under `control`; samples and
+/// by its method (`Auto`: see the module doc) under `limits`; samples and
 /// events as any run's.
 pub fn run(
     scene: &Scene,
     names: &[String],
-    control: &Control,
+    limits: &Limits,
     times: &[f64],
     on_sample: &mut dyn FnMut(&Sample),
     observer: &mut dyn Observer,
@@ -263,7 +264,7 @@ pub fn run(
         Method::Dopri5(t) | Method::Dop853(t) => t,
         _ => Tolerances::default(),
     };
-    let options = control.options(scene.t_end(), MAX_EVENTS, method, tolerances);
+    let options = limits.options(scene.t_end(), MAX_EVENTS, method, tolerances);
     let x0 = variational.initial(&start, &setup.s0);
     let outcome = simulate_sampled(
         &variational,
@@ -331,13 +332,13 @@ pub fn run(
 pub fn sampled(
     scene: &Scene,
     names: &[String],
-    control: &Control,
+    limits: &Limits,
     times: &[f64],
     observer: &mut dyn Observer,
 ) -> Result<crate::runner::Trajectory, SceneError> {
     let family = scene.family()?;
     let own = family.state_names().into_iter().map(Name::from).collect();
     crate::runner::Trajectory::record(own, |on_sample| {
-        run(scene, names, control, times, on_sample, observer)
+        run(scene, names, limits, times, on_sample, observer)
     })
 }

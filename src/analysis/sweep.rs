@@ -26,8 +26,8 @@ use std::path::{Path, PathBuf};
 use rayon::prelude::*;
 use serde_json::Value;
 
+use crate::engine::Limits;
 use crate::engine::{EventRecord, Observer, SETTLE, Status};
-use crate::runner::Control;
 use crate::scene::fields::Fields;
 use crate::scene::{Registry, SceneError};
 
@@ -325,10 +325,10 @@ impl Sweep {
     }
 
     /// Run the points of `shard`, in parallel, in point order, under
-    /// `control`: once its stop flag is set or its deadline passed, the
+    /// `limits`: once its stop flag is set or its deadline passed, the
     /// runs under way end and the points not begun are marked so.
     /// `done` hears of each point as it finishes.
-    pub fn run(&self, shard: Shard, control: &Control, done: &(dyn Fn() + Sync)) -> Vec<Row> {
+    pub fn run(&self, shard: Shard, limits: &Limits, done: &(dyn Fn() + Sync)) -> Vec<Row> {
         let points: Vec<usize> = (shard.index..self.points()).step_by(shard.count).collect();
         // Points differ in cost by orders of magnitude (chattering orbits
         // make thousands of impacts): small pieces keep both cores busy.
@@ -336,14 +336,14 @@ impl Sweep {
             .par_iter()
             .with_max_len(4)
             .map(|&point| {
-                let row = self.run_point(point, control);
+                let row = self.run_point(point, limits);
                 done();
                 row
             })
             .collect()
     }
 
-    fn run_point(&self, point: usize, control: &Control) -> Row {
+    fn run_point(&self, point: usize, limits: &Limits) -> Row {
         let values = self.values_at(point);
         let failed = |reason: String| Row {
             point,
@@ -365,15 +365,15 @@ impl Sweep {
             Ok(scene) => scene,
             Err(e) => return failed(format!("invalid: {e}")),
         };
-        if control.stopped() {
-            return failed(format!("{}; not begun", control.stop_reason()));
+        if limits.stopped() {
+            return failed(format!("{}; not begun", limits.stop_reason()));
         }
-        let control = &Control {
+        let limits = &Limits {
             past_horizon: self.past_horizon,
-            ..control.clone()
+            ..limits.clone()
         };
         let mut times = FirstAndLast::default();
-        let report = match scene.run(control, &mut times) {
+        let report = match scene.run(limits, &mut times) {
             Ok(report) => report,
             Err(e) => return failed(format!("invalid: {e}")),
         };

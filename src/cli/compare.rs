@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use crate::session::{
-    CompareRequest, CompareRow as Row, Control, Registry, compare_chart as chart,
+    CompareRequest, CompareRow as Row, Limits, Registry, compare_chart as chart,
     write_compare_csv as write_csv,
 };
 
@@ -45,15 +45,15 @@ pub fn compare(
         "method", "tol", "step", "seconds", "evals", "events", "error"
     );
     let stop = crate::cli::setup::stop_flag();
-    let control = Control {
+    let limits = Limits {
         stop: Some(stop.clone()),
         deadline,
         ..Default::default()
     };
     let (reference, rows) = comparison
-        .run(&control, &mut |row| eprintln!("{}", line(row)))
+        .run(&limits, &mut |row| eprintln!("{}", line(row)))
         .map_err(|e| {
-            if control.interrupted() {
+            if limits.interrupted() {
                 Failure {
                     code: Code::Interrupted,
                     message: e.in_path(scene_path).to_string(),

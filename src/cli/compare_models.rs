@@ -6,7 +6,7 @@ use std::sync::atomic::Ordering;
 
 use crate::log::summary::write_atomically;
 use crate::session::{
-    Control, ModelsRequest, Registry, Status, release_chart as chart, release_files as files,
+    Limits, ModelsRequest, Registry, Status, release_chart as chart, release_files as files,
 };
 
 use crate::cli::exit::{Code, Failure};
@@ -71,11 +71,10 @@ pub fn compare_models(args: CompareModelsArgs, registry: &Registry) -> Result<Co
     });
     crate::cli::setup::output_folder(&out)?;
     let stop = crate::cli::setup::stop_flag();
-    let control = Control {
+    let limits = Limits {
         stop: Some(stop.clone()),
         max_wall_seconds: None,
-        deadline: None,
-        past_horizon: false,
+        ..Limits::default()
     };
     if let Some(why) = &models.left_out {
         say!("{why}");
@@ -90,7 +89,7 @@ pub fn compare_models(args: CompareModelsArgs, registry: &Registry) -> Result<Co
             .join(", "),
         models.t_end()
     );
-    let measured = models.run(&control).map_err(Failure::bad_input)?;
+    let measured = models.run(&limits).map_err(Failure::bad_input)?;
     let (tracks, reference, distances) =
         (&measured.tracks, measured.reference, &measured.distances);
     if let Some(t) = tracks.iter().find(|t| t.status != Status::Completed) {

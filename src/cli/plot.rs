@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use crate::plot::phase::Plane;
 use crate::plot::plane::DEFAULT_SAMPLES;
-use crate::session::{Control, Registry};
+use crate::session::{Limits, Registry};
 
 use crate::cli::exit::{Code, Failure};
 
@@ -148,13 +148,12 @@ fn scene_plane(
             "plot phase SCENE: name the two states to draw with --x and --y",
         ));
     };
-    let control = Control {
+    let limits = Limits {
         stop: Some(crate::cli::setup::stop_flag()),
         max_wall_seconds: None,
-        deadline: None,
-        past_horizon: false,
+        ..Limits::default()
     };
-    let (figure, report) = crate::session::state_plane(&scene, (&x, &y), samples, &control)
+    let (figure, report) = crate::session::state_plane(&scene, (&x, &y), samples, &limits)
         .map_err(|e| Failure::bad_input(format!("{}: {e}", path.display())))?;
     figure
         .draw(out)

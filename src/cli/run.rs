@@ -172,7 +172,7 @@ pub fn run(args: RunArgs, registry: &Registry) -> Result<Code, Failure> {
     let scene = run.scene();
     let out = out.unwrap_or_else(|| default_out(scene_path));
     crate::cli::setup::output_folder(&out)?;
-    let control = run.control(Some(crate::cli::setup::stop_flag()));
+    let limits = run.limits(Some(crate::cli::setup::stop_flag()));
 
     let log_path = out.join("events.jsonl");
     let states;
@@ -183,7 +183,7 @@ pub fn run(args: RunArgs, registry: &Registry) -> Result<Code, Failure> {
             eprintln!("flicker: {s}")
         });
         let mut observer = WithProgress::new(JsonlWriter::new(file), scene.t_end(), quiet);
-        let ran = run.run(&control, &mut observer);
+        let ran = run.run(&limits, &mut observer);
         observer.finish();
         let (mut report, sampled) = ran.map_err(|e| Failure::bad_input(e.in_path(scene_path)))?;
         states = sampled;
@@ -207,7 +207,7 @@ pub fn run(args: RunArgs, registry: &Registry) -> Result<Code, Failure> {
         report
     } else {
         let mut observer = WithProgress::new((), scene.t_end(), quiet);
-        let ran = run.run(&control, &mut observer);
+        let ran = run.run(&limits, &mut observer);
         observer.finish();
         let (report, sampled) = ran.map_err(|e| Failure::bad_input(e.in_path(scene_path)))?;
         states = sampled;
@@ -251,7 +251,7 @@ pub fn run(args: RunArgs, registry: &Registry) -> Result<Code, Failure> {
     // failed run says so by itself.
     let completed = report.outcome.status == Status::Completed;
     let ensemble = if completed {
-        run.ensemble(&control)
+        run.ensemble(&limits)
     } else {
         None
     };
@@ -298,7 +298,7 @@ pub fn run(args: RunArgs, registry: &Registry) -> Result<Code, Failure> {
     if let Some(why) = ensemble_failed {
         say!("  ensemble failed: {why}");
         eprintln!("flicker: the ensemble failed: {why}");
-        let interrupted = control
+        let interrupted = limits
             .stop
             .as_ref()
             .is_some_and(|s| s.load(Ordering::Relaxed));

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use crate::cli::exit::{Code, Failure};
-use crate::session::{Control, Registry, Shard, SweepRun};
+use crate::session::{Limits, Registry, Shard, SweepRun};
 
 /// Run `flicker sweep`: run the points of the sweep in `file` (all, or one
 /// `shard` given as `I/N`) on `threads` threads (default: one per core)
@@ -52,13 +52,13 @@ pub fn sweep(
         })?;
     }
     let started = Instant::now();
-    let control = Control {
+    let limits = Limits {
         stop: Some(crate::cli::setup::stop_flag()),
         deadline,
         ..Default::default()
     };
     let bar = Points::new(points.points(), quiet);
-    let rows = points.run(&control, &|| bar.tick());
+    let rows = points.run(&limits, &|| bar.tick());
     bar.finish();
     let seconds = started.elapsed().as_secs_f64();
     let file = File::create(&out)
@@ -76,10 +76,10 @@ pub fn sweep(
         points.threads(),
         out.display()
     );
-    if control.stopped() {
-        let why = control.stop_reason();
+    if limits.stopped() {
+        let why = limits.stop_reason();
         eprintln!("flicker: the sweep stopped short ({why}); the points not begun say so");
-        return Ok(Code::stopped(control.interrupted()));
+        return Ok(Code::stopped(limits.interrupted()));
     }
     Ok(Code::Ok)
 }

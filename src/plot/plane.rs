@@ -6,9 +6,10 @@
 //! in red. A run with more than [`MAX_JUMPS`] events is drawn as dots at
 //! the samples, without its jumps.
 
+use crate::engine::Limits;
 use crate::engine::Recorder;
 use crate::plot::draw::{Curve, Figure, Style};
-use crate::runner::{Control, Report};
+use crate::runner::Report;
 use crate::scene::Scene;
 
 /// Sample times of a picture unless told otherwise.
@@ -24,7 +25,7 @@ pub fn state_plane(
     x: &str,
     y: &str,
     samples: usize,
-    control: &Control,
+    limits: &Limits,
 ) -> Result<(Figure, Report), String> {
     if samples < 2 {
         return Err(format!("--samples: at least 2 (got {samples})"));
@@ -35,7 +36,7 @@ pub fn state_plane(
         .collect();
     let mut events = Recorder::default();
     let trajectory = scene
-        .sampled(control, &times, &mut events)
+        .sampled(limits, &times, &mut events)
         .ok_or_else(|| {
             format!(
                 "a {} scene offers no samples of its state to draw",

@@ -4,10 +4,7 @@
 pub mod ensemble;
 mod fields;
 
-use std::sync::Arc;
-use std::sync::atomic::AtomicBool;
-
-use crate::engine::{Method, Name, Options, Outcome, Tolerances};
+use crate::engine::{Method, Name, Outcome};
 
 pub use fields::{CLASSICAL_MAX_UNITS, Classical, FieldOutputs, Profile, TraceRow};
 
@@ -70,21 +67,6 @@ impl Trajectory {
     }
 }
 
-/// What may stop a run from outside the scene.
-#[derive(Debug, Clone, Default)]
-pub struct Control {
-    /// Interrupts the run cleanly when set (a signal handler sets it).
-    pub stop: Option<Arc<AtomicBool>>,
-    /// Fails the run after this much wall time.
-    pub max_wall_seconds: Option<f64>,
-    /// When the whole work under this control must end (a tool's
-    /// `--wall`): each run gets what is left of it, and a tool that runs
-    /// many begins none past it.
-    pub deadline: Option<std::time::Instant>,
-    /// Runs go on past their horizon as pseudo-orbits (`--past-horizon`).
-    pub past_horizon: bool,
-}
-
 /// The instant `seconds` (a wall-clock budget, `--wall`) from now, or
 /// why `seconds` is not a budget.
 pub fn deadline_in(seconds: f64) -> Result<Option<std::time::Instant>, String> {
@@ -92,61 +74,4 @@ pub fn deadline_in(seconds: f64) -> Result<Option<std::time::Instant>, String> {
         return Err(format!("a time > 0 (got {seconds})"));
     }
     Ok(std::time::Instant::now().checked_add(std::time::Duration::from_secs_f64(seconds.min(1e9))))
-}
-
-impl Control {
-    /// Whether the stop flag is set: a tool that runs many scenes stops
-    /// between them.
-    pub fn stopped(&self) -> bool {
-        self.interrupted() || self.past_deadline()
-    }
-
-    /// Whether the stop flag is set.
-    pub fn interrupted(&self) -> bool {
-        self.stop
-            .as_ref()
-            .is_some_and(|s| s.load(std::sync::atomic::Ordering::Relaxed))
-    }
-
-    /// Whether the deadline has passed.
-    pub fn past_deadline(&self) -> bool {
-        self.deadline
-            .is_some_and(|d| std::time::Instant::now() >= d)
-    }
-
-    /// Why the work stopped, in words, once [`stopped`](Control::stopped).
-    pub fn stop_reason(&self) -> &'static str {
-        if self.interrupted() {
-            "interrupted: the stop flag was set"
-        } else {
-            "stopped: past the wall-clock budget (--wall)"
-        }
-    }
-
-    /// The engine's options for a scene's run under this control.
-    pub fn options(
-        &self,
-        t_end: f64,
-        max_events: u64,
-        method: Method,
-        tolerances: Tolerances,
-    ) -> Options {
-        Options {
-            t_end,
-            max_events,
-            method,
-            tolerances,
-            stop: self.stop.clone(),
-            max_wall_seconds: match (self.max_wall_seconds, self.deadline) {
-                (own, None) => own,
-                (own, Some(d)) => {
-                    let left = d
-                        .saturating_duration_since(std::time::Instant::now())
-                        .as_secs_f64();
-                    Some(own.map_or(left, |own| own.min(left)))
-                }
-            },
-            past_horizon: self.past_horizon,
-        }
-    }
 }

@@ -15,9 +15,10 @@ use std::fmt;
 
 use serde_json::Value;
 
+use crate::engine::Limits;
 use crate::engine::{Family, Observer};
 use crate::runner::ensemble::{EnsembleReport, EnsembleRequest};
-use crate::runner::{Control, Report, Trajectory};
+use crate::runner::{Report, Trajectory};
 use crate::scene::Reference;
 use crate::scene::SceneError;
 use crate::scene::fields::{Fields, kind};
@@ -53,8 +54,8 @@ pub trait SceneModel: fmt::Debug + Send + Sync + 'static {
     /// names the file and the model).
     fn describe(&self) -> Vec<String>;
 
-    /// Run the scene under `control`, reporting events to `observer`.
-    fn run(&self, control: &Control, observer: &mut dyn Observer) -> Result<Report, SceneError>;
+    /// Run the scene under `limits`, reporting events to `observer`.
+    fn run(&self, limits: &Limits, observer: &mut dyn Observer) -> Result<Report, SceneError>;
 
     /// The scene's model as the tools see it: the hybrid model, where the
     /// scene starts, and its parameters. Periodic orbits, continuation,
@@ -94,11 +95,11 @@ pub trait SceneModel: fmt::Debug + Send + Sync + 'static {
     /// the model offers no samples of its state.
     fn sampled(
         &self,
-        control: &Control,
+        limits: &Limits,
         times: &[f64],
         observer: &mut dyn Observer,
     ) -> Option<Result<Trajectory, SceneError>> {
-        let _ = (control, times, observer);
+        let _ = (limits, times, observer);
         None
     }
 
@@ -129,10 +130,10 @@ pub trait SceneModel: fmt::Debug + Send + Sync + 'static {
     fn ensemble(
         &self,
         request: &EnsembleRequest,
-        control: &Control,
+        limits: &Limits,
     ) -> Result<EnsembleReport, String> {
         self.check_ensemble(request).map_err(|e| e.reason)?;
-        let _ = control;
+        let _ = limits;
         Err(format!("a {} scene has no ensemble", self.model()))
     }
 

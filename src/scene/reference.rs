@@ -4,8 +4,9 @@
 use std::fmt;
 use std::sync::Arc;
 
+use crate::engine::Limits;
 use crate::engine::{EventTimes, Status, bound::zeno};
-use crate::runner::{Control, Report};
+use crate::runner::Report;
 use crate::scene::{Scene, SceneError};
 
 /// A run measured against a [`Reference`] ([`Reference::measure`]).
@@ -77,10 +78,10 @@ impl Reference {
         (self.event_time)(k)
     }
 
-    /// Run `scene` under `control` and measure it against this reference.
-    pub fn measure(&self, scene: &Scene, control: &Control) -> Result<Against, SceneError> {
+    /// Run `scene` under `limits` and measure it against this reference.
+    pub fn measure(&self, scene: &Scene, limits: &Limits) -> Result<Against, SceneError> {
         let mut times = EventTimes::default();
-        let report = scene.run(control, &mut times)?;
+        let report = scene.run(limits, &mut times)?;
         let final_error = report
             .final_state
             .iter()

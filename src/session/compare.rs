@@ -2,7 +2,7 @@
 //! `flicker compare` and Python's `compare()` ask it.
 
 use crate::analysis::work_precision::{self, Plan, Row};
-use crate::runner::Control;
+use crate::engine::Limits;
 use crate::scene::{Reference, Scene, SceneError};
 
 /// A comparison as asked: each unset list takes its default.
@@ -38,14 +38,14 @@ pub struct Comparison {
 }
 
 impl Comparison {
-    /// Run every setting under `control` (whose stop and deadline end it
+    /// Run every setting under `limits` (whose stop and deadline end it
     /// between runs), telling `progress` of each row: the reference
     /// measured against, and the rows.
     pub fn run(
         &self,
-        control: &Control,
+        limits: &Limits,
         progress: &mut dyn FnMut(&Row),
     ) -> Result<(Reference, Vec<Row>), SceneError> {
-        work_precision::compare(&self.scene, &self.plan, control, progress)
+        work_precision::compare(&self.scene, &self.plan, limits, progress)
     }
 }

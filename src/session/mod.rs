@@ -56,11 +56,9 @@ pub use crate::analysis::work_precision::{
     read_csv as read_compare_csv, write_csv as write_compare_csv,
 };
 pub use crate::engine::step::method::NAMES as METHODS;
-pub use crate::engine::{EventRecord, Name, Observer, Status};
+pub use crate::engine::{EventRecord, Limits, Name, Observer, Status};
 pub use crate::runner::ensemble::EnsembleRequest;
-pub use crate::runner::{
-    Control, FieldOutputs, Profile, Report, TraceRow, Trajectory, deadline_in,
-};
+pub use crate::runner::{FieldOutputs, Profile, Report, TraceRow, Trajectory, deadline_in};
 pub use crate::scene::solver::SolverSpec;
 pub use crate::scene::{Registry, Scene, SceneError};
 

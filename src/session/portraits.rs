@@ -2,10 +2,11 @@
 //! portrait (level sets beside simulated trajectories), or any two states
 //! of a scene's run.
 
+use crate::engine::Limits;
 use crate::models::mechanism::Mechanism;
 use crate::plot::draw::Figure;
 use crate::plot::phase::{Plane, Portrait};
-use crate::runner::{Control, Report};
+use crate::runner::Report;
 use crate::scene::Scene;
 
 /// The mechanism's portrait at load ratio `eta` and frequency `omega`
@@ -15,13 +16,13 @@ pub fn mechanism_portrait(eta: f64, omega: f64, plane: Plane) -> Portrait {
 }
 
 /// States `x` and `y` of `scene`'s run against each other, sampled at
-/// `samples` evenly spaced times, under `control`: the picture and the
+/// `samples` evenly spaced times, under `limits`: the picture and the
 /// run's report, or why it cannot be drawn.
 pub fn state_plane(
     scene: &Scene,
     (x, y): (&str, &str),
     samples: usize,
-    control: &Control,
+    limits: &Limits,
 ) -> Result<(Figure, Report), String> {
-    crate::plot::plane::state_plane(scene, x, y, samples, control)
+    crate::plot::plane::state_plane(scene, x, y, samples, limits)
 }

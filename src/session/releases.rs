@@ -6,9 +6,9 @@ use crate::analysis::release_convergence::{
     DEFAULT_CELLS, Distance, Model, Track, chain_track, continuum_track, distance, release,
     run_all, without_homogenized,
 };
+use crate::engine::Limits;
 use crate::models::continuum::Variant;
 use crate::models::continuum::scene::{ContinuumScene, MAX_FINITE_VOLUMES};
-use crate::runner::Control;
 use crate::scene::{Scene, SceneError};
 
 /// The models a release is run as (`flicker compare-models`).
@@ -102,10 +102,10 @@ impl ModelsCompared {
         self.release.t_end
     }
 
-    /// Run every model in parallel under `control`, and measure each
+    /// Run every model in parallel under `limits`, and measure each
     /// against the densest chain.
-    pub fn run(&self, control: &Control) -> Result<Measured, String> {
-        let tracks = run_all(&self.release, &self.models, control)?;
+    pub fn run(&self, limits: &Limits) -> Result<Measured, String> {
+        let tracks = run_all(&self.release, &self.models, limits)?;
         let reference = self.units.len() - 1;
         Ok(measured(tracks, reference))
     }
@@ -174,14 +174,14 @@ pub fn probe(scene: &Scene, tolerance: f64) -> Result<Probe, NotProbed> {
     let mut release = release(scene).map_err(NotProbed::Refused)?.string;
     release.samples = PROBE_SAMPLES;
     let probe = units.min(PROBE_UNITS);
-    let control = Control::default();
+    let limits = Limits::default();
     let mut runs = vec![
-        chain_track(&release, probe, &control),
-        continuum_track(&release, Variant::Paper, &control),
+        chain_track(&release, probe, &limits),
+        continuum_track(&release, Variant::Paper, &limits),
     ];
     let left_out = without_homogenized(&release);
     if left_out.is_none() {
-        runs.push(continuum_track(&release, Variant::Homogenized, &control));
+        runs.push(continuum_track(&release, Variant::Homogenized, &limits));
     }
     let tracks: Vec<Track> = runs
         .into_iter()

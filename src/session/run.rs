@@ -7,9 +7,10 @@
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
+use crate::engine::Limits;
 use crate::engine::Observer;
 use crate::runner::ensemble::{EnsembleReport, EnsembleRequest};
-use crate::runner::{Control, Report, Trajectory};
+use crate::runner::{Report, Trajectory};
 use crate::scene::solver::SolverSpec;
 use crate::scene::{Scene, SceneError};
 
@@ -138,19 +139,19 @@ impl PreparedRun {
     }
 
     /// The limits the run goes under, stopped by `stop` where given.
-    pub fn control(&self, stop: Option<Arc<AtomicBool>>) -> Control {
-        Control {
+    pub fn limits(&self, stop: Option<Arc<AtomicBool>>) -> Limits {
+        Limits {
             stop,
             past_horizon: self.past_horizon,
-            ..Control::default()
+            ..Limits::default()
         }
     }
 
-    /// Run it under `control`, events to `observer`: the report, and the
+    /// Run it under `limits`, events to `observer`: the report, and the
     /// samples where they were asked for.
     pub fn run(
         &self,
-        control: &Control,
+        limits: &Limits,
         observer: &mut dyn Observer,
     ) -> Result<(Report, Option<Trajectory>), SceneError> {
         let scene = &self.scene;
@@ -159,28 +160,28 @@ impl PreparedRun {
             (Some(directions), None) => crate::analysis::sensitivities::run(
                 scene,
                 directions,
-                control,
+                limits,
                 &[],
                 &mut |_| {},
                 observer,
             )
             .map(|report| (report, None)),
             (Some(directions), Some(times)) => {
-                crate::analysis::sensitivities::sampled(scene, directions, control, times, observer)
+                crate::analysis::sensitivities::sampled(scene, directions, limits, times, observer)
                     .map(sampled)
             }
-            (None, None) => scene.run(control, observer).map(|report| (report, None)),
-            (None, Some(times)) => match scene.sampled(control, times, observer) {
+            (None, None) => scene.run(limits, observer).map(|report| (report, None)),
+            (None, Some(times)) => match scene.sampled(limits, times, observer) {
                 Some(ran) => ran.map(sampled),
                 None => Err(no_samples(scene)),
             },
         }
     }
 
-    /// The ensemble asked for, under `control`, if one was: its report, or
+    /// The ensemble asked for, under `limits`, if one was: its report, or
     /// why it failed.
-    pub fn ensemble(&self, control: &Control) -> Option<Result<EnsembleReport, String>> {
+    pub fn ensemble(&self, limits: &Limits) -> Option<Result<EnsembleReport, String>> {
         let request = self.ensemble.as_ref()?;
-        Some(self.scene.ensemble(request, control))
+        Some(self.scene.ensemble(request, limits))
     }
 }

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use serde_json::Value;
 
 use crate::analysis::sweep::{self, Row, Shard, Sweep};
-use crate::runner::Control;
+use crate::engine::Limits;
 use crate::scene::{Registry, Scene, SceneError};
 
 /// Where a scene or a sweep is read from.
@@ -110,11 +110,11 @@ impl<'s> SweepRun<'s> {
             .count()
     }
 
-    /// Run the shard's points under `control` (its stop and deadline leave
+    /// Run the shard's points under `limits` (its stop and deadline leave
     /// the points not begun as such), `done` told of each: a row per point.
-    pub fn run(&self, control: &Control, done: &(dyn Fn() + Sync)) -> Vec<Row> {
+    pub fn run(&self, limits: &Limits, done: &(dyn Fn() + Sync)) -> Vec<Row> {
         self.pool
-            .install(|| self.sweep.run(self.shard, control, done))
+            .install(|| self.sweep.run(self.shard, limits, done))
     }
 }
 

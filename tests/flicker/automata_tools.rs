@@ -274,8 +274,8 @@ fn a_phase_plane_of_any_two_states_follows_the_flights_and_jumps() {
 /// as the file's would.
 #[test]
 fn the_builder_makes_the_same_automaton_as_the_file() {
+    use flicker::engine::Limits;
     use flicker::models::automaton::{AutomatonBuilder, TransitionBuilder};
-    use flicker::runner::Control;
     let built = AutomatonBuilder::new()
         .parameter("g", 9.81)
         .parameter("e", 0.8)
@@ -292,12 +292,12 @@ fn the_builder_makes_the_same_automaton_as_the_file() {
         .energy("v^2 / 2 + g * y");
     let scene = built.scene(10.0).unwrap();
     let mut events = flicker::engine::Recorder::default();
-    let report = scene.run(&Control::default(), &mut events).unwrap();
+    let report = scene.run(&Limits::default(), &mut events).unwrap();
     let file = flicker::scene::Registry::builtin()
         .load(Path::new(&automaton("bouncing_ball.json")))
         .unwrap();
     let mut expected = flicker::engine::Recorder::default();
-    let from_file = file.run(&Control::default(), &mut expected).unwrap();
+    let from_file = file.run(&Limits::default(), &mut expected).unwrap();
     assert_eq!(events.events, expected.events);
     assert_eq!(report.outcome.final_state, from_file.outcome.final_state);
     // The first bounce of a ball dropped from 1 m under 9.81.

@@ -5,10 +5,10 @@
 //! refused.
 
 use flicker::analysis::release_convergence::{Model, distance, release as release_of, run_all};
+use flicker::engine::Limits;
 use flicker::models as scene;
 use flicker::models::ContinuumScene;
 use flicker::models::continuum::Variant;
-use flicker::runner::Control;
 
 use crate::support::{flicker, models, read_json};
 
@@ -27,7 +27,7 @@ fn the_paper_continuum_front_runs_at_c_and_its_free_end_lags_the_chain() {
         Model::Continuum(Variant::Paper),
     ];
     free.samples = 41;
-    let tracks = run_all(&free, &models, &Control::default()).unwrap();
+    let tracks = run_all(&free, &models, &Limits::default()).unwrap();
     let reference = &tracks[1];
     let d: Vec<_> = tracks.iter().map(|t| distance(t, reference)).collect();
     assert_eq!(d[1].right_end, 0.0);

@@ -166,7 +166,7 @@ fn the_front_ends_name_nothing_below_the_session_but_files() {
 fn the_reading_sees_a_front_end_that_goes_around() {
     let around = "use crate::session::Registry;\nfn f() { crate::engine::simulate(); }";
     assert!(named_after("crate::", around).contains("engine"));
-    let python = "use flicker::{session::Scene, runner::Control};";
+    let python = "use flicker::{session::Scene, runner::Limits};";
     let names = named_after("flicker::", python);
     assert!(names.contains("runner") && names.contains("session"));
     // `_flicker::` is the module's own name, not the library's.

@@ -4,10 +4,11 @@
 
 use std::path::Path;
 
+use flicker::engine::Limits;
 use flicker::engine::Status;
 use flicker::models::mechanism::Mechanism;
 use flicker::models::{self as scene, ChainScene, ContinuumScene, Formulation, MechanismScene};
-use flicker::runner::{Control, Report};
+use flicker::runner::Report;
 use flicker::scene::Scene;
 
 use crate::oscillator::Unit;
@@ -37,7 +38,7 @@ const EXPECTED: &[(&str, Status)] = &[
 
 fn run_file(path: &Path) -> (Scene, Report) {
     let scene = scene::load(path).unwrap_or_else(|e| panic!("{e}"));
-    let report = scene.run(&Control::default(), &mut ()).unwrap();
+    let report = scene.run(&Limits::default(), &mut ()).unwrap();
     (scene, report)
 }
 

@@ -5,8 +5,9 @@
 
 use serde_json::{Value, json};
 
+use flicker::engine::Limits;
 use flicker::engine::Recorder;
-use flicker::runner::{Control, Report};
+use flicker::runner::Report;
 use flicker::scene::Registry;
 use flicker::session::RunRequest;
 
@@ -26,7 +27,7 @@ fn run(scene: &Value, directions: &[&str]) -> (Report, Recorder) {
     };
     let run = request.prepare(scene).unwrap();
     let mut events = Recorder::default();
-    let (report, _) = run.run(&Control::default(), &mut events).unwrap();
+    let (report, _) = run.run(&Limits::default(), &mut events).unwrap();
     assert_eq!(
         report.outcome.status.as_str(),
         "completed",
@@ -169,7 +170,7 @@ fn bounce_times_and_the_zeno_point_move_with_the_restitution_as_the_closed_form(
     request
         .prepare(registry_scene)
         .unwrap()
-        .run(&Control::default(), &mut events)
+        .run(&Limits::default(), &mut events)
         .unwrap();
     let n = events.events[0].after.len();
     let (de, dy) = (n - 2, n - 1);

@@ -6,9 +6,9 @@
 
 use serde_json::{Value, json};
 
+use flicker::engine::Limits;
 use flicker::engine::{Method, Options, simulate};
 use flicker::models::mechanism::{ExactOrbit, Mechanism, Phase};
-use flicker::runner::Control;
 use flicker::scene::{Registry, Scene};
 use flicker::session::RunRequest;
 
@@ -89,7 +89,7 @@ fn sensitivities(scene: Scene, directions: &[&str]) -> Value {
         ..RunRequest::default()
     };
     let run = request.prepare(scene).unwrap();
-    let (report, _) = run.run(&Control::default(), &mut ()).unwrap();
+    let (report, _) = run.run(&Limits::default(), &mut ()).unwrap();
     assert_eq!(report.outcome.status.as_str(), "completed");
     report.sensitivities.unwrap()
 }

@@ -20,12 +20,12 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 
+use crate::engine::Limits;
 use crate::engine::{LocalModel, Method, Options, Status, Tolerances, simulate_local};
 use crate::models::chain::coarse::{Coarse, WINDOW_WIDTH};
 use crate::models::chain::{Chain, TaylorChain};
 use crate::models::continuum::scene::ContinuumScene;
 use crate::models::continuum::{StringModel, Variant};
-use crate::runner::Control;
 use crate::scene::SceneError;
 use crate::time::Time;
 
@@ -120,7 +120,7 @@ pub struct Sample {
 pub fn chain_track(
     release: &ContinuumScene,
     units: usize,
-    control: &Control,
+    limits: &Limits,
 ) -> Result<Track, String> {
     let chain = Chain::in_scene_units(
         units,
@@ -162,7 +162,7 @@ pub fn chain_track(
         Model::Chain(units),
         &mut model,
         release,
-        control,
+        limits,
         sample,
     )
 }
@@ -171,7 +171,7 @@ pub fn chain_track(
 pub fn continuum_track(
     release: &ContinuumScene,
     variant: Variant,
-    control: &Control,
+    limits: &Limits,
 ) -> Result<Track, String> {
     let label = format!("continuum ({})", variant.name());
     // Energies are compared with the scene's load: where the paper's
@@ -185,11 +185,11 @@ pub fn continuum_track(
             let mut model =
                 crate::models::continuum::run::front_tracking(release, release.constraint)
                     .map_err(refused)?;
-            string_track(label, variant, held, &mut model, release, control)
+            string_track(label, variant, held, &mut model, release, limits)
         }
         Variant::Homogenized => {
             let mut model = crate::models::continuum::run::homogenized(release).map_err(refused)?;
-            string_track(label, variant, 0.0, &mut model, release, control)
+            string_track(label, variant, 0.0, &mut model, release, limits)
         }
     }
 }
@@ -201,7 +201,7 @@ fn string_track<M: StringModel>(
     held: f64,
     model: &mut M,
     release: &ContinuumScene,
-    control: &Control,
+    limits: &Limits,
 ) -> Result<Track, String> {
     let centres = centres(release);
     let sample = |m: &M, t: f64| {
@@ -221,7 +221,7 @@ fn string_track<M: StringModel>(
         Model::Continuum(variant),
         model,
         release,
-        control,
+        limits,
         sample,
     )
 }
@@ -232,10 +232,10 @@ fn track<M: LocalModel>(
     kind: Model,
     model: &mut M,
     release: &ContinuumScene,
-    control: &Control,
+    limits: &Limits,
     sample: impl Fn(&M, f64) -> Sample,
 ) -> Result<Track, String> {
-    let options: Options = control.options(
+    let options: Options = limits.options(
         release.t_end,
         release.max_events,
         Method::Exact,
@@ -425,13 +425,13 @@ pub enum Model {
 pub fn run_all(
     release: &ContinuumScene,
     models: &[Model],
-    control: &Control,
+    limits: &Limits,
 ) -> Result<Vec<Track>, String> {
     models
         .par_iter()
         .map(|&model| match model {
-            Model::Chain(n) => chain_track(release, n, control),
-            Model::Continuum(v) => continuum_track(release, v, control),
+            Model::Chain(n) => chain_track(release, n, limits),
+            Model::Continuum(v) => continuum_track(release, v, limits),
         })
         .collect()
 }

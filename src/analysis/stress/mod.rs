@@ -12,8 +12,8 @@ use std::time::Instant;
 
 pub mod closed_forms;
 
+use crate::engine::Limits;
 use crate::engine::Status;
-use crate::runner::Control;
 use crate::scene::solver::SolverSpec;
 use crate::scene::{Registry, Scene, SceneError};
 
@@ -198,14 +198,13 @@ pub fn run_case(
     let mut scene = scene.clone();
     scene.set_solver(setting.clone())?;
     let reference = closed_forms::reference(case, &scene).unwrap_or_else(|| scene.reference())?;
-    let control = Control {
+    let limits = Limits {
         stop: None,
         max_wall_seconds: Some(wall_seconds),
-        deadline: None,
-        past_horizon: false,
+        ..Limits::default()
     };
     let start = Instant::now();
-    let run = reference.measure(&scene, &control)?;
+    let run = reference.measure(&scene, &limits)?;
     let wall = start.elapsed().as_secs_f64();
     let (report, o) = (&run.report, &run.report.outcome);
     let measured = Measured {

@@ -14,7 +14,6 @@ use serde::{Deserialize, Serialize};
 
 use crate::engine::step::method::NAMES;
 use crate::engine::{EachEvent, Status};
-use crate::runner;
 use crate::scene::Reference;
 use crate::scene::solver::SolverSpec;
 use crate::scene::{Scene, SceneError};
@@ -114,12 +113,12 @@ impl Plan {
 }
 
 /// Run every method of `plan` on `scene` and measure it against the
-/// reference; `control`'s stop flag ends the comparison between runs and
+/// reference; `limits`'s stop flag ends the comparison between runs and
 /// interrupts the one under way.
 pub fn compare(
     scene: &Scene,
     plan: &Plan,
-    control: &runner::Control,
+    limits: &crate::engine::Limits,
     progress: &mut dyn FnMut(&Row),
 ) -> Result<(Reference, Vec<Row>), SceneError> {
     let reference = scene.reference()?;
@@ -146,17 +145,17 @@ pub fn compare(
             _ => vec![spec(method, None, None)],
         };
         for setting in settings {
-            if control.stopped() {
+            if limits.stopped() {
                 return Err(SceneError {
                     file: None,
                     field: None,
-                    reason: control.stop_reason().into(),
+                    reason: limits.stop_reason().into(),
                     untrusted: true,
                 });
             }
             let mut run_scene = scene.clone();
             run_scene.set_solver(setting.clone())?;
-            let row = measure(&run_scene, &setting, &reference, control)?;
+            let row = measure(&run_scene, &setting, &reference, limits)?;
             progress(&row);
             rows.push(row);
         }
@@ -193,18 +192,18 @@ fn measure(
     scene: &Scene,
     setting: &SolverSpec,
     reference: &Reference,
-    control: &runner::Control,
+    limits: &crate::engine::Limits,
 ) -> Result<Row, SceneError> {
     let start = Instant::now();
-    let run = reference.measure(scene, control)?;
+    let run = reference.measure(scene, limits)?;
     let mut walls = vec![start.elapsed().as_secs_f64()];
-    while !control.stopped()
+    while !limits.stopped()
         && (walls.len() < 3 || (walls.iter().sum::<f64>() < 0.05 && walls.len() < 1000))
     {
         let start = Instant::now();
         // Every event fired, as in the measured run: a run that looks at
         // none would jump over a periodic orbit's periods.
-        scene.run(control, &mut EachEvent)?;
+        scene.run(limits, &mut EachEvent)?;
         walls.push(start.elapsed().as_secs_f64());
     }
     walls.sort_by(f64::total_cmp);

@@ -1,10 +1,11 @@
 //! A run said in three parts: the [`Problem`] (a model, where it starts,
 //! how long it runs), the [`Method`] that solves it, and the [`Limits`] it
-//! runs under (an event budget, a wall-time budget, a stop flag). [`Options`]
+//! runs under (an event budget, a wall-time budget or deadline, a stop flag). [`Options`]
 //! holds all three at once for [`simulate`]; a problem builds it.
 
 use std::sync::Arc;
-use std::sync::atomic::AtomicBool;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
 
 use crate::engine::model::{HybridModel, Mode};
 use crate::engine::run::observer::Observer;
@@ -27,13 +28,20 @@ pub struct Problem<'m, M: HybridModel + ?Sized> {
     pub t_end: f64,
 }
 
-/// What may end a run besides reaching `t_end`.
-#[derive(Debug, Clone)]
+/// What may end a run besides reaching `t_end`, set from outside the
+/// model: by a program, a scene's front end, or a tool that runs many.
+#[derive(Debug, Clone, Default)]
 pub struct Limits {
-    /// The run fails once it would log more events than this.
-    pub max_events: u64,
+    /// The run fails once it would log more events than this; unset, the
+    /// run's own budget ([`MAX_EVENTS`] for a problem, a scene's
+    /// `max_events`). Where both are set the tighter holds.
+    pub max_events: Option<u64>,
     /// The run fails after this much wall time (seconds), if set.
     pub max_wall_seconds: Option<f64>,
+    /// When the whole work under these limits must end (a tool's
+    /// `--wall`): each run gets what is left of it, and a tool that runs
+    /// many begins none past it.
+    pub deadline: Option<Instant>,
     /// Set from outside (a signal handler) to interrupt the run cleanly.
     pub stop: Option<Arc<AtomicBool>>,
     /// Go on past the horizon as a pseudo-orbit instead of stopping there
@@ -41,14 +49,64 @@ pub struct Limits {
     pub past_horizon: bool,
 }
 
-impl Default for Limits {
-    /// 10^9 events, no wall-time budget, no stop flag.
-    fn default() -> Self {
-        Limits {
-            max_events: 1_000_000_000,
-            max_wall_seconds: None,
-            stop: None,
-            past_horizon: false,
+/// A problem's event budget unless its limits set one.
+pub const MAX_EVENTS: u64 = 1_000_000_000;
+
+impl Limits {
+    /// Whether the stop flag is set or the deadline has passed: a tool
+    /// that runs many scenes stops between them.
+    pub fn stopped(&self) -> bool {
+        self.interrupted() || self.past_deadline()
+    }
+
+    /// Whether the stop flag is set.
+    pub fn interrupted(&self) -> bool {
+        self.stop
+            .as_ref()
+            .is_some_and(|s| s.load(Ordering::Relaxed))
+    }
+
+    /// Whether the deadline has passed.
+    pub fn past_deadline(&self) -> bool {
+        self.deadline.is_some_and(|d| Instant::now() >= d)
+    }
+
+    /// Why the work stopped, in words, once [`stopped`](Limits::stopped).
+    pub fn stop_reason(&self) -> &'static str {
+        if self.interrupted() {
+            "interrupted: the stop flag was set"
+        } else {
+            "stopped: past the wall-clock budget (--wall)"
+        }
+    }
+
+    /// The [`Options`] of a run to `t_end` by `method` (with `tolerances`
+    /// where `Auto` takes Dormand-Prince) whose own event budget is
+    /// `max_events`, under these limits: the tighter budget, and the wall
+    /// time left before the deadline where that is sooner.
+    pub fn options(
+        &self,
+        t_end: f64,
+        max_events: u64,
+        method: Method,
+        tolerances: Tolerances,
+    ) -> Options {
+        Options {
+            t_end,
+            max_events: self
+                .max_events
+                .map_or(max_events, |own| own.min(max_events)),
+            method,
+            tolerances,
+            stop: self.stop.clone(),
+            max_wall_seconds: match (self.max_wall_seconds, self.deadline) {
+                (own, None) => own,
+                (own, Some(d)) => {
+                    let left = d.saturating_duration_since(Instant::now()).as_secs_f64();
+                    Some(own.map_or(left, |own| own.min(left)))
+                }
+            },
+            past_horizon: self.past_horizon,
         }
     }
 }
@@ -66,20 +124,13 @@ impl<'m, M: HybridModel + ?Sized> Problem<'m, M> {
 
     /// The [`Options`] of solving it by `method` under `limits`.
     pub fn options(&self, method: Method, limits: &Limits) -> Options {
-        Options {
-            t_end: self.t_end,
-            max_events: limits.max_events,
-            method,
-            // What `Auto` takes where a mode has only an ODE: the method's
-            // own tolerances where it names them.
-            tolerances: match method {
-                Method::Dopri5(t) | Method::Dop853(t) | Method::Taylor(t) => t,
-                _ => Tolerances::default(),
-            },
-            stop: limits.stop.clone(),
-            max_wall_seconds: limits.max_wall_seconds,
-            past_horizon: limits.past_horizon,
-        }
+        // What `Auto` takes where a mode has only an ODE: the method's own
+        // tolerances where it names them.
+        let tolerances = match method {
+            Method::Dopri5(t) | Method::Dop853(t) | Method::Taylor(t) => t,
+            _ => Tolerances::default(),
+        };
+        limits.options(self.t_end, MAX_EVENTS, method, tolerances)
     }
 
     /// Solve it by `method` under `limits`, events to `observer`.
@@ -153,10 +204,39 @@ mod tests {
         }
         // The limits are the run's: one event allowed, none.
         let none = Limits {
-            max_events: 0,
+            max_events: Some(0),
             ..Limits::default()
         };
         let outcome = problem.solve(Method::Dopri5(tight), &none, &mut ());
         assert_eq!(outcome.status, crate::engine::Status::Failed);
+    }
+
+    #[test]
+    fn the_tighter_budget_holds_and_a_deadline_leaves_what_is_left() {
+        let options =
+            |limits: &Limits| limits.options(1.0, 10, Method::Exact, Tolerances::default());
+        assert_eq!(options(&Limits::default()).max_events, 10);
+        let with = |n| Limits {
+            max_events: Some(n),
+            ..Limits::default()
+        };
+        assert_eq!(options(&with(5)).max_events, 5);
+        assert_eq!(options(&with(50)).max_events, 10);
+        // A deadline already past leaves no wall time, and stops a tool.
+        let past = Limits {
+            max_wall_seconds: Some(60.0),
+            deadline: Some(Instant::now()),
+            ..Limits::default()
+        };
+        assert_eq!(options(&past).max_wall_seconds, Some(0.0));
+        assert!(past.stopped() && !past.interrupted());
+        // A deadline later than the run's own budget leaves the budget.
+        let later = Limits {
+            max_wall_seconds: Some(1.0),
+            deadline: Instant::now().checked_add(std::time::Duration::from_secs(3600)),
+            ..Limits::default()
+        };
+        assert_eq!(options(&later).max_wall_seconds, Some(1.0));
+        assert!(!later.stopped());
     }
 }

@@ -4,7 +4,7 @@
 //!
 //! ```
 //! use flicker::models::automaton::{AutomatonBuilder, TransitionBuilder};
-//! use flicker::runner::Control;
+//! use flicker::engine::Limits;
 //!
 //! let scene = AutomatonBuilder::new()
 //!     .parameter("g", 9.81)
@@ -17,7 +17,7 @@
 //!     .energy("v^2 / 2 + g * y")
 //!     .scene(10.0)
 //!     .unwrap();
-//! let report = scene.run(&Control::default(), &mut ()).unwrap();
+//! let report = scene.run(&Limits::default(), &mut ()).unwrap();
 //! // Dropped from 1 m, the ball first lands at sqrt(2 h / g).
 //! assert_eq!(report.outcome.status.as_str(), "zeno");
 //! assert!(report.outcome.events > 30);

@@ -13,9 +13,9 @@ use rand::RngExt;
 use rayon::prelude::*;
 use serde_json::{Value, json};
 
+use crate::engine::Limits;
 use crate::engine::{HybridModel, Name, Status, simulate_sampled};
 use crate::models::automaton::scene::AutomatonScene;
-use crate::runner::Control;
 use crate::runner::ensemble::{EnsembleReport, EnsembleRequest, spread};
 use crate::scene::SceneError;
 
@@ -56,7 +56,7 @@ pub fn check(scene: &AutomatonScene, request: &EnsembleRequest) -> Result<(), Sc
 pub fn run(
     scene: &AutomatonScene,
     request: &EnsembleRequest,
-    control: &Control,
+    limits: &Limits,
 ) -> Result<EnsembleReport, String> {
     check(scene, request).map_err(|e| e.reason)?;
     let times: Vec<f64> = (0..SAMPLES)
@@ -64,7 +64,7 @@ pub fn run(
         .collect();
     let runs: Vec<Vec<Vec<f64>>> = (0..request.copies)
         .into_par_iter()
-        .map(|copy| run_copy(scene, request, copy, &times, control))
+        .map(|copy| run_copy(scene, request, copy, &times, limits))
         .collect::<Result<_, _>>()?;
     let reached = runs.iter().map(Vec::len).min().unwrap_or(0);
     let names = scene.automaton.state_names(0);
@@ -94,7 +94,7 @@ fn run_copy(
     request: &EnsembleRequest,
     copy: usize,
     times: &[f64],
-    control: &Control,
+    limits: &Limits,
 ) -> Result<Vec<Vec<f64>>, String> {
     let model = &*scene.automaton;
     let mut rng = request.stream(copy);
@@ -113,7 +113,7 @@ fn run_copy(
         *v += request.perturb * scale * rng.random_range(-1.0..=1.0);
     }
     let (method, _) = scene.resolved();
-    let options = control.options(scene.t_end, scene.max_events, method, scene.tolerances);
+    let options = limits.options(scene.t_end, scene.max_events, method, scene.tolerances);
     let mut samples = Vec::with_capacity(times.len());
     let outcome = simulate_sampled(
         model,

@@ -4,11 +4,12 @@
 
 use std::sync::Arc;
 
+use crate::engine::Limits;
 use crate::engine::step::method::cheapest;
 use crate::engine::{Method, Observer, Sample, Tolerances, simulate_sampled, step::taylor_method};
 use crate::models::automaton::definition::{Definition, Transition};
 use crate::models::automaton::model::Automaton;
-use crate::runner::{Control, Report};
+use crate::runner::Report;
 use crate::scene::fields::Fields;
 use crate::scene::solver::SolverSpec;
 use crate::scene::{Scene, SceneError, SceneModel};
@@ -148,13 +149,13 @@ impl AutomatonScene {
     /// each of `times` passed to `on_sample`.
     pub(super) fn run_sampled(
         &self,
-        control: &Control,
+        limits: &Limits,
         times: &[f64],
         on_sample: &mut dyn FnMut(&Sample),
         observer: &mut dyn Observer,
     ) -> Result<Report, SceneError> {
         let (method, description) = self.resolved();
-        let options = control.options(self.t_end, self.max_events, method, self.tolerances);
+        let options = limits.options(self.t_end, self.max_events, method, self.tolerances);
         let model = &*self.automaton;
         let outcome = simulate_sampled(
             model,

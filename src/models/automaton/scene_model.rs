@@ -3,6 +3,7 @@
 //! samples, measures against and offers the tools, each handed to the
 //! module that does it (`run.rs`, the family, the ensemble).
 
+use crate::engine::Limits;
 use crate::engine::bound::zeno;
 use crate::engine::step::integrator::{methods_for, runs};
 use crate::engine::{
@@ -10,7 +11,7 @@ use crate::engine::{
 };
 use crate::models::automaton::scene::AutomatonScene;
 use crate::runner::ensemble::{EnsembleReport, EnsembleRequest};
-use crate::runner::{Control, Report, Trajectory};
+use crate::runner::{Report, Trajectory};
 use crate::scene::Reference;
 use crate::scene::solver::{SolverSpec, check_steps};
 use crate::scene::{SceneError, SceneModel};
@@ -166,8 +167,8 @@ impl SceneModel for AutomatonScene {
         lines
     }
 
-    fn run(&self, control: &Control, observer: &mut dyn Observer) -> Result<Report, SceneError> {
-        self.run_sampled(control, &[], &mut |_| {}, observer)
+    fn run(&self, limits: &Limits, observer: &mut dyn Observer) -> Result<Report, SceneError> {
+        self.run_sampled(limits, &[], &mut |_| {}, observer)
     }
 
     fn family(&self) -> Result<Box<dyn Family>, SceneError> {
@@ -180,13 +181,13 @@ impl SceneModel for AutomatonScene {
 
     fn sampled(
         &self,
-        control: &Control,
+        limits: &Limits,
         times: &[f64],
         observer: &mut dyn Observer,
     ) -> Option<Result<Trajectory, SceneError>> {
         let names = self.automaton.state_names(0).to_vec();
         Some(Trajectory::record(names, |on_sample| {
-            self.run_sampled(control, times, on_sample, observer)
+            self.run_sampled(limits, times, on_sample, observer)
         }))
     }
 
@@ -197,9 +198,9 @@ impl SceneModel for AutomatonScene {
     fn ensemble(
         &self,
         request: &EnsembleRequest,
-        control: &Control,
+        limits: &Limits,
     ) -> Result<EnsembleReport, String> {
-        super::ensemble::run(self, request, control)
+        super::ensemble::run(self, request, limits)
     }
 
     /// The exact linear propagator where every mode is affine, else
@@ -233,7 +234,7 @@ impl SceneModel for AutomatonScene {
         let mut exact = self.clone();
         exact.method = method;
         let mut times = EventTimes::default();
-        let report = exact.run(&Control::default(), &mut times)?;
+        let report = exact.run(&Limits::default(), &mut times)?;
         let o = report.outcome;
         // A run that stops at a Zeno point stops where it can no longer
         // resolve the events, which differs from method to method: it is

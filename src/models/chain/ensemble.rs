@@ -13,11 +13,11 @@ use rand::RngExt;
 use rayon::prelude::*;
 use serde_json::json;
 
+use crate::engine::Limits;
 use crate::engine::{Method, Options, Status, Tolerances, simulate_local};
 use crate::models::chain::coarse::Coarse;
 use crate::models::chain::scene::ChainScene;
 use crate::models::chain::{Chain, TaylorChain};
-use crate::runner::Control;
 use crate::runner::ensemble::{EnsembleReport, EnsembleRequest, spread};
 use crate::scene::SceneError;
 use crate::time::Time;
@@ -112,12 +112,12 @@ pub fn check(scene: &ChainScene, request: &EnsembleRequest) -> Result<(), SceneE
 pub fn run_ensemble(
     scene: &ChainScene,
     request: &EnsembleRequest,
-    control: &Control,
+    limits: &Limits,
 ) -> Result<Ensemble, String> {
     check(scene, request).map_err(|e| e.reason)?;
     let times = scene.sample_times();
     let chain = scene.chain(scene.constraint);
-    let options = control.options(
+    let options = limits.options(
         scene.t_end,
         scene.max_events,
         Method::Exact,

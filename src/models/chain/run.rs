@@ -2,15 +2,14 @@
 //! chain as an ODE under a numerical method (the independent path), with
 //! profiles at the snapshot times and the trace at the sample times.
 
+use crate::engine::Limits;
 use crate::engine::{
     HybridModel, LocalModel, Method, Name, Observer, Options, Outcome, Sample, Status,
     simulate_local, simulate_sampled,
 };
 use crate::models::chain::scene::ChainScene;
 use crate::models::chain::{Chain, TaylorChain};
-use crate::runner::{
-    CLASSICAL_MAX_UNITS, Classical, Control, FieldOutputs, Profile, Report, TraceRow,
-};
+use crate::runner::{CLASSICAL_MAX_UNITS, Classical, FieldOutputs, Profile, Report, TraceRow};
 use crate::scene::SceneError;
 use crate::time::Time;
 
@@ -98,11 +97,11 @@ impl<'s> Sampler<'s> {
 
 pub(crate) fn run(
     scene: &ChainScene,
-    control: &Control,
+    limits: &Limits,
     observer: &mut dyn Observer,
 ) -> Result<Report, SceneError> {
     let chain = scene.chain(scene.constraint);
-    let options = control.options(
+    let options = limits.options(
         scene.t_end,
         scene.max_events,
         scene.method,

@@ -3,11 +3,12 @@
 //! samples, measures against and offers the tools, each handed to the
 //! module that does it (`run.rs`, the family, the ensemble).
 
+use crate::engine::Limits;
 use crate::engine::Observer;
 use crate::engine::step::integrator::methods_for;
 use crate::models::chain::scene::{ChainScene, MAX_ODE_UNITS, resolve_solver};
+use crate::runner::Report;
 use crate::runner::ensemble::{EnsembleReport, EnsembleRequest};
-use crate::runner::{Control, Report};
 use crate::scene::Reference;
 use crate::scene::extent;
 use crate::scene::solver::{SolverSpec, check_steps};
@@ -75,8 +76,8 @@ impl SceneModel for ChainScene {
         ]
     }
 
-    fn run(&self, control: &Control, observer: &mut dyn Observer) -> Result<Report, SceneError> {
-        super::run::run(self, control, observer)
+    fn run(&self, limits: &Limits, observer: &mut dyn Observer) -> Result<Report, SceneError> {
+        super::run::run(self, limits, observer)
     }
 
     fn reference(&self) -> Result<Reference, SceneError> {
@@ -99,9 +100,9 @@ impl SceneModel for ChainScene {
     fn ensemble(
         &self,
         request: &EnsembleRequest,
-        control: &Control,
+        limits: &Limits,
     ) -> Result<EnsembleReport, String> {
-        super::ensemble::run_ensemble(self, request, control).map(|e| super::ensemble::report(&e))
+        super::ensemble::run_ensemble(self, request, limits).map(|e| super::ensemble::report(&e))
     }
 
     fn clone_box(&self) -> Box<dyn SceneModel> {

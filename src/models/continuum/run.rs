@@ -3,31 +3,32 @@
 //! snapshot times, the trace at the sample times, and the classical string
 //! (constraint off) beside it.
 
+use crate::engine::Limits;
 use crate::engine::{Method, Name, Observer, Outcome, Status, simulate_local};
 use crate::models::continuum::scene::ContinuumScene;
 use crate::models::continuum::{FrontTracking, Homogenized, StringModel, Variant};
-use crate::runner::{Classical, Control, FieldOutputs, Profile, Report, TraceRow};
+use crate::runner::{Classical, FieldOutputs, Profile, Report, TraceRow};
 use crate::scene::SceneError;
 use crate::time::Time;
 
 pub(crate) fn run(
     scene: &ContinuumScene,
-    control: &Control,
+    limits: &Limits,
     observer: &mut dyn Observer,
 ) -> Result<Report, SceneError> {
     let (outcome, mut fields) = match scene.variant {
         Variant::Paper => {
             let mut model = front_tracking(scene, scene.constraint)?;
-            run_model(scene, &mut model, control, observer)
+            run_model(scene, &mut model, limits, observer)
         }
         Variant::Homogenized => {
             let mut model = homogenized(scene)?;
-            run_model(scene, &mut model, control, observer)
+            run_model(scene, &mut model, limits, observer)
         }
     };
     if scene.constraint && outcome.status == Status::Completed {
         let mut classical = front_tracking(scene, false)?;
-        let (companion, sampled) = sample(scene, &mut classical, control, &mut ());
+        let (companion, sampled) = sample(scene, &mut classical, limits, &mut ());
         // A companion cut short (interrupted) is left out, not shown half.
         if companion.status == Status::Completed {
             fields.classical = Some(Classical {
@@ -86,10 +87,10 @@ pub fn homogenized(scene: &ContinuumScene) -> Result<Homogenized, SceneError> {
 fn run_model<M: StringModel>(
     scene: &ContinuumScene,
     model: &mut M,
-    control: &Control,
+    limits: &Limits,
     observer: &mut dyn Observer,
 ) -> (Outcome, FieldOutputs) {
-    let (outcome, sampled) = sample(scene, model, control, observer);
+    let (outcome, sampled) = sample(scene, model, limits, observer);
     let end = Time::new(outcome.t_reached);
     let string = scene.string(scene.constraint);
     let momentum = model.momentum(end);
@@ -148,10 +149,10 @@ struct Sampled {
 fn sample<M: StringModel>(
     scene: &ContinuumScene,
     model: &mut M,
-    control: &Control,
+    limits: &Limits,
     observer: &mut dyn Observer,
 ) -> (Outcome, Sampled) {
-    let options = control.options(
+    let options = limits.options(
         scene.t_end,
         scene.max_events,
         crate::engine::Method::Exact,

@@ -3,10 +3,11 @@
 //! samples, measures against and offers the tools, each handed to the
 //! module that does it (`run.rs`, the family).
 
+use crate::engine::Limits;
 use crate::engine::{Method, Observer};
 use crate::models::continuum::Variant;
 use crate::models::continuum::scene::{ContinuumScene, OWN_METHOD};
-use crate::runner::{Control, Report};
+use crate::runner::Report;
 use crate::scene::Reference;
 use crate::scene::extent;
 use crate::scene::solver::SolverSpec;
@@ -82,8 +83,8 @@ impl SceneModel for ContinuumScene {
         ]
     }
 
-    fn run(&self, control: &Control, observer: &mut dyn Observer) -> Result<Report, SceneError> {
-        super::run::run(self, control, observer)
+    fn run(&self, limits: &Limits, observer: &mut dyn Observer) -> Result<Report, SceneError> {
+        super::run::run(self, limits, observer)
     }
 
     fn reference(&self) -> Result<Reference, SceneError> {

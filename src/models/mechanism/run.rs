@@ -1,18 +1,19 @@
 //! Running a mechanism scene in the formulation and method it asks for.
 
+use crate::engine::Limits;
 use crate::engine::{Method, Name, Observer, Sample, simulate_sampled};
 use crate::models::mechanism::scene::{Formulation, Initial, MechanismScene};
 use crate::models::mechanism::strain::FLIGHT;
 use crate::models::mechanism::{AngleMechanism, Charts, StrainMechanism};
-use crate::runner::{Control, Report};
+use crate::runner::Report;
 use crate::scene::SceneError;
 
 pub(crate) fn run(
     scene: &MechanismScene,
-    control: &Control,
+    limits: &Limits,
     observer: &mut dyn Observer,
 ) -> Result<Report, SceneError> {
-    run_sampled(scene, control, &[], &mut |_| {}, observer)
+    run_sampled(scene, limits, &[], &mut |_| {}, observer)
 }
 
 /// [`run`], the state at each of `times` passed to `on_sample`: the strain
@@ -20,12 +21,12 @@ pub(crate) fn run(
 /// mapped back to them).
 pub(crate) fn run_sampled(
     scene: &MechanismScene,
-    control: &Control,
+    limits: &Limits,
     times: &[f64],
     on_sample: &mut dyn FnMut(&Sample),
     observer: &mut dyn Observer,
 ) -> Result<Report, SceneError> {
-    let options = control.options(
+    let options = limits.options(
         scene.t_end,
         scene.max_events,
         scene.method,

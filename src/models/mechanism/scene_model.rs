@@ -3,6 +3,7 @@
 //! samples, measures against and offers the tools, each handed to the
 //! module that does it (`run.rs`, the family).
 
+use crate::engine::Limits;
 use crate::engine::Name;
 use crate::engine::Observer;
 use crate::engine::step::integrator::methods_for;
@@ -10,7 +11,7 @@ use crate::models::mechanism::ExactOrbit;
 use crate::models::mechanism::scene::{
     Formulation, MechanismScene, regime, resolve_solver, with_model,
 };
-use crate::runner::{Control, Report, Trajectory};
+use crate::runner::{Report, Trajectory};
 use crate::scene::Reference;
 use crate::scene::solver::{SolverSpec, check_steps};
 use crate::scene::{SceneError, SceneModel};
@@ -71,8 +72,8 @@ impl SceneModel for MechanismScene {
         ]
     }
 
-    fn run(&self, control: &Control, observer: &mut dyn Observer) -> Result<Report, SceneError> {
-        super::run::run(self, control, observer)
+    fn run(&self, limits: &Limits, observer: &mut dyn Observer) -> Result<Report, SceneError> {
+        super::run::run(self, limits, observer)
     }
 
     fn family(&self) -> Result<Box<dyn crate::engine::Family>, SceneError> {
@@ -85,13 +86,13 @@ impl SceneModel for MechanismScene {
 
     fn sampled(
         &self,
-        control: &Control,
+        limits: &Limits,
         times: &[f64],
         observer: &mut dyn Observer,
     ) -> Option<Result<Trajectory, SceneError>> {
         Some(Trajectory::record(
             vec![Name::new("strain"), Name::new("strain_rate")],
-            |on_sample| super::run::run_sampled(self, control, times, on_sample, observer),
+            |on_sample| super::run::run_sampled(self, limits, times, on_sample, observer),
         ))
     }
 
