@@ -12,8 +12,8 @@ use std::time::Instant;
 
 pub mod closed_forms;
 
-use crate::engine::Limits;
-use crate::engine::Status;
+use crate::engine::step::method::{Setting, setting};
+use crate::engine::{Limits, Status};
 use crate::scene::solver::SolverSpec;
 use crate::scene::{Registry, Scene, SceneError};
 
@@ -173,9 +173,12 @@ pub fn settings(scene: &Scene) -> Vec<SolverSpec> {
         .methods()
         .into_iter()
         .map(|method| {
-            let (tol, step) = match method {
-                "dopri5" | "dop853" => (Some(TOLERANCE), None),
-                "verlet" => (None, Some(step)),
+            let (tol, step) = match setting(method) {
+                // Taylor's method at its own default, machine precision:
+                // the suite judges it where it is meant to run.
+                Some(Setting::Tolerances) if method == "taylor" => (None, None),
+                Some(Setting::Tolerances) => (Some(TOLERANCE), None),
+                Some(Setting::Step) => (None, Some(step)),
                 _ => (None, None),
             };
             SolverSpec {

@@ -12,7 +12,7 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
-use crate::engine::step::method::NAMES;
+use crate::engine::step::method::{NAMES, Setting, setting};
 use crate::engine::{EachEvent, Status};
 use crate::scene::Reference;
 use crate::scene::solver::SolverSpec;
@@ -124,13 +124,13 @@ pub fn compare(
     let reference = scene.reference()?;
     let mut rows = Vec::new();
     for method in &plan.methods {
-        let settings: Vec<SolverSpec> = match method.as_str() {
-            "dopri5" | "dop853" | "taylor" => plan
+        let settings: Vec<SolverSpec> = match setting(method) {
+            Some(Setting::Tolerances) => plan
                 .tolerances
                 .iter()
                 .map(|&tol| spec(method, Some(tol), None))
                 .collect(),
-            "verlet" => plan
+            Some(Setting::Step) => plan
                 .steps
                 .clone()
                 .unwrap_or_else(|| {

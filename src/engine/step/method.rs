@@ -40,6 +40,29 @@ pub enum Method {
 /// The method names a scene's `solver.method` or `--method` may give.
 pub const NAMES: [&str; 6] = ["exact", "linear", "taylor", "dopri5", "dop853", "verlet"];
 
+/// What a method named in [`NAMES`] is set by besides its name: the keys
+/// [`Method::parse`] takes for it, the settings `flicker compare` sweeps
+/// and the stress suite fixes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Setting {
+    /// Nothing: the closed form, the linear propagator.
+    None,
+    /// `rtol` and `atol`: the adaptive methods.
+    Tolerances,
+    /// `step`: the fixed-step method.
+    Step,
+}
+
+/// How the method `name` is set, or `None` for a name not in [`NAMES`].
+pub fn setting(name: &str) -> Option<Setting> {
+    match name {
+        "exact" | "linear" => Some(Setting::None),
+        "taylor" | "dopri5" | "dop853" => Some(Setting::Tolerances),
+        "verlet" => Some(Setting::Step),
+        _ => None,
+    }
+}
+
 /// A method named with a key that does not belong to it, or without one it
 /// needs: the key (`method`, `rtol`, `atol` or `step`) and why.
 #[derive(Debug, Clone, PartialEq)]
@@ -87,37 +110,45 @@ impl Method {
             key,
             reason: format!("does not apply to method {method:?}"),
         };
-        let method = match name {
-            None | Some("dopri5" | "dop853" | "taylor") if step.is_some() => {
-                return Err(not_for("step", name.unwrap_or("auto")));
+        let Some(name) = name else {
+            return match step {
+                Some(_) => Err(not_for("step", "auto")),
+                None => Ok((Method::Auto, tolerances)),
+            };
+        };
+        let refused = match setting(name) {
+            None => {
+                return Err(Refused {
+                    key: "method",
+                    reason: format!("unknown method {name:?} (known: {})", NAMES.join(", ")),
+                });
             }
-            None => Method::Auto,
-            Some("dopri5") => Method::Dopri5(tolerances),
-            Some("dop853") => Method::Dop853(tolerances),
-            Some("taylor") => Method::Taylor(Tolerances {
+            Some(Setting::Tolerances) => step.map(|_| "step"),
+            Some(Setting::Step) => rtol.map(|_| "rtol").or(atol.map(|_| "atol")),
+            Some(Setting::None) => rtol
+                .map(|_| "rtol")
+                .or(atol.map(|_| "atol"))
+                .or(step.map(|_| "step")),
+        };
+        if let Some(key) = refused {
+            return Err(not_for(key, name));
+        }
+        let method = match name {
+            "dopri5" => Method::Dopri5(tolerances),
+            "dop853" => Method::Dop853(tolerances),
+            "taylor" => Method::Taylor(Tolerances {
                 rtol: rtol.unwrap_or(taylor_method::DEFAULT_TOLERANCE),
                 atol: atol.unwrap_or(taylor_method::DEFAULT_TOLERANCE),
             }),
-            Some(other @ ("verlet" | "linear" | "exact")) if rtol.is_some() || atol.is_some() => {
-                return Err(not_for(if rtol.is_some() { "rtol" } else { "atol" }, other));
-            }
-            Some("verlet") => Method::Verlet {
+            "verlet" => Method::Verlet {
                 step: step.ok_or_else(|| Refused {
                     key: "step",
                     reason: "is required by method \"verlet\"".into(),
                 })?,
             },
-            Some(other @ ("linear" | "exact")) if step.is_some() => {
-                return Err(not_for("step", other));
-            }
-            Some("linear") => Method::Linear,
-            Some("exact") => Method::Exact,
-            Some(other) => {
-                return Err(Refused {
-                    key: "method",
-                    reason: format!("unknown method {other:?} (known: {})", NAMES.join(", ")),
-                });
-            }
+            "linear" => Method::Linear,
+            // "exact": the last name `setting` knows.
+            _ => Method::Exact,
         };
         Ok((method, tolerances))
     }
@@ -279,5 +310,32 @@ mod tests {
         );
         let refused = Method::parse(Some("rk4"), None, None, None).unwrap_err();
         assert_eq!(refused.key, "method");
+    }
+
+    #[test]
+    fn each_name_takes_exactly_the_keys_of_its_setting() {
+        assert_eq!(setting("rk4"), None);
+        for name in NAMES {
+            let allowed: &[&str] = match setting(name).unwrap() {
+                Setting::None => &[],
+                Setting::Tolerances => &["rtol", "atol"],
+                Setting::Step => &["step"],
+            };
+            // Every subset of the three keys, given or not.
+            for given in 0..8 {
+                let has = |bit: usize| given & (1 << bit) != 0;
+                let keys = [("rtol", has(0)), ("atol", has(1)), ("step", has(2))];
+                let value = |bit: usize| has(bit).then_some(0.1);
+                let parsed = Method::parse(Some(name), value(0), value(1), value(2));
+                let stray = keys.iter().find(|(k, on)| *on && !allowed.contains(k));
+                let missing = allowed == ["step"] && !has(2);
+                match (stray, parsed) {
+                    (Some((key, _)), Err(refused)) => assert_eq!(refused.key, *key, "{name}"),
+                    (None, Err(refused)) => assert!(missing && refused.key == "step", "{name}"),
+                    (None, Ok((method, _))) => assert_eq!(method.name(), name),
+                    (Some(_), Ok(_)) => panic!("{name} took a key of another method: {keys:?}"),
+                }
+            }
+        }
     }
 }
