@@ -109,7 +109,7 @@ impl RunRequest {
             scene,
             sensitivities: self.sensitivities.clone(),
             times,
-            ensemble: self.ensemble.clone(),
+            ensemble: self.ensemble,
             past_horizon: self.past_horizon,
         })
     }
