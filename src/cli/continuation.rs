@@ -184,28 +184,7 @@ pub fn continue_orbit(args: ContinueArgs, registry: &Registry) -> Result<Code, F
             .map_err(|e| Failure::untrusted(format!("{}: {e}", path.display())))?;
         written.push(path);
     }
-    say!(
-        "{} orbits along `{}` from {} to {} ({})",
-        branch.points.len(),
-        args.param,
-        first.parameter,
-        branch.points.last().map_or(f64::NAN, |q| q.parameter),
-        branch.ended
-    );
-    for q in branch
-        .points
-        .iter()
-        .filter(|q| !q.label.is_empty() && q.label != "end")
-    {
-        say!(
-            "  {} at {} = {:.12e} (period {:e}, largest multiplier modulus {:.9})",
-            q.label,
-            args.param,
-            q.parameter,
-            q.period,
-            largest(q)
-        );
-    }
+    say_branch(&branch, &args.param, first.parameter);
     let names: Vec<String> = written.iter().map(|p| p.display().to_string()).collect();
     say!("  wrote {}", names.join(", "));
     // A branch that turned back at a fold, or ended at a graze, is an
@@ -222,6 +201,30 @@ pub fn continue_orbit(args: ContinueArgs, registry: &Registry) -> Result<Code, F
         return Ok(Code::stopped(interrupted));
     }
     Ok(if lost { Code::Untrusted } else { Code::Ok })
+}
+
+/// Print the branch followed in `param` from `from`: how far it went and
+/// why it ended, and each bifurcation labelled on it.
+fn say_branch(branch: &Branch, param: &str, from: f64) {
+    say!(
+        "{} orbits along `{param}` from {from} to {} ({})",
+        branch.points.len(),
+        branch.points.last().map_or(f64::NAN, |q| q.parameter),
+        branch.ended
+    );
+    for q in branch
+        .points
+        .iter()
+        .filter(|q| !q.label.is_empty() && q.label != "end")
+    {
+        say!(
+            "  {} at {param} = {:.12e} (period {:e}, largest multiplier modulus {:.9})",
+            q.label,
+            q.parameter,
+            q.period,
+            largest(q)
+        );
+    }
 }
 
 /// The largest modulus among an orbit's multipliers but the trivial one.

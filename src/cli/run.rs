@@ -10,8 +10,8 @@ use crate::log::size_notice::{FIRST_NOTICE, LogSize};
 use crate::log::summary::{summary, write_atomically};
 use crate::log::writer::LazyFile;
 use crate::session::{
-    Ask, EnsembleRequest, METHODS, Registry, Report, RunRequest, Samples, Scene, SolverSpec,
-    Status, Trajectory,
+    Ask, EnsembleRequest, Limits, METHODS, PreparedRun, Registry, Report, RunRequest, Samples,
+    Scene, SceneError, SolverSpec, Status, Trajectory,
 };
 
 use crate::cli::exit::{Code, Failure};
@@ -175,108 +175,43 @@ pub fn run(args: RunArgs, registry: &Registry) -> Result<Code, Failure> {
     let limits = run.limits(Some(crate::cli::setup::stop_flag()));
 
     let log_path = out.join("events.jsonl");
-    let states;
-    let report = if log_events {
-        // Created with the first event or at the end: a run the scene
-        // refuses as it starts leaves no log, and an earlier one untouched.
-        let file = LogSize::new(LazyFile::new(&log_path), FIRST_NOTICE, |s| {
-            eprintln!("flicker: {s}")
-        });
-        let mut observer = WithProgress::new(JsonlWriter::new(file), scene.t_end(), quiet);
-        let ran = run.run(&limits, &mut observer);
-        observer.finish();
-        let (mut report, sampled) = ran.map_err(|e| Failure::bad_input(e.in_path(scene_path)))?;
-        states = sampled;
-        // A log that could not be written spoils the run, but its summary
-        // still says how far it got and why it stopped.
-        let flushed = observer.inner.flush();
-        if let Err(e) = &flushed
-            && report.outcome.status != Status::Failed
-        {
-            report.outcome.status = Status::Failed;
-            report.outcome.reason = Some(format!(
-                "could not write the event log {}: {e}",
-                log_path.display()
-            ));
-        }
-        if report.outcome.status == Status::Failed {
-            // A write that failed half way (a full disk) may have left part
-            // of a line: cut the log back to its last whole line.
-            let _ = crate::log::writer::cut_to_last_line(&log_path);
-        }
-        report
-    } else {
-        let mut observer = WithProgress::new((), scene.t_end(), quiet);
-        let ran = run.run(&limits, &mut observer);
-        observer.finish();
-        let (report, sampled) = ran.map_err(|e| Failure::bad_input(e.in_path(scene_path)))?;
-        states = sampled;
-        report
-    };
-
     let log = log_events.then_some(log_path.as_path());
-    let mut written = Vec::new();
-    if let Some(chain) = &report.fields {
-        let profiles = out.join("profiles.json");
-        let trace = out.join("trace.csv");
-        write_atomically(&profiles, &field_files::profiles(chain))
-            .and_then(|()| field_files::write_trace(chain, &trace))
-            .map_err(|e| {
-                Failure::untrusted(format!("{}: cannot be written: {e}", out.display()))
-            })?;
-        written.extend([profiles, trace]);
-    }
+    let (report, states) = run_logged(&run, &limits, log, quiet)
+        .map_err(|e| Failure::bad_input(e.in_path(scene_path)))?;
     let mut summary = summary(&report, scene.model(), scene_path, log);
-    if let Some(trajectory) = &states {
-        let path = out.join("samples.csv");
-        let Trajectory {
-            names,
-            samples,
-            bounds,
-            ..
-        } = trajectory;
-        crate::log::samples::write_csv(&path, names, samples, bounds).map_err(|e| {
-            Failure::untrusted(format!("{}: cannot be written: {e}", path.display()))
-        })?;
-        summary["samples"] = serde_json::json!({
-            "file": path.display().to_string(),
-            "count": samples.len(),
-            "largest_bound": bounds.iter().copied().fold(0.0, f64::max),
-        });
-        written.push(path);
-    }
-    let mut horizon = None;
-    let mut ensemble_failed = None;
+    let mut written = write_fields_and_samples(&report, states.as_ref(), &out, &mut summary)?;
     // The copies run only after a run that completed: an interrupted or
     // failed run says so by itself.
-    let completed = report.outcome.status == Status::Completed;
-    let ensemble = if completed {
+    let ensemble = if report.outcome.status == Status::Completed {
         run.ensemble(&limits)
     } else {
         None
     };
-    if let Some(found) = ensemble {
-        let path = out.join("ensemble.csv");
-        let found = found.and_then(|found| {
-            found
-                .write_csv(&path)
-                .map(|()| found)
-                .map_err(|e| format!("{}: cannot be written: {e}", path.display()))
-        });
-        match found {
-            Ok(found) => {
-                written.push(path);
-                summary["ensemble"] = found.summary.clone();
-                horizon = Some(found);
-            }
-            Err(why) => {
-                // The run itself stands; the ensemble's failure is said in
-                // its summary and in the exit code.
-                summary["ensemble"] = serde_json::json!({ "error": why });
-                ensemble_failed = Some(why);
+    let (horizon, ensemble_failed) = match ensemble {
+        None => (None, None),
+        Some(found) => {
+            let path = out.join("ensemble.csv");
+            let found = found.and_then(|found| {
+                found
+                    .write_csv(&path)
+                    .map(|()| found)
+                    .map_err(|e| format!("{}: cannot be written: {e}", path.display()))
+            });
+            match found {
+                Ok(found) => {
+                    written.push(path);
+                    summary["ensemble"] = found.summary.clone();
+                    (Some(found), None)
+                }
+                Err(why) => {
+                    // The run itself stands; the ensemble's failure is said
+                    // in its summary and in the exit code.
+                    summary["ensemble"] = serde_json::json!({ "error": why });
+                    (None, Some(why))
+                }
             }
         }
-    }
+    };
     let summary_path = out.join("summary.json");
     write_atomically(&summary_path, &summary).map_err(|e| {
         Failure::untrusted(format!(
@@ -319,6 +254,91 @@ pub fn run(args: RunArgs, registry: &Registry) -> Result<Code, Failure> {
         );
     }
     Ok(Code::of(report.outcome.status))
+}
+
+/// Run `run` under `limits` with its progress drawn (unless `quiet`) and
+/// its events streamed to `log` where given: the report (failed where the
+/// log could not be written) and the samples taken.
+fn run_logged(
+    run: &PreparedRun,
+    limits: &Limits,
+    log: Option<&Path>,
+    quiet: bool,
+) -> Result<(Report, Option<Trajectory>), SceneError> {
+    let t_end = run.scene().t_end();
+    let Some(log_path) = log else {
+        let mut observer = WithProgress::new((), t_end, quiet);
+        let ran = run.run(limits, &mut observer);
+        observer.finish();
+        return ran;
+    };
+    // Created with the first event or at the end: a run the scene refuses
+    // as it starts leaves no log, and an earlier one untouched.
+    let file = LogSize::new(LazyFile::new(log_path), FIRST_NOTICE, |s| {
+        eprintln!("flicker: {s}")
+    });
+    let mut observer = WithProgress::new(JsonlWriter::new(file), t_end, quiet);
+    let ran = run.run(limits, &mut observer);
+    observer.finish();
+    let (mut report, sampled) = ran?;
+    // A log that could not be written spoils the run, but its summary
+    // still says how far it got and why it stopped.
+    if let Err(e) = observer.inner.flush()
+        && report.outcome.status != Status::Failed
+    {
+        report.outcome.status = Status::Failed;
+        report.outcome.reason = Some(format!(
+            "could not write the event log {}: {e}",
+            log_path.display()
+        ));
+    }
+    if report.outcome.status == Status::Failed {
+        // A write that failed half way (a full disk) may have left part of
+        // a line: cut the log back to its last whole line.
+        let _ = crate::log::writer::cut_to_last_line(log_path);
+    }
+    Ok((report, sampled))
+}
+
+/// Write a chain's or continuum's fields and the samples, where the run
+/// has them, into `out`, and say the samples in `summary`: the files
+/// written.
+fn write_fields_and_samples(
+    report: &Report,
+    states: Option<&Trajectory>,
+    out: &Path,
+    summary: &mut serde_json::Value,
+) -> Result<Vec<PathBuf>, Failure> {
+    let mut written = Vec::new();
+    if let Some(chain) = &report.fields {
+        let profiles = out.join("profiles.json");
+        let trace = out.join("trace.csv");
+        write_atomically(&profiles, &field_files::profiles(chain))
+            .and_then(|()| field_files::write_trace(chain, &trace))
+            .map_err(|e| {
+                Failure::untrusted(format!("{}: cannot be written: {e}", out.display()))
+            })?;
+        written.extend([profiles, trace]);
+    }
+    if let Some(trajectory) = states {
+        let path = out.join("samples.csv");
+        let Trajectory {
+            names,
+            samples,
+            bounds,
+            ..
+        } = trajectory;
+        crate::log::samples::write_csv(&path, names, samples, bounds).map_err(|e| {
+            Failure::untrusted(format!("{}: cannot be written: {e}", path.display()))
+        })?;
+        summary["samples"] = serde_json::json!({
+            "file": path.display().to_string(),
+            "count": samples.len(),
+            "largest_bound": bounds.iter().copied().fold(0.0, f64::max),
+        });
+        written.push(path);
+    }
+    Ok(written)
 }
 
 fn default_out(scene: &Path) -> PathBuf {
