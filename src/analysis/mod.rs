@@ -1,11 +1,13 @@
 //! The tools that answer what comes after a run, on any model: periodic
-//! orbits, their continuation and the brute-force diagram ([`orbit`]),
+//! orbits, their continuation and the brute-force diagram drawn under it
+//! ([`orbit`]), bifurcation diagrams of any parameter ([`diagram`]),
 //! Lyapunov spectra ([`lyapunov`]), sensitivities ([`sensitivities`]),
 //! sweeps over parameters and initial values ([`sweep`]); and those that
 //! measure methods and models against exact answers: the stress suite
 //! ([`stress`]), the work-precision chart ([`work_precision`]) and a
 //! release as chains and continua ([`release_convergence`]).
 
+pub mod diagram;
 pub mod lyapunov;
 pub mod orbit;
 pub mod release_convergence;

@@ -27,6 +27,7 @@ pub mod check;
 pub mod compare;
 pub mod compare_models;
 pub mod continuation;
+pub mod diagram;
 pub mod events;
 pub mod exit;
 pub mod lyapunov;
@@ -164,6 +165,10 @@ enum Command {
     /// Find a periodic orbit through a Poincare section (Newton shooting)
     /// and its stability; writes DIR/orbit.json.
     Orbit(orbit::OrbitArgs),
+    /// A brute-force bifurcation diagram: at each value of a parameter, the
+    /// state after each of K section events past a transient; writes
+    /// DIR/diagram.csv, diagram.json and diagram.svg.
+    Diagram(diagram::DiagramArgs),
     /// Follow a periodic orbit in a parameter (pseudo-arclength), label its
     /// bifurcations; writes DIR/continuation.csv and DIR/bifurcation.svg.
     Continue(continuation::ContinueArgs),
@@ -227,6 +232,7 @@ pub fn dispatch(cli: Cli, registry: &Registry) -> Result<Code, Failure> {
         Command::CompareModels(args) => compare_models::compare_models(args, registry),
         Command::Orbit(args) => orbit::orbit(args, registry),
         Command::Continue(args) => continuation::continue_orbit(args, registry),
+        Command::Diagram(args) => diagram::diagram(args, registry),
         Command::Lyapunov(args) => lyapunov::lyapunov(args, registry),
         Command::Advise(args) => advise::advise(args, registry),
         Command::Stress {

@@ -79,3 +79,36 @@ impl<O: Observer> Observer for WithProgress<O> {
         }
     }
 }
+
+/// A progress bar over the points of a sweep or a diagram, drawn only on
+/// a terminal.
+pub struct Points(Option<indicatif::ProgressBar>);
+
+impl Points {
+    /// A bar over `total` points; none if `quiet` or not on a terminal.
+    pub fn new(total: usize, quiet: bool) -> Self {
+        use std::io::IsTerminal;
+        Points((!quiet && std::io::stderr().is_terminal()).then(|| {
+            let bar = indicatif::ProgressBar::new(total as u64);
+            bar.set_style(
+                indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} points ({elapsed})")
+                    .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+            );
+            bar
+        }))
+    }
+
+    /// One point more done.
+    pub fn tick(&self) {
+        if let Some(bar) = &self.0 {
+            bar.inc(1);
+        }
+    }
+
+    /// Clear the bar.
+    pub fn finish(&self) {
+        if let Some(bar) = &self.0 {
+            bar.finish_and_clear();
+        }
+    }
+}

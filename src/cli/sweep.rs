@@ -57,7 +57,7 @@ pub fn sweep(
         deadline,
         ..Default::default()
     };
-    let bar = Points::new(points.points(), quiet);
+    let bar = crate::cli::progress::Points::new(points.points(), quiet);
     let rows = points.run(&limits, &|| bar.tick());
     bar.finish();
     let seconds = started.elapsed().as_secs_f64();
@@ -98,33 +98,4 @@ pub fn merge(
         .map_err(|e| Failure::untrusted(format!("{}: cannot be written: {e}", out.display())))?;
     say!("merged {} shards into {}", shards.len(), out.display());
     Ok(Code::Ok)
-}
-
-/// A progress bar over a sweep's points, drawn only on a terminal.
-struct Points(Option<indicatif::ProgressBar>);
-
-impl Points {
-    fn new(total: usize, quiet: bool) -> Self {
-        use std::io::IsTerminal;
-        Points((!quiet && std::io::stderr().is_terminal()).then(|| {
-            let bar = indicatif::ProgressBar::new(total as u64);
-            bar.set_style(
-                indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} points ({elapsed})")
-                    .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-            );
-            bar
-        }))
-    }
-
-    fn tick(&self) {
-        if let Some(bar) = &self.0 {
-            bar.inc(1);
-        }
-    }
-
-    fn finish(&self) {
-        if let Some(bar) = &self.0 {
-            bar.finish_and_clear();
-        }
-    }
 }

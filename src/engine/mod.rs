@@ -23,7 +23,7 @@ pub use run::local::{Accuracy, Fired, LocalModel, simulate_local};
 pub use run::observer::{
     EachEvent, EventRecord, EventTimes, Observer, RecordedEvent, Recorder, SETTLE,
 };
-pub use run::problem::{Limits, Problem};
+pub use run::problem::{Limits, MAX_EVENTS, Problem};
 pub use run::simulation::{Sample, simulate, simulate_sampled};
 pub use run::{FastForward, Options, Outcome, Status};
 pub use step::adaptive::Tolerances;

@@ -11,6 +11,7 @@
 //! | `check`, `flicker.check` | [`read`] → [`Input::check_lines`] |
 //! | `compare`, `flicker.compare` | [`CompareRequest`] → [`Comparison`] |
 //! | `sweep`, `merge`, `flicker.sweep` | [`load`], [`read`] → [`SweepRun`], [`merge`] |
+//! | `diagram` | [`DiagramRequest`] → [`PreparedDiagram`] |
 //! | `stress` | [`stress()`] |
 //! | `compare-models` | [`ModelsRequest`] → [`ModelsCompared`] |
 //! | `advise` | [`probe`] |
@@ -25,6 +26,7 @@
 //! `tests/flicker/one_door.rs` checks.
 
 mod compare;
+mod diagram;
 mod portraits;
 mod releases;
 mod run;
@@ -34,6 +36,7 @@ mod stress;
 mod sweeps;
 
 pub use compare::{CompareRequest, Comparison};
+pub use diagram::{DiagramRequest, PreparedDiagram};
 pub use portraits::{mechanism_portrait, state_plane};
 pub use releases::{Measured, ModelsCompared, ModelsRequest, NotProbed, PROBE_UNITS, Probe, probe};
 pub use run::{Ask, PreparedRun, Refused, RunRequest, Samples};
@@ -43,6 +46,7 @@ pub use stress::stress;
 pub use sweeps::{Input, Source, SweepRun, load, merge, read};
 
 // What the front ends read and write of the layers below.
+pub use crate::analysis::diagram::{Diagram, DiagramPoint, Request as DiagramSettings};
 pub use crate::analysis::lyapunov::Spectrum;
 pub use crate::analysis::orbit::continuation::{Branch, Point};
 pub use crate::analysis::orbit::diagram::Column;

@@ -18,6 +18,7 @@ mod conformance;
 mod continuation;
 mod continuum;
 mod convergence;
+mod diagram;
 mod docs_links;
 mod engine_generic;
 mod error_bound;

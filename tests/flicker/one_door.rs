@@ -14,7 +14,7 @@ use crate::architecture::{code, named_after, rust_files};
 /// Each subcommand, the file that runs it, and the names of its doors
 /// (each must be in that file's code); an empty list for those that only
 /// read or write files.
-const SUBCOMMANDS: [(&str, &str, &[&str]); 16] = [
+const SUBCOMMANDS: [(&str, &str, &[&str]); 17] = [
     ("run", "run.rs", &["RunRequest", ".prepare(", "run.run("]),
     ("compare", "compare.rs", &["CompareRequest", "comparison"]),
     ("compare-models", "compare_models.rs", &["ModelsRequest"]),
@@ -30,6 +30,11 @@ const SUBCOMMANDS: [(&str, &str, &[&str]); 16] = [
         &["SearchRequest", ".branch("],
     ),
     ("lyapunov", "lyapunov.rs", &["SpectrumRequest"]),
+    (
+        "diagram",
+        "diagram.rs",
+        &["DiagramRequest", "prepared.run("],
+    ),
     (
         "plot",
         "plot.rs",
