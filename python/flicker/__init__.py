@@ -30,15 +30,18 @@ import numpy as np
 
 from . import _flicker
 from ._flicker import SceneError
-from .plotting import bifurcation, work_precision
+from .plotting import bifurcation, diagram_plot, work_precision
 
 __all__ = [
     "Run",
     "SceneError",
     "bifurcation",
     "check",
+    "diagram_plot",
     "compare",
     "continuation",
+    "diagram",
+    "diagram_frame",
     "orbit",
     "lyapunov",
     "run",
@@ -431,3 +434,57 @@ def continuation(
         max_step=float(max_step),
         wall=float(wall),
     )
+
+
+def diagram(
+    scene: Scene,
+    param: str,
+    start: float,
+    stop: float,
+    *,
+    section: str,
+    points: int = 100,
+    transient: Optional[float] = None,
+    record: int = 50,
+    span: Optional[float] = None,
+    follow: bool = False,
+    past_horizon: bool = False,
+    wall: float = 3600.0,
+) -> Dict[str, Any]:
+    """`flicker diagram`: a brute-force bifurcation diagram. At each of
+    `points` values of `param` from `start` to `stop`, the scene runs
+    `transient` (default: its `t_end`), then records the state just after
+    each of the next `record` events of the guard `section`, running at most
+    `span` past the transient (default: its `t_end`). `follow` starts each
+    value from where the one before ended (the clock continuing);
+    `past_horizon` lets chaotic runs go on as pseudo-orbits.
+
+    Returns a dict: `param`, `t` and each state as float64 arrays, a row per
+    record, and `ended_short`: a list of dicts (`param`, `status`, `reason`,
+    `records`), one per value that ended at a Zeno point, failed or was
+    interrupted (the diagram goes on past them). `diagram_frame` makes a
+    pandas DataFrame of it, `diagram_plot` draws it."""
+    text, path = _source(scene)
+    return _flicker.diagram(
+        text,
+        path,
+        param=param,
+        start=float(start),
+        stop=float(stop),
+        points=int(points),
+        section=section,
+        transient=None if transient is None else float(transient),
+        record=int(record),
+        span=None if span is None else float(span),
+        follow=bool(follow),
+        past_horizon=bool(past_horizon),
+        wall=float(wall),
+    )
+
+
+def diagram_frame(found: Dict[str, Any]):
+    """The records of a `diagram` as a pandas DataFrame: `param`, `t`, each
+    state. Needs pandas."""
+    import pandas as pd
+
+    return pd.DataFrame({k: v for k, v in found.items() if k != "ended_short"})

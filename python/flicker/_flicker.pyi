@@ -65,3 +65,18 @@ def continuation(
     points: int = 200,
     max_step: float = 0.05,
 ) -> Dict[str, Any]: ...
+def diagram(
+    text: Optional[str] = None,
+    path: Optional[str] = None,
+    param: str = "",
+    start: float = 0.0,
+    stop: float = 0.0,
+    points: int = 100,
+    section: str = "",
+    transient: Optional[float] = None,
+    record: int = 50,
+    span: Optional[float] = None,
+    follow: bool = False,
+    past_horizon: bool = False,
+    wall: float = 3600.0,
+) -> Dict[str, Any]: ...

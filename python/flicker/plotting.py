@@ -185,6 +185,25 @@ def bifurcation(branch: dict, state: Optional[str] = None, ax: Any = None):
     return ax
 
 
+def diagram_plot(found: dict, state: Optional[str] = None, ax: Any = None):
+    """Draw a `flicker.diagram`: `state` (default: the first) just after
+    each section event against the parameter, as small dots, the way
+    bifurcation diagrams are drawn. Returns the Axes."""
+    import matplotlib.pyplot as plt
+
+    states = [k for k in found if k not in ("param", "t", "ended_short")]
+    if state is None:
+        state = states[0]
+    elif state not in states:
+        raise ValueError(f"state: the diagram has no {state!r} (its states: {', '.join(states)})")
+    if ax is None:
+        _, ax = plt.subplots()
+    ax.plot(found["param"], found[state], ",", color="C3")
+    ax.set_xlabel("parameter")
+    ax.set_ylabel(state)
+    return ax
+
+
 def work_precision(compared: dict, ax: Any = None):
     """Draw what `flicker.compare` returned: each method's error at the end
     against its wall time, both logarithmic, a line per method through its

@@ -9,8 +9,8 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
 use flicker::session::{
-    CompareRequest, CompareRow, Input, Limits, Point, Registry, SearchRequest, Source,
-    SpectrumRequest, Sweep, SweepRow, SweepRun,
+    CompareRequest, CompareRow, DiagramPoint, DiagramRequest, Input, Limits, Point, Registry,
+    SearchRequest, Source, SpectrumRequest, Status, Sweep, SweepRow, SweepRun,
 };
 
 use crate::interrupt::interruptible;
@@ -310,4 +310,78 @@ pub fn lyapunov(
     })?;
     let (found, request) = found.map_err(|e| scene_error(py, &e))?;
     Ok(found.to_json(&request, Path::new(&label)).to_string())
+}
+
+/// `flicker diagram`: the state after each section event recorded at each
+/// value of the parameter. Returns a dict: `param`, `t` and each state
+/// (float64, a row per record), and `ended_short`, a list of dicts
+/// (`param`, `status`, `reason`, `records`) for each value that did not
+/// complete.
+#[pyfunction]
+#[pyo3(signature = (text=None, path=None, param=String::new(), start=0.0, stop=0.0, points=100, section=String::new(), transient=None, record=50, span=None, follow=false, past_horizon=false, wall=3600.0))]
+#[allow(clippy::too_many_arguments)]
+pub fn diagram<'py>(
+    py: Python<'py>,
+    text: Option<&str>,
+    path: Option<&str>,
+    param: String,
+    start: f64,
+    stop: f64,
+    points: usize,
+    section: String,
+    transient: Option<f64>,
+    record: usize,
+    span: Option<f64>,
+    follow: bool,
+    past_horizon: bool,
+    wall: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    let (scene, _) = load(py, text, path)?;
+    let asked = DiagramRequest {
+        parameter: param,
+        from: start,
+        to: stop,
+        points,
+        section,
+        transient,
+        record,
+        span,
+        follow,
+        past_horizon,
+        shard: None,
+        wall,
+    };
+    let prepared = asked.on(&scene).map_err(|e| scene_error(py, &e))?;
+    let found = interruptible(py, |flag| prepared.run(Some(flag.clone()), &|| {}))?
+        .map_err(|why| override_error(py, "param", why))?;
+    let out = PyDict::new(py);
+    let rows = || {
+        found
+            .points
+            .iter()
+            .flat_map(|p| p.records.iter().map(move |r| (p, r)))
+    };
+    let column = |f: &dyn Fn((&DiagramPoint, &(f64, Vec<f64>))) -> f64| {
+        rows().map(f).collect::<Vec<f64>>().into_pyarray(py)
+    };
+    out.set_item("param", column(&|(p, _)| p.parameter))?;
+    out.set_item("t", column(&|(_, r)| r.0))?;
+    for (i, name) in found.names.iter().enumerate() {
+        out.set_item(name.as_str(), column(&|(_, r)| r.1[i]))?;
+    }
+    let short = PyList::empty(py);
+    for p in found
+        .points
+        .iter()
+        .filter(|p| p.status != Status::Completed)
+    {
+        let one = PyDict::new(py);
+        one.set_item("param", p.parameter)?;
+        one.set_item("status", p.status.as_str())?;
+        one.set_item("reason", p.reason.clone())?;
+        one.set_item("records", p.records.len())?;
+        short.append(one)?;
+    }
+    out.set_item("ended_short", short)?;
+    Ok(out)
 }

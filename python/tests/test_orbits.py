@@ -133,3 +133,48 @@ def test_lyapunov_spectrum_of_the_table_ball_sums_to_its_restitution_loss():
     assert abs(sum(found["exponents"]) - 2 * math.log(R) * rate) < 1e-6
     assert min(abs(x) for x in found["exponents"]) < 1e-9
     assert found["history"][-1]["t"] == found["t_span"]
+
+
+def doubling_amplitude(r):
+    """Holmes's period doubling of the vibrating table: Gamma_PD^2 =
+    (pi (1 - r) / (1 + r))^2 + (2 (1 + r^2) / (1 + r)^2)^2, A = Gamma g / w^2."""
+    fold = math.pi * (1 - r) / (1 + r)
+    return math.hypot(fold, 2 * (1 + r * r) / (1 + r) ** 2) * G / W**2
+
+
+def test_diagram_splits_at_the_period_doubling_and_matches_the_command_line(cli):
+    a_pd = doubling_amplitude(R)
+    lo, hi = 0.95 * a_pd, 1.05 * a_pd
+    asked = dict(section="impact", points=3, transient=300 * PERIOD, record=8, span=100 * PERIOD)
+    found = flicker.diagram(TABLE, "A", lo, hi, **asked)
+    assert set(found) == {"param", "t", "y", "v", "ended_short"}
+    assert found["ended_short"] == []
+    for value, count in [(lo, 1), (hi, 2)]:
+        v = np.sort(found["v"][found["param"] == value])
+        assert len(v) == 8
+        assert 1 + np.count_nonzero(np.diff(v) > 1e-3) == count, (value, v)
+    # Below the doubling: Holmes's take-off speed g T / 2.
+    below = found["v"][found["param"] == lo]
+    assert np.allclose(below, G * PERIOD / 2, rtol=1e-4)
+    # The command line writes the same records.
+    done, out = cli(
+        "diagram", TABLE, "--param", "A", "--from", repr(lo), "--to", repr(hi),
+        "--points", "3", "--section", "impact", "--transient", repr(300 * PERIOD),
+        "--record", "8", "--span", repr(100 * PERIOD), "--out", "cli", "--quiet",
+    )
+    assert done.returncode == 0, done.stderr
+    rows = np.loadtxt(out / "diagram.csv", delimiter=",", skiprows=1)
+    for k, name in enumerate(["param", "t", "y", "v"]):
+        assert np.allclose(rows[:, k], found[name], rtol=1e-12, atol=0), name
+    frame = flicker.diagram_frame(found)
+    assert list(frame.columns) == ["param", "t", "y", "v"] and len(frame) == 24
+
+
+def test_diagram_names_its_zeno_values_and_goes_on():
+    found = flicker.diagram(TABLE, "A", 0.0, 0.13, section="impact", points=5, transient=60,
+                            record=4, span=60)
+    short = found["ended_short"]
+    assert short and all(s["status"] == "zeno" for s in short)
+    assert found["param"].max() == 0.13
+    with pytest.raises(flicker.SceneError, match="no parameter"):
+        flicker.diagram(TABLE, "B", 0.0, 0.1, section="impact", points=2)

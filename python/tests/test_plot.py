@@ -125,3 +125,15 @@ def test_the_legend_says_what_the_ticks_are():
                       t_eval=np.linspace(0.0, 2.0, 101))
     labels = [t.get_text() for t in run.plot().get_legend().get_texts()]
     assert "events" in labels and "y" in labels
+
+
+def test_a_diagram_is_drawn_as_its_records():
+    found = flicker.diagram(MODELS / "automata/vibrating_table.json", "A", 0.14, 0.16,
+                            section="impact", points=5, transient=60, record=6, span=60)
+    ax = flicker.diagram_plot(found, "v")
+    (dots,) = ax.get_lines()
+    x, y = dots.get_data()
+    assert np.array_equal(x, found["param"]) and np.array_equal(y, found["v"])
+    assert ax.get_ylabel() == "v"
+    with pytest.raises(ValueError, match="no 'w'"):
+        flicker.diagram_plot(found, "w")

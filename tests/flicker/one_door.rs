@@ -51,7 +51,7 @@ const SUBCOMMANDS: [(&str, &str, &[&str]); 17] = [
 
 /// Each function the Python module offers, and the names of its doors
 /// (each must be in that function's body).
-const PYTHON: [(&str, &[&str]); 7] = [
+const PYTHON: [(&str, &[&str]); 8] = [
     ("run", &["RunRequest", ".prepare(", "run.run("]),
     ("check", &["read(", "check_lines("]),
     ("compare", &["CompareRequest", "comparison.run("]),
@@ -59,6 +59,7 @@ const PYTHON: [(&str, &[&str]); 7] = [
     ("orbit", &["asked(", ".orbit("]),
     ("continuation", &["asked(", ".branch("]),
     ("lyapunov", &["SpectrumRequest", ".spectrum("]),
+    ("diagram", &["DiagramRequest", "prepared.run("]),
 ];
 
 /// What of the library a front end may name: the session, and the log and
