@@ -24,17 +24,19 @@ second, leaving `status == "interrupted"`.
 
 import json
 import os
-from typing import Any, Dict, List, Optional, Sequence, Union
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
 from . import _flicker
 from ._flicker import SceneError
-from .plotting import bifurcation, diagram_plot, work_precision
+from .plotting import basins_plot, bifurcation, diagram_plot, work_precision
 
 __all__ = [
     "Run",
     "SceneError",
+    "basins",
+    "basins_plot",
     "bifurcation",
     "check",
     "diagram_plot",
@@ -488,3 +490,41 @@ def diagram_frame(found: Dict[str, Any]):
     import pandas as pd
 
     return pd.DataFrame({k: v for k, v in found.items() if k != "ended_short"})
+
+
+def basins(
+    scene: Scene,
+    grid: Dict[str, Tuple[float, float, int]],
+    *,
+    transient: Optional[float] = None,
+    section: Optional[str] = None,
+    record: int = 64,
+    tolerance: float = 1e-6,
+    wall: float = 3600.0,
+) -> Dict[str, Any]:
+    """`flicker basins`: basins of attraction. `grid` gives two states'
+    starting values, `{"x": (start, stop, count), "v": (...)}` (the other
+    states from the scene); each point runs `transient` (default: its
+    `t_end`) and is named by the attractor it reaches: an equilibrium (the
+    state settles to `tolerance`), a periodic orbit (the states after the
+    `section` guard's events repeat within `record` of them), a Zeno point,
+    or unresolved (said, with why).
+
+    Returns a dict: the two states' starting values and `attractor` (the id
+    each point reaches) as arrays, a row per point, and `attractors`, a
+    list of dicts (`id`, `kind`, `state` as a dict, `points`, and `period`
+    and `cycle` for an orbit, `reason` where unresolved)."""
+    if len(grid) != 2:
+        raise ValueError("grid: give two states, {name: (start, stop, count), ...}")
+    axes = [f"{name}={float(a)!r}:{float(b)!r}:{int(n)}" for name, (a, b, n) in grid.items()]
+    text, path = _source(scene)
+    return _flicker.basins(
+        text,
+        path,
+        grid=axes,
+        transient=None if transient is None else float(transient),
+        section=section,
+        record=int(record),
+        tolerance=float(tolerance),
+        wall=float(wall),
+    )

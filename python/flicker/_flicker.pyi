@@ -80,3 +80,13 @@ def diagram(
     past_horizon: bool = False,
     wall: float = 3600.0,
 ) -> Dict[str, Any]: ...
+def basins(
+    text: Optional[str] = None,
+    path: Optional[str] = None,
+    grid: List[str] = ...,
+    transient: Optional[float] = None,
+    section: Optional[str] = None,
+    record: int = 64,
+    tolerance: float = 1e-6,
+    wall: float = 3600.0,
+) -> Dict[str, Any]: ...

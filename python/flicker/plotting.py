@@ -204,6 +204,25 @@ def diagram_plot(found: dict, state: Optional[str] = None, ax: Any = None):
     return ax
 
 
+def basins_plot(found: dict, ax: Any = None):
+    """Draw what `flicker.basins` returned: each point at its two starting
+    values, coloured by the attractor it reaches, a legend naming each.
+    Returns the Axes."""
+    import matplotlib.pyplot as plt
+
+    x, y = [k for k in found if k not in ("attractor", "attractors")]
+    if ax is None:
+        _, ax = plt.subplots()
+    for a in found["attractors"]:
+        at = found["attractor"] == a["id"]
+        ax.plot(found[x][at], found[y][at], "s", ms=3, color=f"C{a['id'] % 10}",
+                label=f"{a['id']}: {a['kind']}")
+    ax.set_xlabel(x)
+    ax.set_ylabel(y)
+    ax.legend()
+    return ax
+
+
 def work_precision(compared: dict, ax: Any = None):
     """Draw what `flicker.compare` returned: each method's error at the end
     against its wall time, both logarithmic, a line per method through its

@@ -251,5 +251,6 @@ fn _flicker(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(tools::lyapunov, m)?)?;
     m.add_function(wrap_pyfunction!(tools::continuation, m)?)?;
     m.add_function(wrap_pyfunction!(tools::diagram, m)?)?;
+    m.add_function(wrap_pyfunction!(tools::basins, m)?)?;
     Ok(())
 }

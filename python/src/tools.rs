@@ -9,8 +9,8 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
 use flicker::session::{
-    CompareRequest, CompareRow, DiagramPoint, DiagramRequest, Input, Limits, Point, Registry,
-    SearchRequest, Source, SpectrumRequest, Status, Sweep, SweepRow, SweepRun,
+    BasinsRequest, CompareRequest, CompareRow, DiagramPoint, DiagramRequest, Input, Limits, Point,
+    Registry, SearchRequest, Source, SpectrumRequest, Status, Sweep, SweepRow, SweepRun,
 };
 
 use crate::interrupt::interruptible;
@@ -383,5 +383,89 @@ pub fn diagram<'py>(
         short.append(one)?;
     }
     out.set_item("ended_short", short)?;
+    Ok(out)
+}
+
+/// `flicker basins`: each point of a grid of two states' starting values
+/// named by the attractor it reaches. Returns a dict: the two states'
+/// values (float64, a row per point run), `attractor` (int64 ids), and
+/// `attractors`, a list of dicts (`id`, `kind`, `state` as a dict,
+/// `points`; `period` and `cycle` for a periodic orbit, `reason` where
+/// unresolved).
+#[pyfunction]
+#[pyo3(signature = (text=None, path=None, grid=Vec::new(), transient=None, section=None, record=64, tolerance=1e-6, wall=3600.0))]
+#[allow(clippy::too_many_arguments)]
+pub fn basins<'py>(
+    py: Python<'py>,
+    text: Option<&str>,
+    path: Option<&str>,
+    grid: Vec<String>,
+    transient: Option<f64>,
+    section: Option<String>,
+    record: usize,
+    tolerance: f64,
+    wall: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    let (scene, _) = load(py, text, path)?;
+    let asked = BasinsRequest {
+        grid,
+        transient,
+        section,
+        record,
+        tolerance,
+        shard: None,
+        wall,
+    };
+    let prepared = asked.on(&scene).map_err(|e| scene_error(py, &e))?;
+    let found = interruptible(py, |flag| prepared.run(Some(flag.clone()), &|| {}))?;
+    let axes = &prepared.request().axes;
+    let width = found.values[1].len();
+    let run: Vec<(usize, usize)> = found
+        .attractor
+        .iter()
+        .enumerate()
+        .filter_map(|(index, id)| id.map(|id| (index, id)))
+        .collect();
+    let out = PyDict::new(py);
+    let first: Vec<f64> = run
+        .iter()
+        .map(|(i, _)| found.values[0][i / width])
+        .collect();
+    let second: Vec<f64> = run
+        .iter()
+        .map(|(i, _)| found.values[1][i % width])
+        .collect();
+    out.set_item(axes[0].state.as_str(), first.into_pyarray(py))?;
+    out.set_item(axes[1].state.as_str(), second.into_pyarray(py))?;
+    let ids: Vec<i64> = run.iter().map(|(_, id)| *id as i64).collect();
+    out.set_item("attractor", ids.into_pyarray(py))?;
+    let named = |x: &[f64]| -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        for (n, v) in found.names.iter().zip(x) {
+            d.set_item(n.as_str(), *v)?;
+        }
+        Ok(d)
+    };
+    let list = PyList::empty(py);
+    for a in &found.attractors {
+        let one = PyDict::new(py);
+        one.set_item("id", a.id)?;
+        one.set_item("kind", a.kind.as_str())?;
+        one.set_item("state", named(&a.state)?)?;
+        one.set_item("points", a.points)?;
+        if !a.cycle.is_empty() {
+            one.set_item("period", a.cycle.len())?;
+            let cycle = PyList::empty(py);
+            for x in &a.cycle {
+                cycle.append(named(x)?)?;
+            }
+            one.set_item("cycle", cycle)?;
+        }
+        if let Some(why) = &a.reason {
+            one.set_item("reason", why.as_str())?;
+        }
+        list.append(one)?;
+    }
+    out.set_item("attractors", list)?;
     Ok(out)
 }

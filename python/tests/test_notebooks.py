@@ -21,6 +21,7 @@ def test_there_are_notebooks():
         "mechanism.ipynb",
         "your_own_automaton.ipynb",
         "sweep.ipynb",
+        "diagrams_and_basins.ipynb",
     }
 
 

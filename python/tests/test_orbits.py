@@ -178,3 +178,20 @@ def test_diagram_names_its_zeno_values_and_goes_on():
     assert found["param"].max() == 0.13
     with pytest.raises(flicker.SceneError, match="no parameter"):
         flicker.diagram(TABLE, "B", 0.0, 0.1, section="impact", points=2)
+
+
+def test_basins_name_the_double_well_s_two_equilibria_as_the_command_line_does(cli):
+    well = MODELS / "automata" / "double_well_wall.json"
+    found = flicker.basins(well, {"x": (-1.35, 2.0, 11), "v": (-2.0, 2.0, 9)})
+    kinds = [a["kind"] for a in found["attractors"]]
+    assert kinds == ["equilibrium", "equilibrium"]
+    at = sorted(round(a["state"]["x"], 6) for a in found["attractors"])
+    assert at == [-1.0, 1.0]
+    assert len(found["x"]) == len(found["v"]) == len(found["attractor"]) == 99
+    done, out = cli("basins", well, "--grid", "x=-1.35:2:11,v=-2:2:9", "--out", "cli", "--quiet")
+    assert done.returncode == 0, done.stderr
+    rows = np.loadtxt(out / "basins.csv", delimiter=",", skiprows=1)
+    assert np.array_equal(rows[:, 2], found["attractor"])
+    assert np.allclose(rows[:, 0], found["x"]) and np.allclose(rows[:, 1], found["v"])
+    with pytest.raises(ValueError, match="two states"):
+        flicker.basins(well, {"x": (0, 1, 3)})

@@ -137,3 +137,13 @@ def test_a_diagram_is_drawn_as_its_records():
     assert ax.get_ylabel() == "v"
     with pytest.raises(ValueError, match="no 'w'"):
         flicker.diagram_plot(found, "w")
+
+
+def test_basins_are_drawn_a_colour_per_attractor():
+    found = flicker.basins(MODELS / "automata/double_well_wall.json",
+                           {"x": (-1.35, 2.0, 6), "v": (-2.0, 2.0, 5)})
+    ax = flicker.basins_plot(found)
+    lines = ax.get_lines()
+    assert len(lines) == len(found["attractors"]) == 2
+    assert sum(len(l.get_xdata()) for l in lines) == 30
+    assert {t.get_text() for t in ax.get_legend().get_texts()} == {"0: equilibrium", "1: equilibrium"}

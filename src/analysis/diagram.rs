@@ -16,14 +16,13 @@
 //! recorded and says why; the diagram goes on.
 
 use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::AtomicBool;
 
 use rayon::prelude::*;
 
+use crate::analysis::section_records::SectionRecords;
 use crate::engine::step::method::tightest;
-use crate::engine::{
-    EventRecord, Family, Limits, MAX_EVENTS, Mode, Observer, Promoted, Status, Tolerances, simulate,
-};
+use crate::engine::{Family, Limits, MAX_EVENTS, Mode, Promoted, Status, Tolerances, simulate};
 
 /// The tolerance of the runs where the model needs a numerical method.
 pub const TOLERANCE: f64 = 1e-12;
@@ -129,16 +128,15 @@ pub fn names(family: &dyn Family, parameter: &str) -> Result<Vec<String>, String
 }
 
 /// Which of `promoted`'s components a diagram records, and their names:
-/// the model's own states, without the parameter held as one or the clock
-/// an automaton that reads it carries as a state named `t` (a name no
-/// state may take): the diagram's `t` says it.
+/// the model's own states, without the parameter held as one or a clock
+/// the model carries as a state: the diagram's `t` says it.
 fn recorded(promoted: &Promoted) -> (Vec<usize>, Vec<String>) {
     let p = promoted.parameters[0];
     let names = promoted.model.state_names(promoted.mode);
     names
         .iter()
         .enumerate()
-        .filter(|(i, n)| *i != p && n.as_str() != "t")
+        .filter(|(i, _)| *i != p && Some(*i) != promoted.model.clock())
         .map(|(i, n)| (i, n.to_string()))
         .unzip()
 }
@@ -208,18 +206,14 @@ pub fn run(
             tolerances,
         );
         options.stop = Some(own_stop.clone());
-        let mut recorder = Recorder {
-            section: &request.section,
-            from: request.transient,
-            wanted: request.record,
-            offset,
-            kept: &kept,
-            records: Vec::new(),
-            own_stop: &own_stop,
-            outer_stop: limits.stop.as_deref(),
-        };
+        let mut recorder = SectionRecords::new(
+            &request.section,
+            (request.transient, request.record),
+            &own_stop,
+            limits.stop.as_deref(),
+        );
         let outcome = simulate(model, mode, &x0, &options, &mut recorder);
-        let full = recorder.records.len() >= request.record;
+        let full = recorder.full();
         let (status, reason) = match outcome.status {
             Status::Interrupted if full => (Status::Completed, None),
             status => (status, outcome.reason.clone()),
@@ -228,7 +222,11 @@ pub fn run(
         let point = DiagramPoint {
             index,
             parameter: value,
-            records: recorder.records,
+            records: recorder
+                .kept
+                .into_iter()
+                .map(|c| (offset + c.t, kept.iter().map(|&i| c.state[i]).collect()))
+                .collect(),
             status,
             reason,
         };
@@ -273,38 +271,5 @@ fn not_begun(index: usize, value: f64, limits: &Limits) -> DiagramPoint {
         records: Vec::new(),
         status: Status::Interrupted,
         reason: Some(format!("not begun: {}", limits.stop_reason())),
-    }
-}
-
-/// Keeps the state after each section event from `from` on, and stops
-/// the run once it has `wanted` of them (or the outer stop flag is set).
-struct Recorder<'a> {
-    section: &'a str,
-    from: f64,
-    wanted: usize,
-    offset: f64,
-    kept: &'a [usize],
-    records: Vec<(f64, Vec<f64>)>,
-    own_stop: &'a AtomicBool,
-    outer_stop: Option<&'a AtomicBool>,
-}
-
-impl Observer for Recorder<'_> {
-    fn on_event(&mut self, event: &EventRecord) -> std::io::Result<()> {
-        if event.guard == self.section && event.t >= self.from && self.records.len() < self.wanted {
-            let state: Vec<f64> = self.kept.iter().map(|&i| event.after[i]).collect();
-            self.records.push((self.offset + event.t, state));
-            if self.records.len() == self.wanted {
-                self.own_stop.store(true, Ordering::Relaxed);
-            }
-        }
-        if self.outer_stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
-            self.own_stop.store(true, Ordering::Relaxed);
-        }
-        Ok(())
-    }
-
-    fn wants_details(&self) -> bool {
-        true
     }
 }

@@ -23,6 +23,7 @@ macro_rules! say_raw {
 }
 
 pub mod advise;
+pub mod basins;
 pub mod check;
 pub mod compare;
 pub mod compare_models;
@@ -169,6 +170,10 @@ enum Command {
     /// state after each of K section events past a transient; writes
     /// DIR/diagram.csv, diagram.json and diagram.svg.
     Diagram(diagram::DiagramArgs),
+    /// Basins of attraction: a grid of two states' starting values, each
+    /// named by the attractor it reaches; writes DIR/basins.csv,
+    /// attractors.json and basins.svg.
+    Basins(basins::BasinsArgs),
     /// Follow a periodic orbit in a parameter (pseudo-arclength), label its
     /// bifurcations; writes DIR/continuation.csv and DIR/bifurcation.svg.
     Continue(continuation::ContinueArgs),
@@ -233,6 +238,7 @@ pub fn dispatch(cli: Cli, registry: &Registry) -> Result<Code, Failure> {
         Command::Orbit(args) => orbit::orbit(args, registry),
         Command::Continue(args) => continuation::continue_orbit(args, registry),
         Command::Diagram(args) => diagram::diagram(args, registry),
+        Command::Basins(args) => basins::basins(args, registry),
         Command::Lyapunov(args) => lyapunov::lyapunov(args, registry),
         Command::Advise(args) => advise::advise(args, registry),
         Command::Stress {

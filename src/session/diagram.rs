@@ -64,13 +64,7 @@ impl DiagramRequest {
             }
         }
         let n = self.points;
-        let values: Vec<f64> = (0..n)
-            .map(|i| match i {
-                0 => self.from,
-                _ if i == n - 1 => self.to,
-                _ => self.from + (self.to - self.from) * i as f64 / (n - 1) as f64,
-            })
-            .collect();
+        let values = crate::analysis::spacing::evenly_spaced(self.from, self.to, n);
         let request = Request {
             parameter: self.parameter.clone(),
             values,

@@ -12,6 +12,7 @@
 //! | `compare`, `flicker.compare` | [`CompareRequest`] → [`Comparison`] |
 //! | `sweep`, `merge`, `flicker.sweep` | [`load`], [`read`] → [`SweepRun`], [`merge`] |
 //! | `diagram` | [`DiagramRequest`] → [`PreparedDiagram`] |
+//! | `basins` | [`BasinsRequest`] → [`PreparedBasins`] |
 //! | `stress` | [`stress()`] |
 //! | `compare-models` | [`ModelsRequest`] → [`ModelsCompared`] |
 //! | `advise` | [`probe`] |
@@ -25,6 +26,7 @@
 //! of the library but the log and picture files (`log`, `plot`), which
 //! `tests/flicker/one_door.rs` checks.
 
+mod basins;
 mod compare;
 mod diagram;
 mod portraits;
@@ -35,6 +37,7 @@ mod spectrum;
 mod stress;
 mod sweeps;
 
+pub use basins::{BasinsRequest, PreparedBasins};
 pub use compare::{CompareRequest, Comparison};
 pub use diagram::{DiagramRequest, PreparedDiagram};
 pub use portraits::{mechanism_portrait, state_plane};
@@ -46,6 +49,9 @@ pub use stress::stress;
 pub use sweeps::{Input, Source, SweepRun, load, merge, read};
 
 // What the front ends read and write of the layers below.
+pub use crate::analysis::basins::{
+    Attractor, Basins, Kind as AttractorKind, Request as BasinsSettings,
+};
 pub use crate::analysis::diagram::{Diagram, DiagramPoint, Request as DiagramSettings};
 pub use crate::analysis::lyapunov::Spectrum;
 pub use crate::analysis::orbit::continuation::{Branch, Point};

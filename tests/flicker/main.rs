@@ -5,6 +5,7 @@ mod architecture_inside;
 mod automata;
 mod automata_models;
 mod automata_tools;
+mod basins;
 mod bouncing_ball;
 mod chain;
 mod chain_cli;

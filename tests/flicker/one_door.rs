@@ -14,7 +14,7 @@ use crate::architecture::{code, named_after, rust_files};
 /// Each subcommand, the file that runs it, and the names of its doors
 /// (each must be in that file's code); an empty list for those that only
 /// read or write files.
-const SUBCOMMANDS: [(&str, &str, &[&str]); 17] = [
+const SUBCOMMANDS: [(&str, &str, &[&str]); 18] = [
     ("run", "run.rs", &["RunRequest", ".prepare(", "run.run("]),
     ("compare", "compare.rs", &["CompareRequest", "comparison"]),
     ("compare-models", "compare_models.rs", &["ModelsRequest"]),
@@ -35,6 +35,7 @@ const SUBCOMMANDS: [(&str, &str, &[&str]); 17] = [
         "diagram.rs",
         &["DiagramRequest", "prepared.run("],
     ),
+    ("basins", "basins.rs", &["BasinsRequest", "prepared.run("]),
     (
         "plot",
         "plot.rs",
@@ -51,7 +52,7 @@ const SUBCOMMANDS: [(&str, &str, &[&str]); 17] = [
 
 /// Each function the Python module offers, and the names of its doors
 /// (each must be in that function's body).
-const PYTHON: [(&str, &[&str]); 8] = [
+const PYTHON: [(&str, &[&str]); 9] = [
     ("run", &["RunRequest", ".prepare(", "run.run("]),
     ("check", &["read(", "check_lines("]),
     ("compare", &["CompareRequest", "comparison.run("]),
@@ -60,6 +61,7 @@ const PYTHON: [(&str, &[&str]); 8] = [
     ("continuation", &["asked(", ".branch("]),
     ("lyapunov", &["SpectrumRequest", ".spectrum("]),
     ("diagram", &["DiagramRequest", "prepared.run("]),
+    ("basins", &["BasinsRequest", "prepared.run("]),
 ];
 
 /// What of the library a front end may name: the session, and the log and

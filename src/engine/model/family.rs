@@ -18,6 +18,14 @@ pub trait Family: Send + Sync {
     /// The mode and state the scene starts in.
     fn start(&self) -> (Mode, Vec<f64>);
 
+    /// A start at `state` (every component given, the clock too where the
+    /// model carries one): the mode a run from it begins in, and the
+    /// state. By default the scene's own mode; a model whose mode depends
+    /// on where the state lies (a region of a discontinuous flow) says so.
+    fn start_from(&self, state: &[f64]) -> (Mode, Vec<f64>) {
+        (self.start().0, state.to_vec())
+    }
+
     /// The names of the state's components where the scene starts, for a
     /// tool's directions (`initial.NAME`) and reports.
     fn state_names(&self) -> Vec<String> {

@@ -24,6 +24,10 @@ impl Family for AutomatonScene {
         )
     }
 
+    fn start_from(&self, state: &[f64]) -> (Mode, Vec<f64>) {
+        (self.automaton.initial_mode_at(state), state.to_vec())
+    }
+
     fn parameters(&self) -> Vec<String> {
         self.definition
             .parameters

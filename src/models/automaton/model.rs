@@ -39,6 +39,9 @@ pub struct Automaton {
     energy: Option<Vec<Tape>>,
     initial: Vec<f64>,
     initial_mode: Mode,
+    /// Where the file's initial mode has switching surfaces, its family:
+    /// a start begins in the region (or on the surface) it lies in.
+    start_family: Option<usize>,
     /// The modes with switching surfaces (see [`filippov`]).
     families: Vec<Surfaces>,
     /// For each mode, the reason a run entering it stops with, where it
@@ -475,9 +478,13 @@ impl Automaton {
             .collect::<Result<Vec<_>, SceneError>>()?;
         // The start: a mode with surfaces begins in the region (or on the
         // surface) the initial state lies in.
-        let initial_mode = match expanded.start {
-            Target::Enter(f) => families[f].pick(&initial, None).0,
-            _ => definition.initial_mode,
+        let start_family = match expanded.start {
+            Target::Enter(f) => Some(f),
+            _ => None,
+        };
+        let initial_mode = match start_family {
+            Some(f) => families[f].pick(&initial, None).0,
+            None => definition.initial_mode,
         };
         Ok(Automaton {
             states: inputs.into_iter().map(Name::from).collect(),
@@ -486,6 +493,7 @@ impl Automaton {
             energy,
             initial,
             initial_mode,
+            start_family,
             families,
             stops: expanded.stops,
             origins: expanded.origins,
@@ -500,6 +508,16 @@ impl Automaton {
     /// The mode the file starts in.
     pub fn initial_mode(&self) -> Mode {
         self.initial_mode
+    }
+
+    /// The mode a run from `state` begins in: the file's initial mode, or,
+    /// where that mode switches its flow by `sign()`, the region (or the
+    /// surface) `state` lies in, as the file's own start is decided.
+    pub fn initial_mode_at(&self, state: &[f64]) -> Mode {
+        match self.start_family {
+            Some(f) => self.families[f].pick(state, None).0,
+            None => self.initial_mode,
+        }
     }
 
     /// The modes mode `file_mode` of the file became: itself, or the

@@ -1,0 +1,226 @@
+//! Basins of attraction (`flicker basins`) against an integrator written
+//! here, independent of flicker: the damped double well against a wall
+//! (`double_well_wall.json`), `x'' + c x' - x + x^3 = 0`, its speed turned
+//! back by `-r` where `x` reaches `-w`, settles at `x = -1` or `x = 1`;
+//! classical Runge-Kutta with a fixed step, the wall found by bisection on
+//! the step, says which. And the vibrating table's period-one orbit, named
+//! periodic, on Holmes's closed form.
+
+use std::f64::consts::PI;
+
+use serde_json::Value;
+
+use flicker::session::{AttractorKind, Basins, BasinsRequest, Registry};
+
+use crate::automata::automaton;
+use crate::support::{flicker, read_json};
+
+const C: f64 = 0.25;
+const WALL: f64 = 1.4;
+const R: f64 = 0.8;
+
+fn field(s: [f64; 2]) -> [f64; 2] {
+    let [x, v] = s;
+    [v, -C * v + x - x * x * x]
+}
+
+/// One classical Runge-Kutta step of `h`.
+fn rk4(s: [f64; 2], h: f64) -> [f64; 2] {
+    let add = |a: [f64; 2], k: [f64; 2], f: f64| [a[0] + f * k[0], a[1] + f * k[1]];
+    let k1 = field(s);
+    let k2 = field(add(s, k1, h / 2.0));
+    let k3 = field(add(s, k2, h / 2.0));
+    let k4 = field(add(s, k3, h));
+    [
+        s[0] + h / 6.0 * (k1[0] + 2.0 * k2[0] + 2.0 * k3[0] + k4[0]),
+        s[1] + h / 6.0 * (k1[1] + 2.0 * k2[1] + 2.0 * k3[1] + k4[1]),
+    ]
+}
+
+/// Where the double well from `(x, v)` ends after `t_end`: -1 or 1, by the
+/// side it settles on.
+fn settles_at(x: f64, v: f64, t_end: f64) -> f64 {
+    let h = 1e-3;
+    let (mut s, mut t) = ([x, v], 0.0);
+    while t < t_end {
+        let next = rk4(s, h);
+        if next[0] + WALL < 0.0 {
+            // The wall within this step: bisect for the part of it before.
+            let (mut lo, mut hi) = (0.0, h);
+            for _ in 0..60 {
+                let mid = 0.5 * (lo + hi);
+                if rk4(s, mid)[0] + WALL < 0.0 {
+                    hi = mid;
+                } else {
+                    lo = mid;
+                }
+            }
+            let at = rk4(s, lo);
+            s = [-WALL, -R * at[1]];
+            t += lo;
+            continue;
+        }
+        s = next;
+        t += h;
+    }
+    assert!(
+        s[1].abs() < 1e-6 && (s[0].abs() - 1.0).abs() < 1e-6,
+        "{x}, {v}: {s:?}"
+    );
+    s[0].signum()
+}
+
+fn basins(scene: &str, grid: [&str; 2], section: Option<&str>) -> Basins {
+    let scene = Registry::builtin()
+        .from_value(&read_json(std::path::Path::new(&automaton(scene))))
+        .unwrap();
+    let asked = BasinsRequest {
+        grid: grid.map(String::from).to_vec(),
+        transient: None,
+        section: section.map(String::from),
+        record: 16,
+        tolerance: 1e-6,
+        shard: None,
+        wall: 120.0,
+    };
+    asked.on(&scene).unwrap().run(None, &|| {})
+}
+
+#[test]
+fn the_double_well_s_basins_agree_with_an_independent_integrator() {
+    let found = basins("double_well_wall.json", ["x=-1.35:2:31", "v=-2:2:31"], None);
+    // Two attractors, both equilibria, at x = -1 and x = 1 at rest.
+    assert_eq!(found.attractors.len(), 2, "{:?}", found.attractors);
+    let mut sides = Vec::new();
+    for a in &found.attractors {
+        assert_eq!(a.kind, AttractorKind::Equilibrium);
+        assert!((a.state[0].abs() - 1.0).abs() < 1e-6 && a.state[1].abs() < 1e-6);
+        sides.push(a.state[0].signum());
+    }
+    assert_eq!(sides.iter().sum::<f64>(), 0.0, "one on each side");
+    let (xs, vs) = (&found.values[0], &found.values[1]);
+    let mut agree = 0;
+    for (index, id) in found.attractor.iter().enumerate() {
+        let (x, v) = (xs[index / vs.len()], vs[index % vs.len()]);
+        let ours = sides[id.unwrap()];
+        if ours == settles_at(x, v, 200.0) {
+            agree += 1;
+        }
+    }
+    // At least 99% of the 961 points: a point can fall either way only
+    // within the two integrators' errors of a basin's edge.
+    assert!(agree >= 952, "{agree} of 961 agree");
+    // Both basins are there in earnest: neither holds nearly everything.
+    let on = |id: usize| found.attractor.iter().filter(|a| **a == Some(id)).count();
+    assert!(on(0) > 100 && on(1) > 100, "{} and {}", on(0), on(1));
+}
+
+#[test]
+fn the_vibrating_table_s_period_one_orbit_is_named_periodic_on_its_closed_form() {
+    // Starts above the table at rest: they reach Holmes's period-one
+    // orbit (one impact a table period, leaving at g T / 2), or chatter
+    // down to it (a Zeno point).
+    let found = basins(
+        "vibrating_table.json",
+        ["y=0.05:0.6:6", "v=0:4:6"],
+        Some("impact"),
+    );
+    let periodic: Vec<_> = found
+        .attractors
+        .iter()
+        .filter(|a| a.kind == AttractorKind::Periodic)
+        .collect();
+    assert!(!periodic.is_empty(), "{:?}", found.attractors);
+    let v = found.names.iter().position(|n| n == "v").unwrap();
+    let one = periodic.iter().find(|a| a.cycle.len() == 1).unwrap();
+    let take_off = 9.81 * PI / 10.0;
+    assert!((one.cycle[0][v] - take_off).abs() < 1e-6, "{:?}", one.cycle);
+    assert!(one.points > 0);
+}
+
+#[test]
+fn the_command_line_writes_the_grid_and_its_attractors() {
+    let out = tempfile::tempdir().unwrap();
+    let dir = out.path().to_str().unwrap();
+    let scene = automaton("double_well_wall.json");
+    let done = flicker(&[
+        "basins",
+        &scene,
+        "--grid",
+        "x=-1.35:2:11,v=-2:2:9",
+        "--out",
+        dir,
+        "--quiet",
+    ]);
+    let stdout = String::from_utf8_lossy(&done.stdout);
+    assert_eq!(done.status.code(), Some(0), "{stdout}");
+    assert!(stdout.contains("reach 2 attractors"), "{stdout}");
+    let csv = std::fs::read_to_string(out.path().join("basins.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(lines.next(), Some("x,v,attractor"));
+    assert_eq!(lines.count(), 99);
+    let list: Value = read_json(&out.path().join("attractors.json"));
+    let list = list.as_array().unwrap();
+    assert_eq!(list.len(), 2);
+    for a in list {
+        assert_eq!(a["kind"], "equilibrium");
+        let x = a["state"]["x"].as_f64().unwrap();
+        assert!((x.abs() - 1.0).abs() < 1e-6, "{a}");
+    }
+    let points: u64 = list.iter().map(|a| a["points"].as_u64().unwrap()).sum();
+    assert_eq!(points, 99);
+    // A grid that names no state of the scene is refused, nothing written.
+    let bad = out.path().join("bad");
+    let done = flicker(&[
+        "basins",
+        &scene,
+        "--grid",
+        "y=0:1:3,v=0:1:3",
+        "--out",
+        bad.to_str().unwrap(),
+    ]);
+    assert_eq!(done.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&done.stderr).contains("--grid: no state is called `y`"));
+    assert!(!bad.exists());
+}
+
+#[test]
+fn the_stick_slip_cycle_is_refined_with_its_multipliers_from_every_start() {
+    // The block on the belt: whatever its start (on either side of the
+    // belt's speed, each begun in its own region of the discontinuous
+    // flow), it ends on the one stick-slip cycle. Right after the wall
+    // the block is at the wall, moving away from it.
+    let scene = Registry::builtin()
+        .from_value(&read_json(std::path::Path::new(&automaton(
+            "stick_slip_belt.json",
+        ))))
+        .unwrap();
+    let asked = BasinsRequest {
+        grid: vec!["x=-0.5:1:6".into(), "v=-1:1:6".into()],
+        transient: Some(100.0),
+        section: Some("wall".into()),
+        record: 6,
+        tolerance: 1e-6,
+        shard: None,
+        wall: 60.0,
+    };
+    let found = asked.on(&scene).unwrap().run(None, &|| {});
+    assert_eq!(found.attractors.len(), 1, "{:?}", found.attractors);
+    let cycle = &found.attractors[0];
+    assert_eq!(
+        (cycle.kind, cycle.cycle.len(), cycle.points),
+        (AttractorKind::Periodic, 1, 36)
+    );
+    let (x, v) = (cycle.cycle[0][0], cycle.cycle[0][1]);
+    assert!((x - 0.4).abs() < 1e-9 && v > 0.0, "{x}, {v}");
+    // Refined by the orbit finder: the trivial multiplier 1 along the
+    // flow, and 0: the sticking forgets where the slip began.
+    let orbit = cycle.orbit.as_ref().expect("refined");
+    let mut moduli: Vec<f64> = orbit.multipliers.iter().map(|m| m.0.hypot(m.1)).collect();
+    moduli.sort_by(f64::total_cmp);
+    assert!(
+        moduli[0] < 1e-9 && (moduli[1] - 1.0).abs() < 1e-9,
+        "{moduli:?}"
+    );
+    assert!(orbit.stable && orbit.period > 0.0);
+}
