@@ -142,10 +142,16 @@ pub fn basins(args: BasinsArgs, registry: &Registry) -> Result<Code, Failure> {
     let names: Vec<String> = written.iter().map(|p| p.display().to_string()).collect();
     say!("  wrote {}", names.join(", "));
     if run < prepared.points() {
-        eprintln!("flicker: the grid stopped short; the points not run have no attractor");
-        return Ok(Code::stopped(
-            stop.load(std::sync::atomic::Ordering::Relaxed),
-        ));
+        let interrupted = stop.load(std::sync::atomic::Ordering::Relaxed);
+        eprintln!(
+            "flicker: the grid stopped short ({}); the points not run have no attractor",
+            if interrupted {
+                "interrupted: the stop flag was set"
+            } else {
+                "stopped: past the wall-clock budget (--wall)"
+            }
+        );
+        return Ok(Code::stopped(interrupted));
     }
     Ok(Code::Ok)
 }

@@ -177,8 +177,11 @@ pub fn diagram(args: DiagramArgs, registry: &Registry) -> Result<Code, Failure> 
     let names: Vec<String> = written.iter().map(|p| p.display().to_string()).collect();
     say!("  wrote {}", names.join(", "));
     let interrupted = stop.load(std::sync::atomic::Ordering::Relaxed);
-    if short.iter().any(|p| p.status == Status::Interrupted) {
-        eprintln!("flicker: the diagram stopped short; the values not run say so");
+    if let Some(p) = short.iter().find(|p| p.status == Status::Interrupted) {
+        eprintln!(
+            "flicker: the diagram stopped short ({}); the values not run say so",
+            p.reason.as_deref().unwrap_or("interrupted")
+        );
         return Ok(Code::stopped(interrupted));
     }
     Ok(Code::Ok)

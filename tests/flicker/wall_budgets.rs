@@ -1,5 +1,6 @@
 //! No silent spinning: every long command (`orbit`, `continue`,
-//! `lyapunov`, `sweep`, `compare`) takes a wall-clock budget (`--wall`),
+//! `lyapunov`, `sweep`, `compare`, `diagram`, `basins`) takes a
+//! wall-clock budget (`--wall`),
 //! stops there saying so (exit 3), keeps what it found, and refuses a
 //! budget that is not a time > 0 (exit 2).
 
@@ -140,5 +141,63 @@ fn a_budget_that_is_not_a_positive_time_is_refused() {
             "{args:?}: {}",
             stderr(&done)
         );
+    }
+}
+
+/// A diagram or a basin grid past its budget (each some seconds of work
+/// on 2 cores, given a fifth of a second) stops there saying so, exit 3,
+/// with what it ran written.
+#[test]
+fn a_diagram_and_a_basin_grid_past_their_budget_stop_saying_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let table = automaton("vibrating_table.json");
+    let well = automaton("double_well_wall.json");
+    let runs: [(&str, Vec<&str>, &str); 2] = [
+        (
+            "diagram",
+            vec![
+                "diagram",
+                &table,
+                "--param",
+                "A",
+                "--from",
+                "0.11",
+                "--to",
+                "0.2",
+                "--points",
+                "20000",
+                "--section",
+                "impact",
+                "--transient",
+                "60",
+                "--record",
+                "64",
+                "--span",
+                "60",
+                "--past-horizon",
+            ],
+            "diagram.csv",
+        ),
+        (
+            "basins",
+            vec!["basins", &well, "--grid", "x=-1.35:2:200,v=-2:2:200"],
+            "basins.csv",
+        ),
+    ];
+    for (name, mut args, file) in runs {
+        let out = dir.path().join(name);
+        let out = out.to_str().unwrap().to_string();
+        args.extend(["--wall", "0.2", "--quiet", "--out", &out]);
+        let started = std::time::Instant::now();
+        let done = flicker(&args);
+        let elapsed = started.elapsed().as_secs_f64();
+        assert_eq!(done.status.code(), Some(3), "{name}: {}", stderr(&done));
+        assert!(
+            stderr(&done).contains("wall-clock budget"),
+            "{name}: {}",
+            stderr(&done)
+        );
+        assert!(elapsed < 10.0, "{name}: {elapsed} s for a budget of 0.2 s");
+        assert!(std::path::Path::new(&out).join(file).exists(), "{name}");
     }
 }
