@@ -500,6 +500,7 @@ def basins(
     section: Optional[str] = None,
     record: int = 64,
     tolerance: float = 1e-6,
+    past_horizon: bool = False,
     wall: float = 3600.0,
 ) -> Dict[str, Any]:
     """`flicker basins`: basins of attraction. `grid` gives two states'
@@ -507,8 +508,9 @@ def basins(
     states from the scene); each point runs `transient` (default: its
     `t_end`) and is named by the attractor it reaches: an equilibrium (the
     state settles to `tolerance`), a periodic orbit (the states after the
-    `section` guard's events repeat within `record` of them), a Zeno point,
-    or unresolved (said, with why).
+    `section` guard's events repeat within `record` of them), a chaotic
+    attractor (no repeat, a positive largest exponent; `past_horizon` lets
+    its runs go on), a Zeno point, or unresolved (said, with why).
 
     Returns a dict: the two states' starting values and `attractor` (the id
     each point reaches) as arrays, a row per point, and `attractors`, a
@@ -526,5 +528,6 @@ def basins(
         section=section,
         record=int(record),
         tolerance=float(tolerance),
+        past_horizon=bool(past_horizon),
         wall=float(wall),
     )

@@ -88,5 +88,6 @@ def basins(
     section: Optional[str] = None,
     record: int = 64,
     tolerance: float = 1e-6,
+    past_horizon: bool = False,
     wall: float = 3600.0,
 ) -> Dict[str, Any]: ...

@@ -393,7 +393,7 @@ pub fn diagram<'py>(
 /// `points`; `period` and `cycle` for a periodic orbit, `reason` where
 /// unresolved).
 #[pyfunction]
-#[pyo3(signature = (text=None, path=None, grid=Vec::new(), transient=None, section=None, record=64, tolerance=1e-6, wall=3600.0))]
+#[pyo3(signature = (text=None, path=None, grid=Vec::new(), transient=None, section=None, record=64, tolerance=1e-6, past_horizon=false, wall=3600.0))]
 #[allow(clippy::too_many_arguments)]
 pub fn basins<'py>(
     py: Python<'py>,
@@ -404,6 +404,7 @@ pub fn basins<'py>(
     section: Option<String>,
     record: usize,
     tolerance: f64,
+    past_horizon: bool,
     wall: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (scene, _) = load(py, text, path)?;
@@ -413,6 +414,7 @@ pub fn basins<'py>(
         section,
         record,
         tolerance,
+        past_horizon,
         shard: None,
         wall,
     };
@@ -460,6 +462,9 @@ pub fn basins<'py>(
                 cycle.append(named(x)?)?;
             }
             one.set_item("cycle", cycle)?;
+        }
+        if let Some(exponent) = a.exponent {
+            one.set_item("exponent", exponent)?;
         }
         if let Some(why) = &a.reason {
             one.set_item("reason", why.as_str())?;

@@ -30,6 +30,7 @@ use std::sync::atomic::AtomicBool;
 
 use rayon::prelude::*;
 
+use crate::analysis::lyapunov;
 use crate::analysis::orbit::{Orbit, OrbitRequest, Watch};
 use crate::analysis::section_records::SectionRecords;
 use crate::analysis::spacing::evenly_spaced;
@@ -106,6 +107,9 @@ pub enum Kind {
     Equilibrium,
     /// The section states repeat.
     Periodic,
+    /// The section states do not repeat, and nearby orbits part: a
+    /// positive largest Lyapunov exponent.
+    Chaotic,
     /// The events accumulate.
     Zeno,
     /// None of these could be told.
@@ -118,6 +122,7 @@ impl Kind {
         match self {
             Kind::Equilibrium => "equilibrium",
             Kind::Periodic => "periodic",
+            Kind::Chaotic => "chaotic",
             Kind::Zeno => "zeno",
             Kind::Unresolved => "unresolved",
         }
@@ -141,6 +146,9 @@ pub struct Attractor {
     pub cycle: Vec<Vec<f64>>,
     /// The orbit as the orbit finder refined it, where it converged.
     pub orbit: Option<Orbit>,
+    /// The largest Lyapunov exponent, where one was measured (for an
+    /// orbit that does not repeat).
+    pub exponent: Option<f64>,
     /// How many points reach it.
     pub points: usize,
     /// Why a point was left unresolved (the first such point's reason).
@@ -216,6 +224,8 @@ enum Reached {
     Equilibrium(Vec<f64>),
     Periodic(Mode, Vec<Vec<f64>>),
     Zeno(Vec<f64>),
+    /// No repeat within the record: where its last section event left it.
+    Aperiodic(Mode, Vec<f64>),
     Unresolved(Vec<f64>, String),
     NotRun,
 }
@@ -282,11 +292,48 @@ pub fn run(
         basins.attractor[index] = gather(&mut basins.attractors, reached, &kept, request.tolerance);
     }
     for attractor in &mut basins.attractors {
-        if let (Kind::Periodic, Some(section)) = (attractor.kind, &request.section) {
-            attractor.orbit = refine(family, attractor, section, request.transient, limits);
+        match (attractor.kind, &request.section) {
+            (Kind::Periodic, Some(section)) => {
+                attractor.orbit = refine(family, attractor, section, request.transient, limits);
+            }
+            (Kind::Chaotic, _) => judge(family, attractor, request, limits),
+            _ => {}
         }
     }
     basins
+}
+
+/// An `attractor` whose section states did not repeat: chaotic where its
+/// largest Lyapunov exponent, over a transient's time from where its
+/// first point's record ended, is positive beyond what the measurement's
+/// length can tell from zero; unresolved otherwise, the exponent said.
+fn judge(family: &dyn Family, attractor: &mut Attractor, request: &Request, limits: &Limits) {
+    let started = StartedAt {
+        family,
+        mode: attractor.mode,
+        state: attractor.state.clone(),
+    };
+    let span = request.transient;
+    let asked = lyapunov::Request {
+        exponents: 1,
+        transient: 0.0,
+        span,
+        interval: span / 100.0,
+        stop: limits.stop.clone(),
+        deadline: limits.deadline,
+    };
+    let spectrum = lyapunov::spectrum(&started, &asked, &mut |_, _| {});
+    let exponent = spectrum.exponents[0];
+    attractor.exponent = exponent.is_finite().then_some(exponent);
+    // A bounded orbit's exponent that does not part converges to zero as
+    // 1 / span: ten times that is a parting, not a remainder.
+    if !(spectrum.status == "completed" && exponent > 10.0 / span) {
+        attractor.kind = Kind::Unresolved;
+        attractor.reason = Some(format!(
+            "no repeat within {} section events, and no positive exponent ({exponent:e}: {})",
+            request.record, spectrum.status
+        ));
+    }
 }
 
 /// The periodic `attractor` refined by the orbit finder from its first
@@ -403,10 +450,7 @@ impl Point<'_> {
         }
         match period(&states, self.request.tolerance) {
             Some(k) => Reached::Periodic(modes[raw.len() - k], raw[raw.len() - k..].to_vec()),
-            None => Reached::Unresolved(
-                a,
-                format!("no repeat within {} section events", self.request.record),
-            ),
+            None => Reached::Aperiodic(modes[modes.len() - 1], raw[raw.len() - 1].clone()),
         }
     }
 }
@@ -446,6 +490,8 @@ fn gather(
         Reached::Equilibrium(x) => (Kind::Equilibrium, (0, x), Vec::new(), None),
         Reached::Periodic(mode, cycle) => (Kind::Periodic, (mode, cycle[0].clone()), cycle, None),
         Reached::Zeno(x) => (Kind::Zeno, (0, x), Vec::new(), None),
+        // Told chaotic or not once gathered, by its largest exponent.
+        Reached::Aperiodic(mode, x) => (Kind::Chaotic, (mode, x), Vec::new(), None),
         Reached::Unresolved(x, why) => (Kind::Unresolved, (0, x), Vec::new(), Some(why)),
     };
     let same = |a: &Attractor| {
@@ -466,7 +512,7 @@ fn gather(
                 // One class for all the accumulations (a forced system's
                 // each at its own phase), one for all that could not be
                 // told.
-                Kind::Zeno | Kind::Unresolved => true,
+                Kind::Zeno | Kind::Chaotic | Kind::Unresolved => true,
             }
     };
     if let Some(found) = attractors.iter_mut().find(|a| same(a)) {
@@ -481,6 +527,7 @@ fn gather(
         state,
         cycle,
         orbit: None,
+        exponent: None,
         points: 1,
         reason: why,
     });

@@ -36,6 +36,10 @@ pub struct BasinsArgs {
     /// larger of 1 and their size).
     #[arg(long, value_name = "D", default_value_t = 1e-6)]
     tolerance: f64,
+    /// Go on past each run's horizon as a pseudo-orbit: what tells a
+    /// chaotic attractor, whose runs otherwise fail there.
+    #[arg(long = "past-horizon")]
+    past_horizon: bool,
     /// Run only the points I, I+N, I+2N, ... (0 <= I < N), for batch jobs.
     #[arg(long, value_name = "I/N")]
     shard: Option<String>,
@@ -69,6 +73,7 @@ pub fn basins(args: BasinsArgs, registry: &Registry) -> Result<Code, Failure> {
         section: args.section.clone(),
         record: args.record,
         tolerance: args.tolerance,
+        past_horizon: args.past_horizon,
         shard: args.shard.clone(),
         wall: args.wall,
     };
@@ -209,6 +214,9 @@ fn attractors(found: &Basins) -> serde_json::Value {
                     .map(|(re, im)| serde_json::json!([re, im]))
                     .collect();
                 one["stable"] = serde_json::json!(orbit.stable);
+            }
+            if let Some(exponent) = a.exponent {
+                one["exponent"] = serde_json::json!(exponent);
             }
             if let Some(why) = &a.reason {
                 one["reason"] = serde_json::json!(why);

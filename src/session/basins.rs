@@ -23,6 +23,9 @@ pub struct BasinsRequest {
     pub record: usize,
     /// How close two states must be to count as the same.
     pub tolerance: f64,
+    /// Runs go on past their horizon as pseudo-orbits (a chaotic
+    /// attractor's points).
+    pub past_horizon: bool,
     /// Only the points `I, I+N, ...` (`I/N`), for batch jobs.
     pub shard: Option<String>,
     /// Seconds of wall time for the whole grid.
@@ -34,6 +37,7 @@ pub struct PreparedBasins {
     family: Box<dyn Family>,
     request: Request,
     indices: Vec<usize>,
+    past_horizon: bool,
     deadline: Option<std::time::Instant>,
 }
 
@@ -75,6 +79,7 @@ impl BasinsRequest {
             family,
             indices: (shard.index..points).step_by(shard.count).collect(),
             request,
+            past_horizon: self.past_horizon,
             deadline,
         })
     }
@@ -97,6 +102,7 @@ impl PreparedBasins {
         let limits = Limits {
             stop,
             deadline: self.deadline,
+            past_horizon: self.past_horizon,
             ..Limits::default()
         };
         basins::run(&*self.family, &self.request, &self.indices, &limits, done)

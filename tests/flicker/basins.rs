@@ -80,6 +80,7 @@ fn basins(scene: &str, grid: [&str; 2], section: Option<&str>) -> Basins {
         section: section.map(String::from),
         record: 16,
         tolerance: 1e-6,
+        past_horizon: false,
         shard: None,
         wall: 120.0,
     };
@@ -201,6 +202,7 @@ fn the_stick_slip_cycle_is_refined_with_its_multipliers_from_every_start() {
         section: Some("wall".into()),
         record: 6,
         tolerance: 1e-6,
+        past_horizon: false,
         shard: None,
         wall: 60.0,
     };
@@ -223,4 +225,55 @@ fn the_stick_slip_cycle_is_refined_with_its_multipliers_from_every_start() {
         "{moduli:?}"
     );
     assert!(orbit.stable && orbit.period > 0.0);
+}
+
+#[test]
+fn a_chaotic_attractor_is_named_by_its_positive_exponent_past_the_horizon() {
+    // The vibrating table at A = 0.169, inside the band the brute-force
+    // diagram shows after the period-doubling cascade: starts either
+    // chatter to rest (Zeno) or reach an attractor whose impacts never
+    // repeat and whose neighbours part.
+    let mut scene = read_json(std::path::Path::new(&automaton("vibrating_table.json")));
+    scene["parameters"]["A"] = serde_json::json!(0.169);
+    scene["t_end"] = serde_json::json!(60.0);
+    let scene = Registry::builtin().from_value(&scene).unwrap();
+    let asked = |past_horizon| BasinsRequest {
+        grid: vec!["y=0.05:0.6:4".into(), "v=0:4:4".into()],
+        transient: None,
+        section: Some("impact".into()),
+        record: 64,
+        tolerance: 1e-6,
+        past_horizon,
+        shard: None,
+        wall: 60.0,
+    };
+    let found = asked(true).on(&scene).unwrap().run(None, &|| {});
+    let chaotic: Vec<_> = found
+        .attractors
+        .iter()
+        .filter(|a| a.kind == AttractorKind::Chaotic)
+        .collect();
+    assert_eq!(chaotic.len(), 1, "{:?}", found.attractors);
+    // Positive well beyond its measurement's 1/span floor (10 / 60).
+    let exponent = chaotic[0].exponent.unwrap();
+    assert!(exponent > 0.2, "{exponent}");
+    assert!(
+        found
+            .attractors
+            .iter()
+            .all(|a| a.kind != AttractorKind::Unresolved)
+    );
+    // Without going past the horizon, those runs fail there: unresolved,
+    // and said why.
+    let found = asked(false).on(&scene).unwrap().run(None, &|| {});
+    let unresolved = found
+        .attractors
+        .iter()
+        .find(|a| a.kind == AttractorKind::Unresolved)
+        .expect("runs stopped at their horizon");
+    assert!(
+        unresolved.reason.as_deref().unwrap().contains("horizon"),
+        "{:?}",
+        unresolved.reason
+    );
 }
