@@ -32,7 +32,7 @@ use rayon::prelude::*;
 
 use crate::analysis::lyapunov;
 use crate::analysis::orbit::{Orbit, OrbitRequest, Watch};
-use crate::analysis::section_records::SectionRecords;
+use crate::analysis::section_records::{SectionRecords, check_section};
 use crate::analysis::spacing::evenly_spaced;
 use crate::analysis::started_at::StartedAt;
 use crate::engine::step::method::tightest;
@@ -201,12 +201,8 @@ pub fn check(family: &dyn Family, request: &Request) -> Result<(), (&'static str
         return Err(("transient", "a finite time > 0".into()));
     }
     if let Some(section) = &request.section {
-        let model = family.model();
-        let known =
-            (0..family.modes()).any(|m| model.guards(m).iter().any(|g| g.name.as_str() == section));
-        if !known {
-            return Err(("section", format!("no guard is called `{section}`")));
-        }
+        check_section(family.model(), family.modes(), section)
+            .map_err(|e| ("section", e.reason))?;
     }
     if !(2..=MAX_RECORD).contains(&request.record) {
         return Err(("record", format!("from 2 to {MAX_RECORD} events")));

@@ -20,7 +20,7 @@ use std::sync::atomic::AtomicBool;
 
 use rayon::prelude::*;
 
-use crate::analysis::section_records::SectionRecords;
+use crate::analysis::section_records::{SectionRecords, check_section};
 use crate::engine::step::method::tightest;
 use crate::engine::{Family, Limits, MAX_EVENTS, Mode, Promoted, Status, Tolerances, simulate};
 
@@ -92,17 +92,8 @@ pub fn check(family: &dyn Family, request: &Request) -> Result<(), (&'static str
             ),
         ));
     }
-    let guards = guard_names(family);
-    if !guards.contains(&request.section) {
-        return Err((
-            "section",
-            format!(
-                "no guard is called `{}` (guards: {})",
-                request.section,
-                guards.join(", ")
-            ),
-        ));
-    }
+    check_section(family.model(), family.modes(), &request.section)
+        .map_err(|e| ("section", e.reason))?;
     if request.values.is_empty() || request.values.len() > MAX_POINTS {
         return Err(("points", format!("from 1 to {MAX_POINTS} values")));
     }
@@ -139,20 +130,6 @@ fn recorded(promoted: &Promoted) -> (Vec<usize>, Vec<String>) {
         .filter(|(i, _)| *i != p && Some(*i) != promoted.model.clock())
         .map(|(i, n)| (i, n.to_string()))
         .unzip()
-}
-
-/// The names of the guards of `family`'s modes, each once.
-fn guard_names(family: &dyn Family) -> Vec<String> {
-    let model = family.model();
-    let mut names: Vec<String> = Vec::new();
-    for mode in 0..family.modes() {
-        for guard in model.guards(mode) {
-            if !names.iter().any(|n| *n == guard.name.as_str()) {
-                names.push(guard.name.to_string());
-            }
-        }
-    }
-    names
 }
 
 /// Run the values of `request` (checked by [`check`]) whose places are in

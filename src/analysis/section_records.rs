@@ -1,11 +1,40 @@
 //! The states a run passes through a section in: an observer that keeps
 //! the mode and state just after each event of one guard (from a time
 //! on), and stops the run once it has as many as it wants, or once an
-//! outer stop flag (Ctrl-C) is set. What diagrams and basins read.
+//! outer stop flag (Ctrl-C) is set. What diagrams and basins read; and
+//! the check, shared with the orbit tools, that a section names a guard.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use crate::engine::{EventRecord, Mode, Observer};
+use crate::engine::{EventRecord, HybridModel, Mode, Observer};
+use crate::scene::SceneError;
+
+/// Refuse, as field `section`, a `section` that names no guard of
+/// `model`'s modes `0..modes`, listing those it has.
+pub fn check_section(
+    model: &dyn HybridModel,
+    modes: usize,
+    section: &str,
+) -> Result<(), SceneError> {
+    let mut known: Vec<&str> = Vec::new();
+    for m in 0..modes {
+        for g in model.guards(m) {
+            if !known.contains(&&*g.name) {
+                known.push(&g.name);
+            }
+        }
+    }
+    if known.contains(&section) {
+        return Ok(());
+    }
+    Err(SceneError::field(
+        "section",
+        format!(
+            "no transition is called `{section}` (transitions: {})",
+            known.join(", ")
+        ),
+    ))
+}
 
 /// One section event: its time, and the mode and state just after it.
 #[derive(Debug, Clone, PartialEq)]

@@ -77,20 +77,10 @@ pub fn basins(args: BasinsArgs, registry: &Registry) -> Result<Code, Failure> {
         shard: args.shard.clone(),
         wall: args.wall,
     };
-    let prepared = asked.on(&scene).map_err(|e| match e.field.as_deref() {
-        Some(field @ "model") => {
-            Failure::bad_input(format!("{}: {field}: {}", args.scene.display(), e.reason))
-        }
-        Some(field) => Failure::bad_input(format!("--{field}: {}", e.reason)),
-        None => Failure::bad_input(e.in_path(&args.scene)),
-    })?;
-    let out = args.out.clone().unwrap_or_else(|| {
-        let stem = args
-            .scene
-            .file_stem()
-            .map_or_else(|| "scene".into(), |s| s.to_string_lossy().into_owned());
-        Path::new("out").join(format!("{stem}-basins"))
-    });
+    let prepared = asked
+        .on(&scene)
+        .map_err(|e| Failure::refused(&args.scene, e))?;
+    let out = crate::cli::setup::out_dir(args.out.clone(), &args.scene, "basins");
     crate::cli::setup::output_folder(&out)?;
     let stop = crate::cli::setup::stop_flag();
     let started = Instant::now();
@@ -106,12 +96,11 @@ pub fn basins(args: BasinsArgs, registry: &Registry) -> Result<Code, Failure> {
     let json = out.join("attractors.json");
     write_atomically(&json, &attractors(&found)).map_err(|e| untrusted(&json, e.to_string()))?;
     let mut written = vec![csv, json];
-    let figure = picture(&found, labels);
-    for name in ["basins.svg", "basins.png"] {
-        let path = out.join(name);
-        figure.draw(&path).map_err(|e| untrusted(&path, e))?;
-        written.push(path);
-    }
+    written.extend(crate::cli::setup::draw_both(
+        &picture(&found, labels),
+        &out,
+        "basins",
+    )?);
     let run = found.attractor.iter().filter(|a| a.is_some()).count();
     say!(
         "{run} points of {} in {seconds:.3} s reach {} attractors:",

@@ -34,12 +34,7 @@ pub fn compare(
     let comparison = asked.on(scene).map_err(|e| {
         Failure::bad_input(format!("--{}: {}", e.field.unwrap_or_default(), e.reason))
     })?;
-    let out = out.unwrap_or_else(|| {
-        let stem = scene_path
-            .file_stem()
-            .map_or_else(|| "scene".into(), |s| s.to_string_lossy().into_owned());
-        Path::new("out").join(format!("{stem}-compare"))
-    });
+    let out = crate::cli::setup::out_dir(out, scene_path, "compare");
     eprintln!(
         "{:<8} {:>9} {:>9} {:>10} {:>10} {:>9} {:>10}  status",
         "method", "tol", "step", "seconds", "evals", "events", "error"

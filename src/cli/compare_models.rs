@@ -1,7 +1,7 @@
 //! `flicker compare-models`: a release scene as the dense chain at several
 //! N and as each continuum, measured against the densest chain.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::atomic::Ordering;
 
 use crate::log::summary::write_atomically;
@@ -63,12 +63,7 @@ pub fn compare_models(args: CompareModelsArgs, registry: &Registry) -> Result<Co
         _ => Failure::bad_input(e.in_path(&path)),
     })?;
     let units = &models.units;
-    let out = out.unwrap_or_else(|| {
-        let stem = path
-            .file_stem()
-            .map_or_else(|| "scene".into(), |s| s.to_string_lossy().into_owned());
-        Path::new("out").join(format!("{stem}-models"))
-    });
+    let out = crate::cli::setup::out_dir(out, &path, "models");
     crate::cli::setup::output_folder(&out)?;
     let stop = crate::cli::setup::stop_flag();
     let limits = Limits {

@@ -105,13 +105,7 @@ pub fn continue_orbit(args: ContinueArgs, registry: &Registry) -> Result<Code, F
             },
         )
         .map_err(Failure::flag)?;
-    let out = args.out.clone().unwrap_or_else(|| {
-        let stem = args
-            .scene
-            .file_stem()
-            .map_or_else(|| "scene".into(), |s| s.to_string_lossy().into_owned());
-        Path::new("out").join(format!("{stem}-continuation"))
-    });
+    let out = crate::cli::setup::out_dir(args.out.clone(), &args.scene, "continuation");
     crate::cli::setup::output_folder(&out)?;
     let csv = out.join("continuation.csv");
     write_csv(&branch, &names, p, &csv)
@@ -177,13 +171,7 @@ pub fn continue_orbit(args: ContinueArgs, registry: &Registry) -> Result<Code, F
         })?;
         written.push(path);
     }
-    for name in ["bifurcation.svg", "bifurcation.png"] {
-        let path = out.join(name);
-        figure
-            .draw(&path)
-            .map_err(|e| Failure::untrusted(format!("{}: {e}", path.display())))?;
-        written.push(path);
-    }
+    written.extend(crate::cli::setup::draw_both(&figure, &out, "bifurcation")?);
     say_branch(&branch, &args.param, first.parameter);
     let names: Vec<String> = written.iter().map(|p| p.display().to_string()).collect();
     say!("  wrote {}", names.join(", "));

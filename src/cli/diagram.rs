@@ -97,13 +97,9 @@ pub fn diagram(args: DiagramArgs, registry: &Registry) -> Result<Code, Failure> 
         shard: args.shard.clone(),
         wall: args.wall,
     };
-    let prepared = asked.on(&scene).map_err(|e| match e.field.as_deref() {
-        Some(field @ "model") | Some(field @ "initial") => {
-            Failure::bad_input(format!("{}: {field}: {}", args.scene.display(), e.reason))
-        }
-        Some(field) => Failure::bad_input(format!("--{field}: {}", e.reason)),
-        None => Failure::bad_input(e.in_path(&args.scene)),
-    })?;
+    let prepared = asked
+        .on(&scene)
+        .map_err(|e| Failure::refused(&args.scene, e))?;
     let names = prepared.names();
     let drawn = args
         .state
@@ -115,13 +111,7 @@ pub fn diagram(args: DiagramArgs, registry: &Registry) -> Result<Code, Failure> 
             names.join(", ")
         )));
     };
-    let out = args.out.clone().unwrap_or_else(|| {
-        let stem = args
-            .scene
-            .file_stem()
-            .map_or_else(|| "scene".into(), |s| s.to_string_lossy().into_owned());
-        Path::new("out").join(format!("{stem}-diagram"))
-    });
+    let out = crate::cli::setup::out_dir(args.out.clone(), &args.scene, "diagram");
     crate::cli::setup::output_folder(&out)?;
     let stop = crate::cli::setup::stop_flag();
     let started = Instant::now();
@@ -139,11 +129,7 @@ pub fn diagram(args: DiagramArgs, registry: &Registry) -> Result<Code, Failure> 
         .map_err(|e| untrusted(&summary_path, e.to_string()))?;
     let mut written = vec![csv, summary_path];
     let figure = picture(&diagram, &args.param, &drawn, column, &args.section);
-    for name in ["diagram.svg", "diagram.png"] {
-        let path = out.join(name);
-        figure.draw(&path).map_err(|e| untrusted(&path, e))?;
-        written.push(path);
-    }
+    written.extend(crate::cli::setup::draw_both(&figure, &out, "diagram")?);
     let short: Vec<_> = diagram
         .points
         .iter()

@@ -97,13 +97,7 @@ pub fn lyapunov(args: LyapunovArgs, registry: &Registry) -> Result<Code, Failure
         .on(&scene, Some(stop.clone()))
         .map_err(|e| Failure::refused(&args.scene, e))?;
     let request = &prepared.request;
-    let out = args.out.clone().unwrap_or_else(|| {
-        let stem = args
-            .scene
-            .file_stem()
-            .map_or_else(|| "scene".into(), |s| s.to_string_lossy().into_owned());
-        Path::new("out").join(format!("{stem}-lyapunov"))
-    });
+    let out = crate::cli::setup::out_dir(args.out.clone(), &args.scene, "lyapunov");
     crate::cli::setup::output_folder(&out)?;
     let mut bar = WithProgress::new((), request.span, args.quiet);
     let found = prepared.spectrum(&mut |t, events| bar.on_progress(t, events));

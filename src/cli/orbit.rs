@@ -2,7 +2,7 @@
 //! by Newton shooting, written to `DIR/orbit.json`.
 
 use std::io::IsTerminal;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 use crate::log::summary::write_atomically;
@@ -61,13 +61,7 @@ pub fn orbit(args: OrbitArgs, registry: &Registry) -> Result<Code, Failure> {
     }
     .on(&scene, Some(crate::cli::setup::stop_flag()))
     .map_err(|e| Failure::refused(&args.scene, e))?;
-    let out = args.out.unwrap_or_else(|| {
-        let stem = args
-            .scene
-            .file_stem()
-            .map_or_else(|| "scene".into(), |s| s.to_string_lossy().into_owned());
-        Path::new("out").join(format!("{stem}-orbit"))
-    });
+    let out = crate::cli::setup::out_dir(args.out, &args.scene, "orbit");
     let started = Instant::now();
     // On a terminal: a bar over the transient, a line per Newton iteration.
     let shown = !args.quiet && std::io::stderr().is_terminal();

@@ -6,7 +6,6 @@ use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
 use crate::analysis::basins::{self, Axis, Basins, Request};
-use crate::analysis::sweep::Shard;
 use crate::engine::{Family, Limits};
 use crate::scene::{Scene, SceneError};
 
@@ -68,12 +67,8 @@ impl BasinsRequest {
             tolerance: self.tolerance,
         };
         basins::check(&*family, &request).map_err(|(field, why)| SceneError::field(field, why))?;
-        let shard = match &self.shard {
-            Some(text) => Shard::parse(text).map_err(|e| SceneError::field("shard", e))?,
-            None => Shard::WHOLE,
-        };
-        let deadline =
-            crate::runner::deadline_in(self.wall).map_err(|why| SceneError::field("wall", why))?;
+        let shard = super::shard(self.shard.as_deref())?;
+        let deadline = super::deadline(self.wall)?;
         let points = request.axes[0].count * request.axes[1].count;
         Ok(PreparedBasins {
             family,

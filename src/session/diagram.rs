@@ -7,7 +7,6 @@ use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
 use crate::analysis::diagram::{self, Diagram, Request};
-use crate::analysis::sweep::Shard;
 use crate::engine::{Family, Limits};
 use crate::scene::{Scene, SceneError};
 
@@ -75,18 +74,14 @@ impl DiagramRequest {
             follow: self.follow,
         };
         diagram::check(&*family, &request).map_err(|(field, why)| SceneError::field(field, why))?;
-        let shard = match &self.shard {
-            Some(_) if self.follow => {
-                return Err(SceneError::field(
-                    "shard",
-                    "a followed diagram runs its values in order, in one piece".into(),
-                ));
-            }
-            Some(text) => Shard::parse(text).map_err(|e| SceneError::field("shard", e))?,
-            None => Shard::WHOLE,
-        };
-        let deadline =
-            crate::runner::deadline_in(self.wall).map_err(|why| SceneError::field("wall", why))?;
+        if self.follow && self.shard.is_some() {
+            return Err(SceneError::field(
+                "shard",
+                "a followed diagram runs its values in order, in one piece".into(),
+            ));
+        }
+        let shard = super::shard(self.shard.as_deref())?;
+        let deadline = super::deadline(self.wall)?;
         Ok(PreparedDiagram {
             family,
             indices: (shard.index..n).step_by(shard.count).collect(),

@@ -85,3 +85,16 @@ pub struct Prepared<R> {
     /// The scene's `t_end`: the latest any return may come.
     t_max: f64,
 }
+
+/// The instant `wall` seconds from now (a tool's `--wall`), refused as
+/// field `wall` where it is not a time > 0.
+fn deadline(wall: f64) -> Result<Option<std::time::Instant>, SceneError> {
+    crate::runner::deadline_in(wall).map_err(|why| SceneError::field("wall", why))
+}
+
+/// The shard `I/N` asked for, or the whole, refused as field `shard`.
+fn shard(asked: Option<&str>) -> Result<Shard, SceneError> {
+    asked.map_or(Ok(Shard::WHOLE), |text| {
+        Shard::parse(text).map_err(|e| SceneError::field("shard", e))
+    })
+}

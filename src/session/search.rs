@@ -39,8 +39,7 @@ impl SearchRequest {
             settle: self.settle,
             forcing_period: self.forcing_period,
             stop,
-            deadline: crate::runner::deadline_in(self.wall)
-                .map_err(|why| SceneError::field("wall", why))?,
+            deadline: super::deadline(self.wall)?,
         })
     }
 

@@ -45,8 +45,7 @@ impl SpectrumRequest {
                 .interval
                 .unwrap_or_else(|| (scene.time_scale() / 4.0).min(span)),
             stop,
-            deadline: crate::runner::deadline_in(self.wall)
-                .map_err(|why| SceneError::field("wall", why))?,
+            deadline: super::deadline(self.wall)?,
         };
         lyapunov::check(family, &request).map_err(|(field, why)| SceneError::field(field, why))?;
         Ok(request)

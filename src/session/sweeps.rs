@@ -82,10 +82,7 @@ impl<'s> SweepRun<'s> {
         shard: Option<&str>,
         threads: Option<usize>,
     ) -> Result<Self, SceneError> {
-        let shard = match shard {
-            Some(text) => Shard::parse(text).map_err(|e| SceneError::field("shard", e))?,
-            None => Shard::WHOLE,
-        };
+        let shard = super::shard(shard)?;
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads.unwrap_or(0))
             .build()

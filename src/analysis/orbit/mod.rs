@@ -30,24 +30,7 @@ pub fn check(
     modes: usize,
     request: &OrbitRequest,
 ) -> Result<(), SceneError> {
-    let mut known: Vec<&str> = Vec::new();
-    for m in 0..modes {
-        for g in model.guards(m) {
-            if !known.contains(&&*g.name) {
-                known.push(&g.name);
-            }
-        }
-    }
-    if !known.contains(&request.guard.as_str()) {
-        return Err(SceneError::field(
-            "section",
-            format!(
-                "no transition is called `{}` (transitions: {})",
-                request.guard,
-                known.join(", ")
-            ),
-        ));
-    }
+    crate::analysis::section_records::check_section(model, modes, &request.guard)?;
     if request.events == 0 {
         return Err(SceneError::field(
             "events",
