@@ -500,6 +500,7 @@ def basins(
     section: Optional[str] = None,
     record: int = 64,
     tolerance: float = 1e-6,
+    forcing_period: Optional[float] = None,
     past_horizon: bool = False,
     wall: float = 3600.0,
 ) -> Dict[str, Any]:
@@ -510,17 +511,21 @@ def basins(
     state settles to `tolerance`), a periodic orbit (the states after the
     `section` guard's events repeat within `record` of them), a chaotic
     attractor (no repeat, a positive largest exponent; `past_horizon` lets
-    its runs go on), a Zeno point, or unresolved (said, with why).
+    its runs go on), a Zeno point, or unresolved (said, with why). A
+    periodic orbit is refined by the orbit finder (period, multipliers,
+    stability); a model that reads the clock needs `forcing_period` for it.
 
     Returns a dict: the two states' starting values and `attractor` (the id
     each point reaches) as arrays, a row per point, and `attractors`, a
     list of dicts (`id`, `kind`, `state` as a dict, `points`, and `period`
-    and `cycle` for an orbit, `reason` where unresolved)."""
+    and `cycle` for an orbit, with `period_time`, `multipliers` (complex)
+    and `stable` where refined, `exponent` where measured, `reason` where
+    unresolved)."""
     if len(grid) != 2:
         raise ValueError("grid: give two states, {name: (start, stop, count), ...}")
     axes = [f"{name}={float(a)!r}:{float(b)!r}:{int(n)}" for name, (a, b, n) in grid.items()]
     text, path = _source(scene)
-    return _flicker.basins(
+    found = _flicker.basins(
         text,
         path,
         grid=axes,
@@ -528,6 +533,11 @@ def basins(
         section=section,
         record=int(record),
         tolerance=float(tolerance),
+        forcing_period=None if forcing_period is None else float(forcing_period),
         past_horizon=bool(past_horizon),
         wall=float(wall),
     )
+    for attractor in found["attractors"]:
+        if "multipliers" in attractor:
+            attractor["multipliers"] = [complex(re, im) for re, im in attractor["multipliers"]]
+    return found

@@ -390,10 +390,12 @@ pub fn diagram<'py>(
 /// named by the attractor it reaches. Returns a dict: the two states'
 /// values (float64, a row per point run), `attractor` (int64 ids), and
 /// `attractors`, a list of dicts (`id`, `kind`, `state` as a dict,
-/// `points`; `period` and `cycle` for a periodic orbit, `reason` where
-/// unresolved).
+/// `points`; `period` and `cycle` for a periodic orbit, with
+/// `period_time`, `multipliers` (`(re, im)` pairs) and `stable` where
+/// refined;
+/// `exponent` where measured, `reason` where unresolved).
 #[pyfunction]
-#[pyo3(signature = (text=None, path=None, grid=Vec::new(), transient=None, section=None, record=64, tolerance=1e-6, past_horizon=false, wall=3600.0))]
+#[pyo3(signature = (text=None, path=None, grid=Vec::new(), transient=None, section=None, record=64, tolerance=1e-6, forcing_period=None, past_horizon=false, wall=3600.0))]
 #[allow(clippy::too_many_arguments)]
 pub fn basins<'py>(
     py: Python<'py>,
@@ -404,6 +406,7 @@ pub fn basins<'py>(
     section: Option<String>,
     record: usize,
     tolerance: f64,
+    forcing_period: Option<f64>,
     past_horizon: bool,
     wall: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
@@ -414,6 +417,7 @@ pub fn basins<'py>(
         section,
         record,
         tolerance,
+        forcing_period,
         past_horizon,
         shard: None,
         wall,
@@ -462,6 +466,11 @@ pub fn basins<'py>(
                 cycle.append(named(x)?)?;
             }
             one.set_item("cycle", cycle)?;
+        }
+        if let Some(orbit) = &a.orbit {
+            one.set_item("period_time", orbit.period)?;
+            one.set_item("multipliers", orbit.multipliers.clone())?;
+            one.set_item("stable", orbit.stable)?;
         }
         if let Some(exponent) = a.exponent {
             one.set_item("exponent", exponent)?;

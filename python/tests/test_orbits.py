@@ -195,3 +195,21 @@ def test_basins_name_the_double_well_s_two_equilibria_as_the_command_line_does(c
     assert np.allclose(rows[:, 0], found["x"]) and np.allclose(rows[:, 1], found["v"])
     with pytest.raises(ValueError, match="two states"):
         flicker.basins(well, {"x": (0, 1, 3)})
+
+
+def test_basins_refine_a_forced_orbit_with_its_forcing_period():
+    # Holmes's period-one orbit of the ball on the vibrating table: its
+    # impact map's multipliers multiply to r^2 (beside the clock's 1).
+    table = MODELS / "automata" / "vibrating_table.json"
+    grid = {"y": (0.05, 0.6, 3), "v": (0.0, 4.0, 3)}
+    period = 2 * np.pi / 10.0
+    found = flicker.basins(table, grid, section="impact", record=16, forcing_period=period)
+    one = next(a for a in found["attractors"] if a.get("period") == 1)
+    assert abs(one["period_time"] - period) < 1e-12
+    assert one["stable"] is True
+    assert abs(np.prod(one["multipliers"]) - 0.25) < 1e-8
+    bare = flicker.basins(table, grid, section="impact", record=16)
+    assert all("multipliers" not in a for a in bare["attractors"])
+    with pytest.raises(ValueError, match="forcing_period"):
+        well = MODELS / "automata" / "double_well_wall.json"
+        flicker.basins(well, {"x": (-1, 1, 3), "v": (-1, 1, 3)}, forcing_period=1.0)

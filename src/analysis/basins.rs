@@ -21,9 +21,10 @@
 //!
 //! Each periodic orbit found is then refined by the orbit finder from one
 //! of its section states ([`crate::analysis::orbit::search`]): its period
-//! in time and its multipliers, where the finder converges (an autonomous
-//! model; a forced one needs its forcing's period, which a grid does not
-//! know, and is left with its period in section events).
+//! in time and its multipliers, where the finder converges. A forced
+//! model (one that reads the clock) is refined only when told its
+//! forcing's period (`--forcing-period`), of which the orbit's is a whole
+//! number; without it the orbit keeps its period in section events.
 
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
@@ -98,6 +99,9 @@ pub struct Request {
     /// How close two states must be to count as the same, relative to
     /// the larger of 1 and their size.
     pub tolerance: f64,
+    /// The forcing's period, for a model that reads the clock: its
+    /// periodic orbits are refined with it.
+    pub forcing_period: Option<f64>,
 }
 
 /// What an attractor is.
@@ -210,7 +214,25 @@ pub fn check(family: &dyn Family, request: &Request) -> Result<(), (&'static str
     if !(request.tolerance.is_finite() && request.tolerance > 0.0) {
         return Err(("tolerance", "a number > 0".into()));
     }
-    Ok(())
+    match (
+        request.forcing_period,
+        family.model().clock(),
+        &request.section,
+    ) {
+        (None, _, _) => Ok(()),
+        (Some(_), None, _) => Err((
+            "forcing_period",
+            "the model does not read the clock: an autonomous orbit has no forcing period".into(),
+        )),
+        (Some(_), _, None) => Err((
+            "forcing_period",
+            "periodic orbits are refined through a section: give --section too".into(),
+        )),
+        (Some(p), _, _) if !(p.is_finite() && p > 0.0) => {
+            Err(("forcing_period", format!("a time > 0 (got {p})")))
+        }
+        _ => Ok(()),
+    }
 }
 
 /// What one point's run reached, before the grid's attractors are
@@ -289,8 +311,12 @@ pub fn run(
     }
     for attractor in &mut basins.attractors {
         match (attractor.kind, &request.section) {
-            (Kind::Periodic, Some(section)) => {
-                attractor.orbit = refine(family, attractor, section, request.transient, limits);
+            // A forced orbit's clock is an unknown of its own, pinned by
+            // the forcing's period: without it there is nothing to refine.
+            (Kind::Periodic, Some(section))
+                if request.forcing_period.is_some() || family.model().clock().is_none() =>
+            {
+                attractor.orbit = refine(family, attractor, section, request, limits);
             }
             (Kind::Chaotic, _) => judge(family, attractor, request, limits),
             _ => {}
@@ -333,12 +359,13 @@ fn judge(family: &dyn Family, attractor: &mut Attractor, request: &Request, limi
 }
 
 /// The periodic `attractor` refined by the orbit finder from its first
-/// section state, each return within `t_max`, if the finder converges.
+/// section state, each return within the transient, if the finder
+/// converges.
 fn refine(
     family: &dyn Family,
     attractor: &Attractor,
     section: &str,
-    t_max: f64,
+    request: &Request,
     limits: &Limits,
 ) -> Option<Orbit> {
     let started = StartedAt {
@@ -346,15 +373,15 @@ fn refine(
         mode: attractor.mode,
         state: attractor.cycle[0].clone(),
     };
-    let request = OrbitRequest {
+    let asked = OrbitRequest {
         guard: section.to_string(),
         events: attractor.cycle.len(),
         settle: 0.0,
-        forcing_period: None,
+        forcing_period: request.forcing_period,
         stop: limits.stop.clone(),
         deadline: limits.deadline,
     };
-    crate::analysis::orbit::search(&started, &request, t_max, Watch::default())
+    crate::analysis::orbit::search(&started, &asked, request.transient, Watch::default())
         .ok()
         .filter(|orbit| orbit.converged)
 }

@@ -36,6 +36,14 @@ pub struct BasinsArgs {
     /// larger of 1 and their size).
     #[arg(long, value_name = "D", default_value_t = 1e-6)]
     tolerance: f64,
+    /// The forcing's period, for a model that reads the clock t: its
+    /// periodic orbits are then refined (period, multipliers, stability).
+    #[arg(
+        long = "forcing-period",
+        value_name = "T",
+        allow_negative_numbers = true
+    )]
+    forcing_period: Option<f64>,
     /// Go on past each run's horizon as a pseudo-orbit: what tells a
     /// chaotic attractor, whose runs otherwise fail there.
     #[arg(long = "past-horizon")]
@@ -73,6 +81,7 @@ pub fn basins(args: BasinsArgs, registry: &Registry) -> Result<Code, Failure> {
         section: args.section.clone(),
         record: args.record,
         tolerance: args.tolerance,
+        forcing_period: args.forcing_period,
         past_horizon: args.past_horizon,
         shard: args.shard.clone(),
         wall: args.wall,
@@ -121,10 +130,15 @@ pub fn basins(args: BasinsArgs, registry: &Registry) -> Result<Code, Failure> {
             if a.cycle.is_empty() {
                 String::new()
             } else {
-                match a.cycle.len() {
+                let events = match a.cycle.len() {
                     1 => " of one section event a period".to_string(),
                     k => format!(" of {k} section events a period"),
-                }
+                };
+                let refined = a.orbit.as_ref().map_or(String::new(), |o| {
+                    let stable = if o.stable { "stable" } else { "unstable" };
+                    format!(" ({:.6e} in time, {stable})", o.period)
+                });
+                events + &refined
             },
             a.points,
             state.join(", "),

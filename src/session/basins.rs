@@ -22,6 +22,9 @@ pub struct BasinsRequest {
     pub record: usize,
     /// How close two states must be to count as the same.
     pub tolerance: f64,
+    /// The forcing's period, for a model that reads the clock: periodic
+    /// orbits are refined with it (multipliers, stability).
+    pub forcing_period: Option<f64>,
     /// Runs go on past their horizon as pseudo-orbits (a chaotic
     /// attractor's points).
     pub past_horizon: bool,
@@ -43,7 +46,7 @@ pub struct PreparedBasins {
 impl BasinsRequest {
     /// The request checked against `scene`; the error names the field at
     /// fault (`grid`, `transient`, `section`, `record`, `tolerance`,
-    /// `shard`, `wall`), or the scene's `model` where it has no finite
+    /// `forcing_period`, `shard`, `wall`), or the scene's `model` where it has no finite
     /// state.
     pub fn on(&self, scene: &Scene) -> Result<PreparedBasins, SceneError> {
         let family = scene.family()?;
@@ -65,6 +68,7 @@ impl BasinsRequest {
             section: self.section.clone(),
             record: self.record,
             tolerance: self.tolerance,
+            forcing_period: self.forcing_period,
         };
         basins::check(&*family, &request).map_err(|(field, why)| SceneError::field(field, why))?;
         let shard = super::shard(self.shard.as_deref())?;

@@ -70,7 +70,12 @@ fn settles_at(x: f64, v: f64, t_end: f64) -> f64 {
     s[0].signum()
 }
 
-fn basins(scene: &str, grid: [&str; 2], section: Option<&str>) -> Basins {
+fn basins(
+    scene: &str,
+    grid: [&str; 2],
+    section: Option<&str>,
+    forcing_period: Option<f64>,
+) -> Basins {
     let scene = Registry::builtin()
         .from_value(&read_json(std::path::Path::new(&automaton(scene))))
         .unwrap();
@@ -80,6 +85,7 @@ fn basins(scene: &str, grid: [&str; 2], section: Option<&str>) -> Basins {
         section: section.map(String::from),
         record: 16,
         tolerance: 1e-6,
+        forcing_period,
         past_horizon: false,
         shard: None,
         wall: 120.0,
@@ -89,7 +95,12 @@ fn basins(scene: &str, grid: [&str; 2], section: Option<&str>) -> Basins {
 
 #[test]
 fn the_double_well_s_basins_agree_with_an_independent_integrator() {
-    let found = basins("double_well_wall.json", ["x=-1.35:2:31", "v=-2:2:31"], None);
+    let found = basins(
+        "double_well_wall.json",
+        ["x=-1.35:2:31", "v=-2:2:31"],
+        None,
+        None,
+    );
     // Two attractors, both equilibria, at x = -1 and x = 1 at rest.
     assert_eq!(found.attractors.len(), 2, "{:?}", found.attractors);
     let mut sides = Vec::new();
@@ -121,10 +132,12 @@ fn the_vibrating_table_s_period_one_orbit_is_named_periodic_on_its_closed_form()
     // Starts above the table at rest: they reach Holmes's period-one
     // orbit (one impact a table period, leaving at g T / 2), or chatter
     // down to it (a Zeno point).
+    let (g, r, a, w) = (9.81_f64, 0.5_f64, 0.1275_f64, 10.0_f64);
     let found = basins(
         "vibrating_table.json",
         ["y=0.05:0.6:6", "v=0:4:6"],
         Some("impact"),
+        Some(2.0 * PI / w),
     );
     let periodic: Vec<_> = found
         .attractors
@@ -134,9 +147,118 @@ fn the_vibrating_table_s_period_one_orbit_is_named_periodic_on_its_closed_form()
     assert!(!periodic.is_empty(), "{:?}", found.attractors);
     let v = found.names.iter().position(|n| n == "v").unwrap();
     let one = periodic.iter().find(|a| a.cycle.len() == 1).unwrap();
-    let take_off = 9.81 * PI / 10.0;
+    let take_off = g * PI / w;
     assert!((one.cycle[0][v] - take_off).abs() < 1e-6, "{:?}", one.cycle);
     assert!(one.points > 0);
+    // Refined with the forcing's period: one table period, and the exact
+    // impact map's multipliers at Holmes's phase `phi` (`cos(phi) = pi (1
+    // - r) / ((1 + r) Gamma)`): the roots of `mu^2 - tr mu + r^2`, `tr =
+    // 1 + r^2 - (1 + r)^2 Gamma sin(phi)`, beside the clock's trivial 1.
+    let orbit = one.orbit.as_ref().expect("refined with the forcing period");
+    assert!(
+        (orbit.period - 2.0 * PI / w).abs() < 1e-12,
+        "{}",
+        orbit.period
+    );
+    let gamma = a * w * w / g;
+    let phi = (PI * (1.0 - r) / ((1.0 + r) * gamma)).acos();
+    let trace = 1.0 + r * r - (1.0 + r).powi(2) * gamma * phi.sin();
+    let mut found: Vec<(f64, f64)> = orbit.multipliers.clone();
+    let trivial = (0..found.len())
+        .min_by(|&i, &j| {
+            let off = |z: (f64, f64)| (z.0 - 1.0).hypot(z.1);
+            off(found[i]).total_cmp(&off(found[j]))
+        })
+        .unwrap();
+    found.remove(trivial);
+    let (sum, product) = match found[..] {
+        [p, q] => (p.0 + q.0, (p.0 * q.0 - p.1 * q.1, p.0 * q.1 + p.1 * q.0)),
+        _ => panic!("{:?}", orbit.multipliers),
+    };
+    assert!((sum - trace).abs() < 1e-8, "{sum} against {trace}");
+    assert!((product.0 - r * r).abs() < 1e-8 && product.1.abs() < 1e-8);
+    assert!(orbit.stable);
+}
+
+#[test]
+fn a_forced_orbit_is_left_unrefined_without_its_forcing_period() {
+    let found = basins(
+        "vibrating_table.json",
+        ["y=0.05:0.6:3", "v=0:4:3"],
+        Some("impact"),
+        None,
+    );
+    let periodic = found
+        .attractors
+        .iter()
+        .find(|a| a.kind == AttractorKind::Periodic);
+    assert!(periodic.expect("periodic").orbit.is_none());
+    // A forcing period for an autonomous model is refused, naming it.
+    let scene = Registry::builtin()
+        .from_value(&read_json(std::path::Path::new(&automaton(
+            "double_well_wall.json",
+        ))))
+        .unwrap();
+    let asked = BasinsRequest {
+        grid: vec!["x=-1:1:3".into(), "v=-1:1:3".into()],
+        transient: None,
+        section: None,
+        record: 16,
+        tolerance: 1e-6,
+        forcing_period: Some(1.0),
+        past_horizon: false,
+        shard: None,
+        wall: 60.0,
+    };
+    let refused = asked.on(&scene).err().expect("refused");
+    assert!(refused.to_string().contains("forcing_period"), "{refused}");
+}
+
+#[test]
+fn a_quasi_periodic_orbit_is_not_called_chaotic() {
+    // A ball bouncing elastically on the floor beside an undamped
+    // oscillator of frequency 1: at the bounces the oscillator's phase
+    // turns by 2 u / g, irrational for almost every start, so the section
+    // states never repeat; yet nearby orbits part only linearly (the
+    // bounce period's shear), an exponent of about ln(t) / t, below ten
+    // times the 1 / span floor. Unresolved, with the exponent said.
+    let scene = serde_json::json!({
+        "model": "automaton",
+        "parameters": {"g": 1.0},
+        "states": ["x", "p", "y", "u"],
+        "initial": {"x": 1.0, "p": 0.0, "y": 0.3, "u": 0.0},
+        "modes": {"flight": {
+            "flow": {"x": "p", "p": "-x", "y": "u", "u": "-g"},
+            "transitions": [{"name": "bounce", "guard": "y", "direction": "falling",
+                             "barrier": true, "reset": {"u": "-u"}}]}},
+        "t_end": 200.0
+    });
+    let scene = Registry::builtin().from_value(&scene).unwrap();
+    let asked = BasinsRequest {
+        grid: vec!["x=0.5:1:2".into(), "y=0.3:0.37:2".into()],
+        transient: None,
+        section: Some("bounce".into()),
+        record: 32,
+        tolerance: 1e-6,
+        forcing_period: None,
+        past_horizon: true,
+        shard: None,
+        wall: 60.0,
+    };
+    let found = asked.on(&scene).unwrap().run(None, &|| {});
+    assert_eq!(found.attractors.len(), 1, "{:?}", found.attractors);
+    let torus = &found.attractors[0];
+    assert_eq!(torus.kind, AttractorKind::Unresolved, "{torus:?}");
+    assert!(
+        torus
+            .reason
+            .as_ref()
+            .unwrap()
+            .contains("no positive exponent")
+    );
+    let exponent = torus.exponent.expect("measured");
+    assert!(exponent.abs() < 10.0 / 200.0, "{exponent}");
+    assert_eq!(torus.points, 4);
 }
 
 #[test]
@@ -202,6 +324,7 @@ fn the_stick_slip_cycle_is_refined_with_its_multipliers_from_every_start() {
         section: Some("wall".into()),
         record: 6,
         tolerance: 1e-6,
+        forcing_period: None,
         past_horizon: false,
         shard: None,
         wall: 60.0,
@@ -243,6 +366,7 @@ fn a_chaotic_attractor_is_named_by_its_positive_exponent_past_the_horizon() {
         section: Some("impact".into()),
         record: 64,
         tolerance: 1e-6,
+        forcing_period: None,
         past_horizon,
         shard: None,
         wall: 60.0,
