@@ -13,9 +13,12 @@
 //! 20 takes 0.1 ms, a chain of 100 states 3.5 ms (heyoka's LLVM takes
 //! 66-146 ms). A tape is compiled once it has been asked for 64
 //! times (`tiered.rs`): a short run never pays for it. Other
-//! processors, and what does not compile, keep the interpreter.
+//! processors, a build without the `jit` feature (on by default), and
+//! what does not compile keep the interpreter.
 
 mod evaluation;
+// Where is no machine code, the layout is built and never read.
+#[cfg_attr(not(all(feature = "jit", target_arch = "x86_64")), allow(dead_code))]
 mod layout;
 mod machine;
 mod series;
@@ -23,6 +26,10 @@ mod tiered;
 
 pub use evaluation::CompiledTape;
 pub use series::{CompiledFlow, CompiledFlows};
+
+/// Whether this build compiles tapes to machine code (x86-64 with the
+/// `jit` feature), rather than interpreting every one.
+pub const MACHINE_CODE: bool = cfg!(all(feature = "jit", target_arch = "x86_64"));
 
 #[cfg(test)]
 mod tests;

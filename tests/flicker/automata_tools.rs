@@ -132,7 +132,7 @@ fn an_automaton_ensemble_drifts_as_the_period_depends_on_the_energy() {
     let dir = tempfile::tempdir().unwrap();
     let ensemble = |name: &str, threads: &str| -> Value {
         let out = dir.path().join(name);
-        let o = std::process::Command::new(env!("CARGO_BIN_EXE_flicker"))
+        let o = crate::support::command()
             .args([
                 "run",
                 &automaton("mechanism.json"),

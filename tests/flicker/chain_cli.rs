@@ -398,7 +398,7 @@ fn bad_chain_scenes_are_refused_naming_the_field() {
 /// three copies; returns the summary's `ensemble` object.
 fn ensemble(dir: &Path, name: &str, seed: &str, threads: &str, perturb: &str) -> serde_json::Value {
     let out = dir.join(name);
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_flicker"))
+    let o = crate::support::command()
         .args([
             "run",
             &models("chain_release_free_end.json"),

@@ -438,7 +438,7 @@ fn an_interrupted_run_keeps_its_log_and_says_so() {
     for signal in ["-INT", "-TERM"] {
         let dir = tempfile::tempdir().unwrap();
         let out = dir.path().join("run");
-        let child = Command::new(env!("CARGO_BIN_EXE_flicker"))
+        let child = crate::support::command()
             .args([
                 "run",
                 &models("mechanism_impacting.json"),
@@ -555,7 +555,7 @@ fn a_closed_stdout_is_not_a_crash() {
     // finish its files and exit normally, not panic.
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("run");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_flicker"))
+    let mut child = crate::support::command()
         .args([
             "run",
             &models("mechanism_impacting.json"),

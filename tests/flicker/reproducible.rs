@@ -1,11 +1,9 @@
 //! The same scene gives byte-identical `events.jsonl` and the same
 //! `summary.json` apart from wall time, run after run.
 
-use std::process::Command;
-
 fn run_to(dir: &std::path::Path, scene: &str) -> (Vec<u8>, serde_json::Value) {
     let scene = format!("{}/models/{scene}", env!("CARGO_MANIFEST_DIR"));
-    let status = Command::new(env!("CARGO_BIN_EXE_flicker"))
+    let status = crate::support::command()
         .args(["run", &scene, "--out", dir.to_str().unwrap()])
         .output()
         .unwrap()

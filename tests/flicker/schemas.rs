@@ -3,7 +3,6 @@
 //! passes the event schema, and `flicker check` accepts and refuses the same.
 
 use std::path::Path;
-use std::process::Command;
 
 use serde_json::Value;
 
@@ -16,7 +15,7 @@ fn schema(name: &str) -> jsonschema::Validator {
 }
 
 fn check(path: &Path) -> Option<i32> {
-    Command::new(env!("CARGO_BIN_EXE_flicker"))
+    crate::support::command()
         .args(["check", path.to_str().unwrap()])
         .output()
         .unwrap()
@@ -91,7 +90,7 @@ fn every_logged_event_passes_the_event_schema() {
         let scene = Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("models")
             .join(scene);
-        let status = Command::new(env!("CARGO_BIN_EXE_flicker"))
+        let status = crate::support::command()
             .args([
                 "run",
                 scene.to_str().unwrap(),
@@ -131,10 +130,7 @@ fn the_shipped_scene_schema_is_the_registrys() {
         shipped,
         flicker::scene::Registry::builtin().schema().unwrap()
     );
-    let printed = Command::new(env!("CARGO_BIN_EXE_flicker"))
-        .arg("schema")
-        .output()
-        .unwrap();
+    let printed = crate::support::command().arg("schema").output().unwrap();
     assert_eq!(printed.status.code(), Some(0));
     let printed: Value = serde_json::from_slice(&printed.stdout).unwrap();
     assert_eq!(printed, shipped);

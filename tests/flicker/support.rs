@@ -36,12 +36,26 @@ impl Observer for EventLog {
     }
 }
 
+/// A command that runs the binary: under `FLICKER_TEST_RUNNER` where that
+/// is set (an emulator, for a build for another processor: `qemu-aarch64
+/// -L /usr/aarch64-linux-gnu`, see `.ci/aarch64`).
+pub fn command() -> Command {
+    let binary = env!("CARGO_BIN_EXE_flicker");
+    let runner = std::env::var("FLICKER_TEST_RUNNER").unwrap_or_default();
+    let mut words = runner.split_whitespace();
+    match words.next() {
+        Some(program) => {
+            let mut command = Command::new(program);
+            command.args(words).arg(binary);
+            command
+        }
+        None => Command::new(binary),
+    }
+}
+
 /// Run the binary with `args` and collect what it did.
 pub fn flicker(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_flicker"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
+    command().args(args).output().expect("the binary runs")
 }
 
 /// The path of a bundled scene in `models/`.

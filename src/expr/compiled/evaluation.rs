@@ -118,32 +118,32 @@ impl Evaluation {
     }
 }
 
-#[cfg(not(target_arch = "x86_64"))]
+#[cfg(not(all(feature = "jit", target_arch = "x86_64")))]
 fn lower(_: &Tape, _: &Layout) -> Option<Code> {
     None
 }
 
 /// `f(a)`, `f` the `kind`-th of the tape's functions of one argument.
-#[cfg(target_arch = "x86_64")]
+#[cfg(all(feature = "jit", target_arch = "x86_64"))]
 extern "sysv64" fn call(kind: u32, a: f64, _: *mut f64, _: *mut f64) -> f64 {
     use crate::expr::tape::FUNS;
     FUNS[kind as usize].1.apply(a)
 }
 
 /// `f(a, b)`, `f` the `kind`-th of the tape's functions of two.
-#[cfg(target_arch = "x86_64")]
+#[cfg(all(feature = "jit", target_arch = "x86_64"))]
 extern "sysv64" fn call2(kind: u32, a: f64, b: f64, _: *mut f64, _: *mut f64) -> f64 {
     use crate::expr::tape::FUNS2;
     FUNS2[kind as usize].1.apply(a, b)
 }
 
 /// `a^b`.
-#[cfg(target_arch = "x86_64")]
+#[cfg(all(feature = "jit", target_arch = "x86_64"))]
 extern "sysv64" fn pow(_: u32, a: f64, b: f64, _: *mut f64, _: *mut f64) -> f64 {
     a.powf(b)
 }
 
-#[cfg(target_arch = "x86_64")]
+#[cfg(all(feature = "jit", target_arch = "x86_64"))]
 fn lower(tape: &Tape, layout: &Layout) -> Option<Code> {
     use crate::expr::compiled::layout::Place;
     use crate::expr::compiled::machine::Emitter;

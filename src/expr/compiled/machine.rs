@@ -26,13 +26,13 @@
 //! registers and may write any place, so it forgets them; memory holds
 //! every value, so nothing is saved.
 
-#[cfg(target_arch = "x86_64")]
+#[cfg(all(feature = "jit", target_arch = "x86_64"))]
 pub use x64::{Code, Emitter};
 
-#[cfg(not(target_arch = "x86_64"))]
+#[cfg(not(all(feature = "jit", target_arch = "x86_64")))]
 pub use other::Code;
 
-#[cfg(target_arch = "x86_64")]
+#[cfg(all(feature = "jit", target_arch = "x86_64"))]
 // dynasm's expansion converts each dynamic register's number by `.into()`.
 #[allow(clippy::useless_conversion)]
 mod x64 {
@@ -508,7 +508,7 @@ mod x64 {
     }
 }
 
-#[cfg(not(target_arch = "x86_64"))]
+#[cfg(not(all(feature = "jit", target_arch = "x86_64")))]
 mod other {
     /// No code: nothing compiles on this processor.
     #[derive(Debug)]

@@ -143,7 +143,7 @@ fn terms(tape: &Tape, order: usize) -> usize {
 /// forcing `cos(w t)` then costs one term an order, not `k`. Leaving out
 /// an exact zero moves no sum (one that starts at `+0` never becomes
 /// `-0`), so the code still gives the interpreter's bits.
-#[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
+#[cfg_attr(not(all(feature = "jit", target_arch = "x86_64")), allow(dead_code))]
 pub(super) fn degrees(tape: &Tape) -> Vec<usize> {
     const ANY: usize = usize::MAX;
     let mut states = vec![ANY; tape.outputs.len()];
@@ -177,13 +177,13 @@ pub(super) fn degrees(tape: &Tape) -> Vec<usize> {
     degree
 }
 
-#[cfg(not(target_arch = "x86_64"))]
+#[cfg(not(all(feature = "jit", target_arch = "x86_64")))]
 fn lower(_: &Tape, _: &Layout, _: usize) -> Option<Code> {
     None
 }
 
 /// The functions whose value the code asks Rust for at a series' origin.
-#[cfg(target_arch = "x86_64")]
+#[cfg(all(feature = "jit", target_arch = "x86_64"))]
 #[derive(Clone, Copy)]
 #[repr(u32)]
 enum Origin {
@@ -196,7 +196,7 @@ enum Origin {
 
 /// A function's value at the origin (and its partner's: the `cos` of a
 /// `sin`), by the same calls as the interpreter's.
-#[cfg(target_arch = "x86_64")]
+#[cfg(all(feature = "jit", target_arch = "x86_64"))]
 extern "sysv64" fn origin(kind: u32, a: f64, value: *mut f64, partner: *mut f64) {
     let (v, p) = match kind {
         k if k == Origin::Sin as u32 => a.sin_cos(),
@@ -218,7 +218,7 @@ extern "sysv64" fn origin(kind: u32, a: f64, value: *mut f64, partner: *mut f64)
 
 /// The series of `tape` at `order`, `None` for an instruction this does
 /// not compile.
-#[cfg(target_arch = "x86_64")]
+#[cfg(all(feature = "jit", target_arch = "x86_64"))]
 fn lower(tape: &Tape, layout: &Layout, order: usize) -> Option<Code> {
     use crate::expr::compiled::layout::Base;
     use crate::expr::compiled::machine::Emitter;

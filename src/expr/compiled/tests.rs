@@ -15,7 +15,7 @@ fn same_as_interpreted(texts: &[&str], inputs: &[&str], x0: &[f64]) {
         let mut interpreted = vec![0.0; x0.len() * w];
         Series::default().flow(&t, x0, order, &mut interpreted);
         let compiled = CompiledFlow::new(&t, order);
-        if !cfg!(target_arch = "x86_64") {
+        if !super::MACHINE_CODE {
             assert!(compiled.is_none());
             return;
         }
@@ -142,7 +142,7 @@ fn every_compiled_instruction_gives_the_interpreters_bits() {
 /// series alone.
 #[test]
 fn the_compiled_oscillator_expands_to_cosine_and_sine() {
-    if !cfg!(target_arch = "x86_64") {
+    if !super::MACHINE_CODE {
         return;
     }
     let order = 20;
@@ -231,7 +231,7 @@ fn threads_share_a_compiled_flow() {
     });
     // 400 calls, the first WARM_UP of them (all threads together) to the
     // interpreter.
-    if cfg!(target_arch = "x86_64") {
+    if super::MACHINE_CODE {
         assert_eq!(compiled_calls, 400 - tiered::WARM_UP);
     }
 }
@@ -247,13 +247,13 @@ fn a_tape_is_compiled_once_warmed_up() {
     for call in 0..=tiered::WARM_UP {
         assert_eq!(
             code.compiled(),
-            cfg!(target_arch = "x86_64") && call > tiered::WARM_UP
+            super::MACHINE_CODE && call > tiered::WARM_UP
         );
         let mut out = [f64::NAN; 2];
         code.eval(&t, &[0.4, -0.2], &mut out);
         assert_eq!(out.map(f64::to_bits), want.map(f64::to_bits), "call {call}");
     }
-    assert_eq!(code.compiled(), cfg!(target_arch = "x86_64"));
+    assert_eq!(code.compiled(), super::MACHINE_CODE);
 }
 
 /// Every instruction and every function, evaluated compiled and
@@ -295,7 +295,7 @@ fn every_compiled_evaluation_gives_the_interpreters_bits() {
         }
         // Compiled for real: only the interpreter's fallback would leave
         // this machine's code unexercised.
-        assert!(!cfg!(target_arch = "x86_64") || code.compiled());
+        assert!(!super::MACHINE_CODE || code.compiled());
     }
 }
 

@@ -49,8 +49,8 @@ const INVERSES: [f64; MAX_COLUMN] = {
 // (`wide::f64x4`, moved in and out with `bytemuck::cast`): left to the
 // compiler, their lanes came out shuffled and partly scalar, and its choices
 // moved with unrelated changes elsewhere in the crate. `f64x4::mul_add`
-// fuses exactly where `mul_add` does (when the build target has FMA), so
-// both give the same bits.
+// fuses exactly where `mul_add` does (where the build target has FMA, and
+// on every aarch64 target), so both give the same bits.
 
 /// Registers of four columns per block.
 const QUADS: usize = LANES / 4;
