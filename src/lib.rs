@@ -61,6 +61,8 @@
 //! ```
 
 #![deny(missing_docs)]
+// Raw memory is touched in one place: the JIT (`expr::compiled`).
+#![deny(unsafe_code)]
 
 pub mod analysis;
 pub mod cli;

@@ -2,6 +2,8 @@
 //! ([`mod@parse`]), compiled to a register tape ([`tape`]) that is evaluated,
 //! differentiated and expanded in Taylor series without walking text.
 
+// The one module that runs machine code it wrote, over raw buffers.
+#[allow(unsafe_code)]
 pub mod compiled;
 pub mod derivative;
 pub mod parse;

@@ -96,14 +96,18 @@ impl Evaluation {
             if work.len() < self.work {
                 work.resize(self.work, 0.0);
             }
-            // The code reads `inputs[..self.inputs]` and `pool`, and
-            // writes `work[..self.work]`, at places fixed when it was
-            // compiled; the lengths were checked above. It writes no input.
-            self.code.run(
-                work.as_mut_ptr(),
-                inputs.as_ptr().cast_mut(),
-                self.pool.as_ptr(),
-            );
+            // SAFETY: the code reads `inputs[..self.inputs]` and `pool`,
+            // and writes `work[..self.work]`, at places fixed when it was
+            // compiled; the lengths were checked above, and the three are
+            // distinct buffers. It writes no input, so the shared slice's
+            // pointer is never written through.
+            unsafe {
+                self.code.run(
+                    work.as_mut_ptr(),
+                    inputs.as_ptr().cast_mut(),
+                    self.pool.as_ptr(),
+                );
+            }
             let results = &work[self.work - self.outputs..self.work];
             match (out, results) {
                 // A guard's or the energy's one value: no call to copy it.

@@ -50,7 +50,9 @@ mod x64 {
         function: Entry,
     }
 
-    type Entry = extern "sysv64" fn(*mut f64, *mut f64, *const f64);
+    /// The compiled function: it reads and writes the three buffers at
+    /// places fixed when it was compiled, so calling it is unsafe.
+    type Entry = unsafe extern "sysv64" fn(*mut f64, *mut f64, *const f64);
 
     /// Its size, not its bytes.
     impl std::fmt::Debug for Code {
@@ -60,10 +62,18 @@ mod x64 {
     }
 
     impl Code {
-        /// Run the code on the three buffers, which must be as long as the
-        /// layout it was compiled for says.
-        pub fn run(&self, work: *mut f64, state: *mut f64, pool: *const f64) {
-            (self.function)(work, state, pool);
+        /// Run the code on the three buffers.
+        ///
+        /// # Safety
+        ///
+        /// Each buffer must be valid, for as many `f64`s as the layout the
+        /// code was compiled for says (`work` and `state` for reads and
+        /// writes, `pool` for reads), and none may overlap another: the
+        /// code reads and writes them at fixed places, unchecked.
+        pub unsafe fn run(&self, work: *mut f64, state: *mut f64, pool: *const f64) {
+            // SAFETY: the buffers are as the caller promised; the function
+            // is one `finish` emitted whole (see there).
+            unsafe { (self.function)(work, state, pool) }
         }
     }
 
@@ -515,7 +525,12 @@ mod other {
     pub enum Code {}
 
     impl Code {
-        pub fn run(&self, _: *mut f64, _: *mut f64, _: *const f64) {
+        /// Never called: no `Code` exists here.
+        ///
+        /// # Safety
+        ///
+        /// As the machine code's (see the x86-64 `Code::run`).
+        pub unsafe fn run(&self, _: *mut f64, _: *mut f64, _: *const f64) {
             match *self {}
         }
     }

@@ -117,11 +117,14 @@ impl CompiledFlow {
             if work.len() < self.work {
                 work.resize(self.work, 0.0);
             }
-            // The code reads and writes `work[..self.work]`, `out[..states
-            // * width]` and `pool`, at places fixed when it was compiled
-            // from these sizes; the lengths were checked above.
-            self.code
-                .run(work.as_mut_ptr(), out.as_mut_ptr(), self.pool.as_ptr());
+            // SAFETY: the code reads and writes `work[..self.work]`,
+            // `out[..states * width]` and `pool`, at places fixed when it
+            // was compiled from these sizes; the lengths were checked
+            // above, and the three are distinct buffers.
+            unsafe {
+                self.code
+                    .run(work.as_mut_ptr(), out.as_mut_ptr(), self.pool.as_ptr());
+            }
         });
     }
 }
@@ -197,7 +200,12 @@ enum Origin {
 /// A function's value at the origin (and its partner's: the `cos` of a
 /// `sin`), by the same calls as the interpreter's.
 #[cfg(all(feature = "jit", target_arch = "x86_64"))]
-extern "sysv64" fn origin(kind: u32, a: f64, value: *mut f64, partner: *mut f64) {
+///
+/// # Safety
+///
+/// `value` and `partner` must be valid for writes: the compiled code passes
+/// two places of its work buffer.
+unsafe extern "sysv64" fn origin(kind: u32, a: f64, value: *mut f64, partner: *mut f64) {
     let (v, p) = match kind {
         k if k == Origin::Sin as u32 => a.sin_cos(),
         k if k == Origin::Cos as u32 => {
