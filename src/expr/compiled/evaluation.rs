@@ -1,11 +1,12 @@
 //! A tape's evaluation compiled: each instruction's value in turn, as
 //! [`Op::value`] takes it, arithmetic in place and every function,
 //! power and two-argument function by a call to the same Rust the
-//! interpreter calls. Every tape compiles (on x86-64); the values are the
+//! interpreter calls. Every tape compiles (where a back end is); the values are the
 //! interpreter's bit for bit.
 
 use std::cell::RefCell;
 
+use crate::expr::compiled::emit::{Emit, Helper};
 use crate::expr::compiled::layout::Layout;
 use crate::expr::compiled::machine::Code;
 use crate::expr::compiled::tiered::Tiered;
@@ -62,7 +63,7 @@ impl Evaluation {
             return None;
         }
         let layout = Layout::new(tape, 1);
-        let code = lower(tape, &layout)?;
+        let code = compile(tape, &layout)?;
         let inputs = tape
             .ops
             .iter()
@@ -122,49 +123,41 @@ impl Evaluation {
     }
 }
 
-#[cfg(not(all(feature = "jit", target_arch = "x86_64")))]
-fn lower(_: &Tape, _: &Layout) -> Option<Code> {
-    None
+/// The evaluation of `tape` in this processor's code, `None` where
+/// nothing compiles.
+fn compile(tape: &Tape, layout: &Layout) -> Option<Code> {
+    #[cfg(all(feature = "jit", any(target_arch = "x86_64", target_arch = "aarch64")))]
+    {
+        let e = crate::expr::compiled::machine::Emitter::new(layout.extents(tape.outputs.len()))?;
+        lower(e, tape, layout)
+    }
+    #[cfg(not(all(feature = "jit", any(target_arch = "x86_64", target_arch = "aarch64"))))]
+    {
+        let _ = (tape, layout);
+        None
+    }
 }
 
-/// `f(a)`, `f` the `kind`-th of the tape's functions of one argument.
-#[cfg(all(feature = "jit", target_arch = "x86_64"))]
-extern "sysv64" fn call(kind: u32, a: f64, _: *mut f64, _: *mut f64) -> f64 {
-    use crate::expr::tape::FUNS;
-    FUNS[kind as usize].1.apply(a)
-}
-
-/// `f(a, b)`, `f` the `kind`-th of the tape's functions of two.
-#[cfg(all(feature = "jit", target_arch = "x86_64"))]
-extern "sysv64" fn call2(kind: u32, a: f64, b: f64, _: *mut f64, _: *mut f64) -> f64 {
-    use crate::expr::tape::FUNS2;
-    FUNS2[kind as usize].1.apply(a, b)
-}
-
-/// `a^b`.
-#[cfg(all(feature = "jit", target_arch = "x86_64"))]
-extern "sysv64" fn pow(_: u32, a: f64, b: f64, _: *mut f64, _: *mut f64) -> f64 {
-    a.powf(b)
-}
-
-#[cfg(all(feature = "jit", target_arch = "x86_64"))]
-fn lower(tape: &Tape, layout: &Layout) -> Option<Code> {
+/// The evaluation of `tape` written by `e`.
+#[cfg_attr(
+    not(all(feature = "jit", any(target_arch = "x86_64", target_arch = "aarch64"))),
+    allow(dead_code)
+)]
+pub(super) fn lower<E: Emit>(mut e: E, tape: &Tape, layout: &Layout) -> Option<E::Code> {
     use crate::expr::compiled::layout::Place;
-    use crate::expr::compiled::machine::Emitter;
     use crate::expr::tape::{FUNS, FUNS2};
 
-    let mut e = Emitter::new(layout.extents(tape.outputs.len()))?;
     let anywhere = layout.output(0);
     for (r, &op) in tape.ops.iter().enumerate() {
         let r = r as u32;
         match op {
             Op::Const(_) | Op::Input(_) => continue,
             Op::Add(a, b) | Op::Sub(a, b) | Op::Mul(a, b) | Op::Div(a, b) => {
-                let apply: fn(&mut Emitter, u8, Place) = match op {
-                    Op::Add(..) => Emitter::add,
-                    Op::Sub(..) => Emitter::sub,
-                    Op::Mul(..) => Emitter::mul,
-                    _ => Emitter::div,
+                let apply: fn(&mut E, u8, Place) = match op {
+                    Op::Add(..) => E::add,
+                    Op::Sub(..) => E::sub,
+                    Op::Mul(..) => E::mul,
+                    _ => E::div,
                 };
                 e.load(0, layout.at(a, 0));
                 apply(&mut e, 0, layout.at(b, 0));
@@ -176,18 +169,18 @@ fn lower(tape: &Tape, layout: &Layout) -> Option<Code> {
             Op::Pow(a, b) => {
                 e.load(0, layout.at(a, 0));
                 e.load(1, layout.at(b, 0));
-                e.call(pow as *const (), 0, anywhere, anywhere);
+                e.call(Helper::Pow, 0, anywhere, anywhere);
             }
             Op::Call(f, a) => {
                 let kind = FUNS.iter().position(|&(_, g)| g == f)?;
                 e.load(0, layout.at(a, 0));
-                e.call(call as *const (), kind as u32, anywhere, anywhere);
+                e.call(Helper::Value, kind as u32, anywhere, anywhere);
             }
             Op::Call2(f, a, b) => {
                 let kind = FUNS2.iter().position(|&(_, g)| g == f)?;
                 e.load(0, layout.at(a, 0));
                 e.load(1, layout.at(b, 0));
-                e.call(call2 as *const (), kind as u32, anywhere, anywhere);
+                e.call(Helper::Value2, kind as u32, anywhere, anywhere);
             }
         }
         e.store(layout.at(r, 0), 0);

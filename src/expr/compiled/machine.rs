@@ -1,7 +1,8 @@
 //! x86-64 code for compiled tapes: scalar SSE2 loads, stores and
 //! arithmetic on places in three buffers, and calls into Rust for what is
-//! not arithmetic (a function's value). Other processors assemble
-//! nothing, and keep the interpreter.
+//! not arithmetic (a function's value). aarch64 has Cranelift's
+//! (`cranelift.rs`); other processors assemble nothing, and keep the
+//! interpreter.
 //!
 //! The code is one function, `extern "sysv64" fn(work, state, pool)`,
 //! straight-line and run once a step: kilobytes of it (11 KB for
@@ -29,7 +30,10 @@
 #[cfg(all(feature = "jit", target_arch = "x86_64"))]
 pub use x64::{Code, Emitter};
 
-#[cfg(not(all(feature = "jit", target_arch = "x86_64")))]
+#[cfg(all(feature = "jit", target_arch = "aarch64"))]
+pub use super::cranelift::{Code, Emitter};
+
+#[cfg(not(all(feature = "jit", any(target_arch = "x86_64", target_arch = "aarch64"))))]
 pub use other::Code;
 
 #[cfg(all(feature = "jit", target_arch = "x86_64"))]
@@ -39,6 +43,8 @@ mod x64 {
     use dynasmrt::x64::Assembler;
     use dynasmrt::{AssemblyOffset, DynasmApi, ExecutableBuffer, dynasm};
 
+    use crate::expr::compiled::callbacks;
+    use crate::expr::compiled::emit::{Emit, Helper};
     use crate::expr::compiled::layout::{Base, Place};
 
     /// Compiled code: one function of three buffers.
@@ -293,9 +299,13 @@ mod x64 {
             };
             self.sse(op, x, operand);
         }
+    }
+
+    impl Emit for Emitter {
+        type Code = Code;
 
         /// The function returned from, made executable.
-        pub fn finish(mut self) -> Option<Code> {
+        fn finish(mut self) -> Option<Code> {
             dynasm!(self.asm
                 ; .arch x64
                 ; pop r15
@@ -315,34 +325,34 @@ mod x64 {
             Some(Code { buffer, function })
         }
 
-        pub fn load(&mut self, x: u8, place: Place) {
+        fn load(&mut self, x: u8, place: Place) {
             match self.kept.find(place) {
                 // The whole register: a move the processor renames.
                 Some(r) => self.sse(MOVAPD, x, Operand::Register(r)),
                 None => self.at(MOVSD_LOAD, x, place),
             }
         }
-        pub fn add(&mut self, x: u8, place: Place) {
+        fn add(&mut self, x: u8, place: Place) {
             self.at(ADDSD, x, place);
         }
-        pub fn sub(&mut self, x: u8, place: Place) {
+        fn sub(&mut self, x: u8, place: Place) {
             self.at(SUBSD, x, place);
         }
-        pub fn mul(&mut self, x: u8, place: Place) {
+        fn mul(&mut self, x: u8, place: Place) {
             self.at(MULSD, x, place);
         }
-        pub fn div(&mut self, x: u8, place: Place) {
+        fn div(&mut self, x: u8, place: Place) {
             self.at(DIVSD, x, place);
         }
         /// A register to compute a value in that is then stored: it keeps
         /// the value with no copy (see [`Emitter::store`]).
-        pub fn fresh(&mut self) -> u8 {
+        fn fresh(&mut self) -> u8 {
             self.kept.fresh()
         }
 
         /// Store `x` at `place`, and keep it in a register: `x` itself
         /// where it came from [`Emitter::fresh`], else a copy.
-        pub fn store(&mut self, place: Place, x: u8) {
+        fn store(&mut self, place: Place, x: u8) {
             let (b, d) = self.address(place);
             self.sse(MOVSD_STORE, x, Operand::Memory(b, d));
             if KEPT.contains(&x) {
@@ -353,23 +363,23 @@ mod x64 {
                 self.sse(MOVAPD, copy, Operand::Register(x));
             }
         }
-        pub fn zero(&mut self, x: u8) {
+        fn zero(&mut self, x: u8) {
             self.sse(XORPD, x, Operand::Register(x));
         }
-        pub fn add_registers(&mut self, x: u8, y: u8) {
+        fn add_registers(&mut self, x: u8, y: u8) {
             self.sse(ADDSD, x, Operand::Register(y));
         }
-        pub fn sub_registers(&mut self, x: u8, y: u8) {
+        fn sub_registers(&mut self, x: u8, y: u8) {
             self.sse(SUBSD, x, Operand::Register(y));
         }
-        pub fn mul_registers(&mut self, x: u8, y: u8) {
+        fn mul_registers(&mut self, x: u8, y: u8) {
             self.sse(MULSD, x, Operand::Register(y));
         }
-        pub fn copy(&mut self, x: u8, y: u8) {
+        fn copy(&mut self, x: u8, y: u8) {
             self.sse(MOVAPD, x, Operand::Register(y));
         }
         /// `x = -x`: its sign bit flipped, as Rust's `-` does.
-        pub fn negate(&mut self, x: u8) {
+        fn negate(&mut self, x: u8) {
             dynasm!(self.asm
                 ; .arch x64
                 ; mov rax, QWORD i64::MIN
@@ -382,10 +392,10 @@ mod x64 {
         /// integer and pointer arguments in rdi, rsi, rdx, the floats in
         /// xmm0 and xmm1, a float result in xmm0), the two places passed
         /// by address.
-        pub fn call(&mut self, helper: *const (), kind: u32, first: Place, second: Place) {
+        fn call(&mut self, helper: Helper, kind: u32, first: Place, second: Place) {
             let (fb, fd) = self.address(first);
             let (sb, sd) = self.address(second);
-            let (kind, helper) = (kind as i32, helper as i64);
+            let (kind, helper) = (kind as i32, callbacks::address(helper) as i64);
             self.kept.forget();
             dynasm!(self.asm
                 ; .arch x64
@@ -396,24 +406,6 @@ mod x64 {
                 ; call rax
             );
             self.set_windows(|r| CLOBBERED_BY_CALLS.contains(&r));
-        }
-
-        /// `sum_{j in terms} a_j b_{k - j}` into `x`, from zero upwards (the
-        /// terms of `lo..=k` that are not known zeros).
-        pub fn product(
-            &mut self,
-            x: u8,
-            a: impl Fn(usize) -> Place,
-            b: impl Fn(usize) -> Place,
-            k: usize,
-            terms: std::ops::RangeInclusive<usize>,
-        ) {
-            self.zero(x);
-            for j in terms {
-                self.load(1, a(j));
-                self.mul(1, b(k - j));
-                self.add_registers(x, 1);
-            }
         }
     }
 
@@ -518,7 +510,7 @@ mod x64 {
     }
 }
 
-#[cfg(not(all(feature = "jit", target_arch = "x86_64")))]
+#[cfg(not(all(feature = "jit", any(target_arch = "x86_64", target_arch = "aarch64"))))]
 mod other {
     /// No code: nothing compiles on this processor.
     #[derive(Debug)]

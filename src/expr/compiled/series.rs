@@ -14,6 +14,8 @@
 use std::cell::RefCell;
 
 use crate::engine::step::taylor_method::MAX_ORDER;
+use crate::expr::compiled::callbacks::Origin;
+use crate::expr::compiled::emit::{Emit, Helper};
 use crate::expr::compiled::layout::Layout;
 use crate::expr::compiled::machine::Code;
 use crate::expr::compiled::tiered::Tiered;
@@ -87,7 +89,7 @@ impl CompiledFlow {
         }
         let width = order + 1;
         let layout = Layout::new(tape, width);
-        let code = lower(tape, &layout, order)?;
+        let code = compile(tape, &layout, order)?;
         Some(CompiledFlow {
             code,
             work: layout.work(0),
@@ -146,7 +148,6 @@ fn terms(tape: &Tape, order: usize) -> usize {
 /// forcing `cos(w t)` then costs one term an order, not `k`. Leaving out
 /// an exact zero moves no sum (one that starts at `+0` never becomes
 /// `-0`), so the code still gives the interpreter's bits.
-#[cfg_attr(not(all(feature = "jit", target_arch = "x86_64")), allow(dead_code))]
 pub(super) fn degrees(tape: &Tape) -> Vec<usize> {
     const ANY: usize = usize::MAX;
     let mut states = vec![ANY; tape.outputs.len()];
@@ -180,59 +181,36 @@ pub(super) fn degrees(tape: &Tape) -> Vec<usize> {
     degree
 }
 
-#[cfg(not(all(feature = "jit", target_arch = "x86_64")))]
-fn lower(_: &Tape, _: &Layout, _: usize) -> Option<Code> {
-    None
-}
-
-/// The functions whose value the code asks Rust for at a series' origin.
-#[cfg(all(feature = "jit", target_arch = "x86_64"))]
-#[derive(Clone, Copy)]
-#[repr(u32)]
-enum Origin {
-    Sin,
-    Cos,
-    Sinh,
-    Cosh,
-    Exp,
-}
-
-/// A function's value at the origin (and its partner's: the `cos` of a
-/// `sin`), by the same calls as the interpreter's.
-#[cfg(all(feature = "jit", target_arch = "x86_64"))]
-///
-/// # Safety
-///
-/// `value` and `partner` must be valid for writes: the compiled code passes
-/// two places of its work buffer.
-unsafe extern "sysv64" fn origin(kind: u32, a: f64, value: *mut f64, partner: *mut f64) {
-    let (v, p) = match kind {
-        k if k == Origin::Sin as u32 => a.sin_cos(),
-        k if k == Origin::Cos as u32 => {
-            let (s, c) = a.sin_cos();
-            (c, s)
-        }
-        k if k == Origin::Sinh as u32 => (a.sinh(), a.cosh()),
-        k if k == Origin::Cosh as u32 => (a.cosh(), a.sinh()),
-        _ => (a.exp(), 0.0),
-    };
-    // SAFETY: the code passes two places of its work buffer, which the
-    // caller of `Code::run` sized for every register's series.
-    unsafe {
-        *value = v;
-        *partner = p;
+/// The series of `tape` at `order` in this processor's code, `None` for
+/// an instruction that does not compile, or where nothing does.
+fn compile(tape: &Tape, layout: &Layout, order: usize) -> Option<Code> {
+    #[cfg(all(feature = "jit", any(target_arch = "x86_64", target_arch = "aarch64")))]
+    {
+        let e = crate::expr::compiled::machine::Emitter::new(layout.extents(0))?;
+        lower(e, tape, layout, order)
+    }
+    #[cfg(not(all(feature = "jit", any(target_arch = "x86_64", target_arch = "aarch64"))))]
+    {
+        let _ = (tape, layout, order);
+        None
     }
 }
 
-/// The series of `tape` at `order`, `None` for an instruction this does
-/// not compile.
-#[cfg(all(feature = "jit", target_arch = "x86_64"))]
-fn lower(tape: &Tape, layout: &Layout, order: usize) -> Option<Code> {
+/// The series of `tape` at `order` written by `e`, `None` for an
+/// instruction this does not compile.
+#[cfg_attr(
+    not(all(feature = "jit", any(target_arch = "x86_64", target_arch = "aarch64"))),
+    allow(dead_code)
+)]
+pub(super) fn lower<E: Emit>(
+    mut e: E,
+    tape: &Tape,
+    layout: &Layout,
+    order: usize,
+) -> Option<E::Code> {
     use crate::expr::compiled::layout::Base;
-    use crate::expr::compiled::machine::Emitter;
     use crate::expr::tape::Fun;
 
-    let mut e = Emitter::new(layout.extents(0))?;
     let constant = |r: u32| matches!(tape.ops[r as usize], Op::Const(_));
     let degree = degrees(tape);
     // The terms `j` of a Cauchy sum `sum_j a_j b_(k - j)` (from `lo`) whose
@@ -338,7 +316,7 @@ fn lower(tape: &Tape, layout: &Layout, order: usize) -> Option<Code> {
                             _ => Origin::Cosh,
                         };
                         e.load(0, layout.at(a, 0));
-                        e.call(origin as *const (), kind as u32, out, layout.helper(r, 0));
+                        e.call(Helper::Origin, kind as u32, out, layout.helper(r, 0));
                         continue;
                     }
                     // s' = a' c, c' = -+ a' s: the rates j a_j times the
@@ -372,12 +350,7 @@ fn lower(tape: &Tape, layout: &Layout, order: usize) -> Option<Code> {
                 Op::Call(Fun::Exp, a) => {
                     if k == 0 {
                         e.load(0, layout.at(a, 0));
-                        e.call(
-                            origin as *const (),
-                            Origin::Exp as u32,
-                            out,
-                            layout.helper(r, 0),
-                        );
+                        e.call(Helper::Origin, Origin::Exp as u32, out, layout.helper(r, 0));
                         continue;
                     }
                     // e' = a' e.
