@@ -170,6 +170,31 @@ def test_diagram_splits_at_the_period_doubling_and_matches_the_command_line(cli)
     assert list(frame.columns) == ["param", "t", "y", "v"] and len(frame) == 24
 
 
+def test_diagram_shards_join_into_the_whole_and_draw(cli, tmp_path):
+    # Shards run disjoint values: their rows, joined, are the whole
+    # diagram's (docs/orbits.md), and the joined CSV draws.
+    import matplotlib
+
+    matplotlib.use("Agg")
+    pd = pytest.importorskip("pandas")
+    asked = ["--param", "A", "--from", "0.11", "--to", "0.13", "--points", "6",
+             "--section", "impact", "--record", "8", "--quiet"]
+    frames = []
+    for shard in [None, "0/2", "1/2"]:
+        out = tmp_path / f"shard{shard}".replace("/", "of")
+        extra = [] if shard is None else ["--shard", shard]
+        done, _ = cli("diagram", TABLE, *asked, *extra, "--out", out)
+        assert done.returncode == 0, done.stderr
+        frames.append(pd.read_csv(out / "diagram.csv"))
+    whole, joined = frames[0], pd.concat(frames[1:], ignore_index=True)
+    key = list(whole.columns)
+    assert len(joined) == len(whole) > 0
+    assert whole.sort_values(key).reset_index(drop=True).equals(
+        joined.sort_values(key).reset_index(drop=True)
+    )
+    assert flicker.diagram_plot(joined) is not None
+
+
 def test_diagram_names_its_zeno_values_and_goes_on():
     found = flicker.diagram(TABLE, "A", 0.0, 0.13, section="impact", points=5, transient=60,
                             record=4, span=60)
