@@ -68,20 +68,20 @@ fn convention(isa: &dyn cranelift_codegen::isa::TargetIsa) -> CallConv {
 
 /// Compiled code: the module that holds its memory, and its entry.
 pub struct Code {
-    module: Option<Module_>,
+    module: Option<Owned>,
     function: Entry,
 }
 
 /// The JIT module, kept only to free its memory when the code goes.
-struct Module_(JITModule);
+struct Owned(JITModule);
 
 // SAFETY: the module is not used again after its code is finalized, but
 // to free its memory when the `Code` drops, which takes it by value:
 // sharing the `Code` between threads shares only the entry, whose code
 // is read only.
-unsafe impl Send for Module_ {}
+unsafe impl Send for Owned {}
 // SAFETY: as above; `&Code` reaches the module by no method.
-unsafe impl Sync for Module_ {}
+unsafe impl Sync for Owned {}
 
 impl std::fmt::Debug for Code {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -91,7 +91,7 @@ impl std::fmt::Debug for Code {
 
 impl Drop for Code {
     fn drop(&mut self) {
-        if let Some(Module_(module)) = self.module.take() {
+        if let Some(Owned(module)) = self.module.take() {
             // SAFETY: the entry, the one pointer into this memory, goes
             // with `self`.
             unsafe { module.free_memory() };
@@ -206,7 +206,7 @@ impl Emit for Emitter {
         // and stays mapped until `module` frees it (see `Drop`).
         let function: Entry = unsafe { std::mem::transmute::<*const u8, Entry>(address) };
         Some(Code {
-            module: Some(Module_(module)),
+            module: Some(Owned(module)),
             function,
         })
     }
