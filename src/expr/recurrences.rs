@@ -63,6 +63,56 @@ enum Step {
     Call2(Fun2, At),
 }
 
+/// Which recurrence an instruction's coefficients follow: the one
+/// classification of a tape's instructions, read by the orders' loop here
+/// ([`Step`]) and by the compiled lowering (`compiled/series.rs`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Recurrence {
+    /// A constant: its value, then zeros.
+    Const(f64),
+    /// An input: its series, copied in.
+    Input(u32),
+    Add(Reg, Reg),
+    Sub(Reg, Reg),
+    Neg(Reg),
+    /// `a * b`, `a` constant.
+    ScaledRight(Reg, Reg),
+    /// `a * b`, `b` constant.
+    ScaledLeft(Reg, Reg),
+    /// `a * a`.
+    Square(Reg),
+    Mul(Reg, Reg),
+    /// `a / b`, `b` constant.
+    DivConst(Reg, Reg),
+    Div(Reg, Reg),
+    /// `a^b`, `b` constant.
+    PowConst(Reg, Reg),
+    Pow(Reg, Reg),
+    Call(Fun, Reg),
+    Call2(Fun2, Reg, Reg),
+}
+
+/// The recurrence of `tape`'s instruction `r`.
+pub(crate) fn recurrence(tape: &Tape, r: usize) -> Recurrence {
+    match tape.ops[r] {
+        Op::Const(c) => Recurrence::Const(c),
+        Op::Input(i) => Recurrence::Input(i),
+        Op::Add(a, b) => Recurrence::Add(a, b),
+        Op::Sub(a, b) => Recurrence::Sub(a, b),
+        Op::Neg(a) => Recurrence::Neg(a),
+        Op::Mul(a, b) if constant(tape, a) => Recurrence::ScaledRight(a, b),
+        Op::Mul(a, b) if constant(tape, b) => Recurrence::ScaledLeft(a, b),
+        Op::Mul(a, b) if a == b => Recurrence::Square(a),
+        Op::Mul(a, b) => Recurrence::Mul(a, b),
+        Op::Div(a, b) if constant(tape, b) => Recurrence::DivConst(a, b),
+        Op::Div(a, b) => Recurrence::Div(a, b),
+        Op::Pow(a, b) if constant(tape, b) => Recurrence::PowConst(a, b),
+        Op::Pow(a, b) => Recurrence::Pow(a, b),
+        Op::Call(f, a) => Recurrence::Call(f, a),
+        Op::Call2(f, a, b) => Recurrence::Call2(f, a, b),
+    }
+}
+
 /// Where a [`Step`] reads and writes: the offsets of its operands'
 /// coefficients and of its own (`b` is `a` for one operand).
 #[derive(Debug, Clone, Copy)]
@@ -88,36 +138,36 @@ impl Series {
         let w = self.width;
         self.program.clear();
         self.loads.clear();
-        for (r, &op) in tape.ops.iter().enumerate() {
+        for r in 0..tape.ops.len() {
             let out = r * w;
             let at = |a: Reg, b: Reg| At {
                 a: a as usize * w,
                 b: b as usize * w,
                 out,
             };
-            self.program.push(match op {
-                Op::Const(c) => {
+            self.program.push(match recurrence(tape, r) {
+                Recurrence::Const(c) => {
                     self.main[out..out + w].fill(0.0);
                     self.main[out] = c;
                     continue;
                 }
-                Op::Input(i) => {
+                Recurrence::Input(i) => {
                     self.loads.push((i as usize * w, out));
                     continue;
                 }
-                Op::Add(a, b) => Step::Add(at(a, b)),
-                Op::Sub(a, b) => Step::Sub(at(a, b)),
-                Op::Neg(a) => Step::Neg(at(a, a)),
-                Op::Mul(a, b) if constant(tape, a) => Step::ScaledRight(at(a, b)),
-                Op::Mul(a, b) if constant(tape, b) => Step::ScaledLeft(at(a, b)),
-                Op::Mul(a, b) if a == b => Step::Square(at(a, a)),
-                Op::Mul(a, b) => Step::Mul(at(a, b)),
-                Op::Div(a, b) if constant(tape, b) => Step::DivConst(at(a, b)),
-                Op::Div(a, b) => Step::Div(at(a, b)),
-                Op::Pow(a, b) if constant(tape, b) => Step::PowConst(at(a, b)),
-                Op::Pow(a, b) => Step::Pow(at(a, b)),
-                Op::Call(f, a) => Step::Call(f, at(a, a)),
-                Op::Call2(f, a, b) => Step::Call2(f, at(a, b)),
+                Recurrence::Add(a, b) => Step::Add(at(a, b)),
+                Recurrence::Sub(a, b) => Step::Sub(at(a, b)),
+                Recurrence::Neg(a) => Step::Neg(at(a, a)),
+                Recurrence::ScaledRight(a, b) => Step::ScaledRight(at(a, b)),
+                Recurrence::ScaledLeft(a, b) => Step::ScaledLeft(at(a, b)),
+                Recurrence::Square(a) => Step::Square(at(a, a)),
+                Recurrence::Mul(a, b) => Step::Mul(at(a, b)),
+                Recurrence::DivConst(a, b) => Step::DivConst(at(a, b)),
+                Recurrence::Div(a, b) => Step::Div(at(a, b)),
+                Recurrence::PowConst(a, b) => Step::PowConst(at(a, b)),
+                Recurrence::Pow(a, b) => Step::Pow(at(a, b)),
+                Recurrence::Call(f, a) => Step::Call(f, at(a, a)),
+                Recurrence::Call2(f, a, b) => Step::Call2(f, at(a, b)),
             });
         }
     }

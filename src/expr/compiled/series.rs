@@ -3,8 +3,9 @@
 //! unrolled (every order, every term of every Cauchy sum), each operand at
 //! a fixed place.
 //!
-//! Tapes of sums, products, quotients, `sin`, `cos`, `sinh`, `cosh` and
-//! `exp` compile; a tape with anything else, or a very large one, keeps
+//! Each instruction follows the recurrence the interpreter gives it
+//! ([`recurrence`]: one classification for both). Tapes of sums,
+//! products, quotients, `sin`, `cos`, `sinh`, `cosh` and `exp` compile; a tape with anything else, or a very large one, keeps
 //! the interpreter. A function's value at the series' origin is taken by
 //! calling Rust's own (the interpreter's), its higher orders by its
 //! recurrence.
@@ -19,6 +20,7 @@ use crate::expr::compiled::emit::{Emit, Helper};
 use crate::expr::compiled::layout::Layout;
 use crate::expr::compiled::machine::Code;
 use crate::expr::compiled::tiered::Tiered;
+use crate::expr::recurrences::{Recurrence, recurrence};
 use crate::expr::tape::{Op, Reg, Tape};
 
 /// A flow's series at each order, compiled once warmed up (see
@@ -211,7 +213,6 @@ pub(super) fn lower<E: Emit>(
     use crate::expr::compiled::layout::Base;
     use crate::expr::tape::Fun;
 
-    let constant = |r: u32| matches!(tape.ops[r as usize], Op::Const(_));
     let degree = degrees(tape);
     // The terms `j` of a Cauchy sum `sum_j a_j b_(k - j)` (from `lo`) whose
     // factors are not past their degrees.
@@ -220,38 +221,37 @@ pub(super) fn lower<E: Emit>(
     };
     let width = order + 1;
     for k in 0..order {
-        for (r, &op) in tape.ops.iter().enumerate() {
-            let r = r as u32;
-            let out = layout.at(r, k);
+        for r in 0..tape.ops.len() {
+            let out = layout.at(r as u32, k);
             // Arithmetic computes in a fresh register, which keeps the value
             // it stores; a function's recurrence works in xmm0-xmm3.
-            let result = match op {
-                Op::Const(_) | Op::Input(_) => continue,
-                Op::Add(a, b) => {
+            let result = match recurrence(tape, r) {
+                Recurrence::Const(_) | Recurrence::Input(_) => continue,
+                Recurrence::Add(a, b) => {
                     let x = e.fresh();
                     e.load(x, layout.at(a, k));
                     e.add(x, layout.at(b, k));
                     x
                 }
-                Op::Sub(a, b) => {
+                Recurrence::Sub(a, b) => {
                     let x = e.fresh();
                     e.load(x, layout.at(a, k));
                     e.sub(x, layout.at(b, k));
                     x
                 }
-                Op::Neg(a) => {
+                Recurrence::Neg(a) => {
                     let x = e.fresh();
                     e.load(x, layout.at(a, k));
                     e.negate(x);
                     x
                 }
-                Op::Mul(a, b) if constant(a) => {
+                Recurrence::ScaledRight(a, b) => {
                     let x = e.fresh();
                     e.load(x, layout.at(a, 0));
                     e.mul(x, layout.at(b, k));
                     x
                 }
-                Op::Mul(a, b) if constant(b) => {
+                Recurrence::ScaledLeft(a, b) => {
                     let x = e.fresh();
                     e.load(x, layout.at(a, k));
                     e.mul(x, layout.at(b, 0));
@@ -260,7 +260,7 @@ pub(super) fn lower<E: Emit>(
                 // A square as the interpreter's (`recurrences::square`):
                 // each pair once, doubled, then the middle term; the terms
                 // past its degree are exact zeros and left out.
-                Op::Mul(a, b) if a == b && k >= 1 => {
+                Recurrence::Square(a) if k >= 1 => {
                     let x = e.fresh();
                     let terms = terms(a, a, k, 0);
                     let pairs = *terms.start()..=(*terms.end()).min((k - 1) / 2);
@@ -273,7 +273,19 @@ pub(super) fn lower<E: Emit>(
                     }
                     x
                 }
-                Op::Mul(a, b) => {
+                // Order 0 of a square is its one product.
+                Recurrence::Square(a) => {
+                    let x = e.fresh();
+                    e.product(
+                        x,
+                        |j| layout.at(a, j),
+                        |j| layout.at(a, j),
+                        k,
+                        terms(a, a, k, 0),
+                    );
+                    x
+                }
+                Recurrence::Mul(a, b) => {
                     let x = e.fresh();
                     e.product(
                         x,
@@ -284,14 +296,15 @@ pub(super) fn lower<E: Emit>(
                     );
                     x
                 }
-                Op::Div(a, b) if constant(b) => {
+                Recurrence::DivConst(a, b) => {
                     let x = e.fresh();
                     e.load(x, layout.at(a, k));
                     e.div(x, layout.at(b, 0));
                     x
                 }
-                Op::Div(a, b) => {
+                Recurrence::Div(a, b) => {
                     let x = e.fresh();
+                    let r = r as u32;
                     // a = q b: q_k = (a_k - sum_{j=1..k} b_j q_{k-j}) / b_0.
                     e.product(
                         2,
@@ -305,7 +318,8 @@ pub(super) fn lower<E: Emit>(
                     e.div(x, layout.at(b, 0));
                     x
                 }
-                Op::Call(f @ (Fun::Sin | Fun::Cos | Fun::Sinh | Fun::Cosh), a) => {
+                Recurrence::Call(f @ (Fun::Sin | Fun::Cos | Fun::Sinh | Fun::Cosh), a) => {
+                    let r = r as u32;
                     let hyperbolic = matches!(f, Fun::Sinh | Fun::Cosh);
                     let is_sin = matches!(f, Fun::Sin | Fun::Sinh);
                     if k == 0 {
@@ -347,7 +361,8 @@ pub(super) fn lower<E: Emit>(
                     e.store(layout.helper(r, k), 1);
                     0
                 }
-                Op::Call(Fun::Exp, a) => {
+                Recurrence::Call(Fun::Exp, a) => {
+                    let r = r as u32;
                     if k == 0 {
                         e.load(0, layout.at(a, 0));
                         e.call(Helper::Origin, Origin::Exp as u32, out, layout.helper(r, 0));
@@ -364,7 +379,10 @@ pub(super) fn lower<E: Emit>(
                     e.div(0, layout.integer(k));
                     0
                 }
-                Op::Pow(..) | Op::Call(..) | Op::Call2(..) => return None,
+                Recurrence::PowConst(..)
+                | Recurrence::Pow(..)
+                | Recurrence::Call(..)
+                | Recurrence::Call2(..) => return None,
             };
             e.store(out, result);
         }
