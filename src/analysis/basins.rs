@@ -15,7 +15,7 @@
 //!
 //! Each point is one run of the model by the tightest method the tools
 //! run (the closed form, the linear propagator, or DOP853 at
-//! [`TOLERANCE`]), the points in parallel. States are compared without a
+//! the diagram's [`TOLERANCE`](crate::analysis::diagram::TOLERANCE)), the points in parallel. States are compared without a
 //! clock the model carries as a state, which never repeats: a forced
 //! system's section states carry its phase in its other states.
 //!
@@ -36,11 +36,7 @@ use crate::analysis::orbit::{Orbit, OrbitRequest, Watch};
 use crate::analysis::section_records::{SectionRecords, check_section};
 use crate::analysis::spacing::evenly_spaced;
 use crate::analysis::started_at::StartedAt;
-use crate::engine::step::method::tightest;
 use crate::engine::{Family, Limits, MAX_EVENTS, Mode, Status, Tolerances, simulate};
-
-/// The tolerance of the runs where the model needs a numerical method.
-pub const TOLERANCE: f64 = 1e-12;
 
 /// Most points a grid may have.
 pub const MAX_POINTS: usize = 10_000_000;
@@ -268,11 +264,7 @@ pub fn run(
             .unwrap_or(0)
     });
     let model = family.model();
-    let method = tightest(model, family.modes(), TOLERANCE);
-    let tolerances = Tolerances {
-        rtol: TOLERANCE,
-        atol: TOLERANCE,
-    };
+    let method = crate::analysis::diagram::method(model, family.modes());
     let (_, start) = family.start();
     let width = values[1].len();
     let kept: Vec<usize> = (0..names.len())
@@ -291,7 +283,7 @@ pub fn run(
                 family,
                 request,
                 limits,
-                method: (method, tolerances),
+                method,
                 kept: &kept,
             };
             let (mode, x0) = family.start_from(&x0);

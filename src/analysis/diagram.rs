@@ -22,7 +22,9 @@ use rayon::prelude::*;
 
 use crate::analysis::section_records::{SectionRecords, check_section};
 use crate::engine::step::method::tightest;
-use crate::engine::{Family, Limits, MAX_EVENTS, Mode, Promoted, Status, Tolerances, simulate};
+use crate::engine::{
+    Family, HybridModel, Limits, MAX_EVENTS, Method, Mode, Promoted, Status, Tolerances, simulate,
+};
 
 /// The tolerance of the runs where the model needs a numerical method.
 pub const TOLERANCE: f64 = 1e-12;
@@ -32,6 +34,16 @@ pub const MAX_RECORD: usize = 100_000;
 
 /// Most values a diagram may have.
 pub const MAX_POINTS: usize = 1_000_000;
+
+/// The tightest method the brute-force tools run `model` (of `modes`
+/// modes) by, at [`TOLERANCE`] where it has tolerances.
+pub fn method(model: &dyn HybridModel, modes: usize) -> (Method, Tolerances) {
+    let tolerances = Tolerances {
+        rtol: TOLERANCE,
+        atol: TOLERANCE,
+    };
+    (tightest(model, modes, TOLERANCE), tolerances)
+}
 
 /// A diagram as asked.
 #[derive(Debug, Clone, PartialEq)]
@@ -148,28 +160,8 @@ pub fn run(
     let p = promoted.parameters[0];
     let model = &*promoted.model;
     let (kept, names) = recorded(&promoted);
-    let tolerances = Tolerances {
-        rtol: TOLERANCE,
-        atol: TOLERANCE,
-    };
-    let method = tightest(model, family.modes(), TOLERANCE);
-    // The start at `value` from the scene: initial values may depend on it.
-    let fresh = |value: f64| -> (Mode, Vec<f64>) {
-        let (mode, own) = family
-            .start_with(&request.parameter, value)
-            .unwrap_or_else(|_| family.start());
-        let mut rest = own.into_iter();
-        let x0 = (0..promoted.start.len())
-            .map(|i| {
-                if i == p {
-                    value
-                } else {
-                    rest.next().unwrap_or(0.0)
-                }
-            })
-            .collect();
-        (mode, x0)
-    };
+    let (method, tolerances) = method(model, family.modes());
+    let fresh = |value: f64| promoted.start_at(family, &request.parameter, value);
     let one = |index: usize, (mode, x0): (Mode, Vec<f64>), offset: f64| {
         let value = request.values[index];
         if limits.stopped() {

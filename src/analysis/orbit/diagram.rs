@@ -38,7 +38,6 @@ pub fn brute_force(
     let promoted = family
         .promoted(&[parameter.to_string()])
         .map_err(|why| SceneError::field("param", why))?;
-    let p = promoted.parameters[0];
     let section = Section {
         family,
         model: &*promoted.model,
@@ -51,20 +50,7 @@ pub fn brute_force(
     Ok(values
         .par_iter()
         .map(|&value| {
-            // The start at this value: initial values may depend on it.
-            let (mode, own) = family
-                .start_with(parameter, value)
-                .unwrap_or_else(|_| family.start());
-            let mut rest = own.into_iter();
-            let x0: Vec<f64> = (0..promoted.start.len())
-                .map(|i| {
-                    if i == p {
-                        value
-                    } else {
-                        rest.next().unwrap_or(0.0)
-                    }
-                })
-                .collect();
+            let (mode, x0) = promoted.start_at(family, parameter, value);
             let mut states = Vec::with_capacity(events);
             if let Ok((mut mode, mut x)) = start(&section, mode, &x0, settle, &mut ()) {
                 states.push(x.clone());

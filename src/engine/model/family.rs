@@ -88,6 +88,30 @@ pub struct Promoted {
     pub slopes: Vec<Vec<f64>>,
 }
 
+impl Promoted {
+    /// Where a family promoted in the one `parameter` starts with it at
+    /// `value`: the family's own start there (an initial value may depend
+    /// on it; its plain start where the family cannot say), the parameter's
+    /// component set to `value`.
+    pub fn start_at(&self, family: &dyn Family, parameter: &str, value: f64) -> (Mode, Vec<f64>) {
+        let p = self.parameters[0];
+        let (mode, own) = family
+            .start_with(parameter, value)
+            .unwrap_or_else(|_| family.start());
+        let mut rest = own.into_iter();
+        let x0 = (0..self.start.len())
+            .map(|i| {
+                if i == p {
+                    value
+                } else {
+                    rest.next().unwrap_or(0.0)
+                }
+            })
+            .collect();
+        (mode, x0)
+    }
+}
+
 impl std::fmt::Debug for Promoted {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Promoted")

@@ -274,18 +274,7 @@ pub(super) fn lower<E: Emit>(
                     x
                 }
                 // Order 0 of a square is its one product.
-                Recurrence::Square(a) => {
-                    let x = e.fresh();
-                    e.product(
-                        x,
-                        |j| layout.at(a, j),
-                        |j| layout.at(a, j),
-                        k,
-                        terms(a, a, k, 0),
-                    );
-                    x
-                }
-                Recurrence::Mul(a, b) => {
+                Recurrence::Mul(a, b) | Recurrence::Square(a @ b) => {
                     let x = e.fresh();
                     e.product(
                         x,
