@@ -69,6 +69,45 @@ pub fn shift(c: &mut [f64], a: f64) {
 }
 
 /// Each row of `rows` (coefficients `width` apiece, one polynomial after
+/// another) at `s` into `out`: [`eval`] of each, bit for bit, four rows in
+/// lockstep (one row's chain of fused steps waits on each last one; four
+/// fill the time it leaves idle).
+pub fn eval_rows(rows: &[f64], width: usize, s: f64, out: &mut [f64]) {
+    if width == 0 {
+        // Every row is the empty polynomial.
+        return out.fill(0.0);
+    }
+    let count = out.len().min(rows.len() / width);
+    let whole = count / 4 * 4;
+    let (fours, rest) = rows[..count * width].split_at(whole * width);
+    let (four_out, rest_out) = out[..count].split_at_mut(whole);
+    for (group, out) in fours
+        .chunks_exact(4 * width)
+        .zip(four_out.chunks_exact_mut(4))
+    {
+        fused_lockstep::<4>(group, width, s, out);
+    }
+    match rest_out.len() {
+        1 => fused_lockstep::<1>(rest, width, s, rest_out),
+        2 => fused_lockstep::<2>(rest, width, s, rest_out),
+        3 => fused_lockstep::<3>(rest, width, s, rest_out),
+        _ => {}
+    }
+}
+
+/// [`eval`] of `L` rows of `width` coefficients at once.
+#[inline(always)]
+fn fused_lockstep<const L: usize>(group: &[f64], width: usize, s: f64, out: &mut [f64]) {
+    let mut sum = [0.0; L];
+    for k in (0..width).rev() {
+        for l in 0..L {
+            sum[l] = mul_add(sum[l], s, group[l * width + k]);
+        }
+    }
+    out[..L].copy_from_slice(&sum);
+}
+
+/// Each row of `rows` (coefficients `width` apiece, one polynomial after
 /// another) at `s` into `out`, by compensated Horner
 /// ([`eval_compensated`], bit for bit). Rows run four in lockstep, and the
 /// last one to three together: each row's Horner chain waits on its last
@@ -209,6 +248,28 @@ mod tests {
                 assert_eq!(o.to_bits(), alone.to_bits(), "{count}, row {i}");
             }
         }
+    }
+
+    #[test]
+    fn plain_rows_in_lockstep_are_each_row_alone() {
+        // One to nine rows at several points: each must be its own fused
+        // Horner, bit for bit (an empty width gives zeros).
+        let width = 6;
+        let rows: Vec<f64> = (0..9 * width)
+            .map(|k| ((k * 29 % 13) as f64 - 6.0) * 0.7f64.powi((k % width) as i32))
+            .collect();
+        for count in 1..=9 {
+            for s in [0.0, -0.7, 0.37, 1.9] {
+                let mut out = vec![f64::NAN; count];
+                eval_rows(&rows[..count * width], width, s, &mut out);
+                for (o, c) in out.iter().zip(rows.chunks_exact(width)) {
+                    assert_eq!(o.to_bits(), eval(c, s).to_bits(), "{count} at {s}");
+                }
+            }
+        }
+        let mut out = [1.0; 3];
+        eval_rows(&[], 0, 0.5, &mut out);
+        assert!(out.iter().all(|o| *o == 0.0));
     }
 
     #[test]

@@ -555,10 +555,11 @@ fn commutator<const N: usize>(a: &Square<N>, b: &Square<N>) -> Square<N> {
     combine(&product(a, b), &product(b, a), |x, y| x - y)
 }
 
-/// `out = exp(a)` for a row-major `n x n` matrix: Pade's (5, 5)
-/// approximant on `a / 2^s` with `|a / 2^s| <= 1/4`, then `s` squarings
+/// `out = exp(a)` for a row-major `n x n` matrix: Pade's (7, 7)
+/// approximant on `a / 2^s` with `|a / 2^s| <= 0.95`, then `s` squarings
 /// (scaling and squaring as Higham 2005, with the one degree a
-/// linearisation's short pieces need: about four products and a solve).
+/// linearisation's pieces need: four products and a solve, and no
+/// squaring up to a piece's largest spread).
 fn exp(n: usize, a: &[f64], out: &mut [f64]) {
     if n == 2 {
         return exp2(a, out);
@@ -650,13 +651,13 @@ fn square<const N: usize>(a: &[f64], scale: f64) -> Square<N> {
     out
 }
 
-/// `b4 x4 + b2 x2 + b0 I`.
-fn even<const N: usize>(x4: &Square<N>, x2: &Square<N>, b4: f64, b2: f64, b0: f64) -> Square<N> {
+/// `b6 x6 + b4 x4 + b2 x2 + b0 I`, with `b = [b6, b4, b2, b0]`.
+fn even<const N: usize>(x6: &Square<N>, x4: &Square<N>, x2: &Square<N>, b: [f64; 4]) -> Square<N> {
     let mut out = [[0.0; N]; N];
     for (i, row) in out.iter_mut().enumerate() {
         for (j, x) in row.iter_mut().enumerate() {
-            let sum = b4 * x4[i][j] + b2 * x2[i][j];
-            *x = if i == j { sum + b0 } else { sum };
+            let sum = b[0] * x6[i][j] + b[1] * x4[i][j] + b[2] * x2[i][j];
+            *x = if i == j { sum + b[3] } else { sum };
         }
     }
     out
@@ -669,22 +670,31 @@ fn exp_sized<const N: usize>(a: &[f64], out: &mut [f64]) {
         out.fill(f64::NAN);
         return;
     }
-    // Scaled to |a / 2^s| <= 1/4, where Pade's (5, 5) approximant is exact
-    // to round-off (Higham 2005: backward error below 2^-53 up to 0.254).
-    let squarings = if norm > PADE_5_REACH {
-        (norm / PADE_5_REACH).log2().ceil() as i32
-    } else {
-        0
-    };
-    let scale = 0.5f64.powi(squarings);
+    // Scaled to |a / 2^s| <= PADE_7_REACH, where Pade's (7, 7) approximant
+    // is exact to round-off: a piece's generator (its spread at most
+    // PIECE_SPREAD) mostly needs no squaring. The halvings are exact.
+    let (mut squarings, mut scale) = (0, 1.0);
+    while norm * scale > PADE_7_REACH {
+        (squarings, scale) = (squarings + 1, 0.5 * scale);
+    }
     // exp(x) ~ (V(x) - U(x))^-1 (V(x) + U(x)), U odd, V even.
-    const B: [f64; 6] = [30240.0, 15120.0, 3360.0, 420.0, 30.0, 1.0];
+    const B: [f64; 8] = [
+        17_297_280.0,
+        8_648_640.0,
+        1_995_840.0,
+        277_200.0,
+        25_200.0,
+        1_512.0,
+        56.0,
+        1.0,
+    ];
     let x = square::<N>(a, scale);
     let x2 = product(&x, &x);
     let x4 = product(&x2, &x2);
-    // term = B5 x^4 + B3 x^2 + B1 I, next = B4 x^4 + B2 x^2 + B0 I.
-    let term = even(&x4, &x2, B[5], B[3], B[1]);
-    let next = even(&x4, &x2, B[4], B[2], B[0]);
+    let x6 = product(&x4, &x2);
+    // U = x (B7 x^6 + B5 x^4 + B3 x^2 + B1 I), V = B6 x^6 + B4 x^4 + B2 x^2 + B0 I.
+    let term = even(&x6, &x4, &x2, [B[7], B[5], B[3], B[1]]);
+    let next = even(&x6, &x4, &x2, [B[6], B[4], B[2], B[0]]);
     let u = product(&x, &term);
     let (mut denominator, mut e) = (next, next);
     for ((d, e), u) in denominator.iter_mut().zip(&mut e).zip(&u) {
@@ -702,9 +712,10 @@ fn exp_sized<const N: usize>(a: &[f64], out: &mut [f64]) {
     }
 }
 
-/// The norm up to which Pade's (5, 5) approximant of `exp` is exact to
-/// round-off.
-const PADE_5_REACH: f64 = 0.25;
+/// The norm up to which Pade's (7, 7) approximant of `exp` is exact to
+/// round-off (Higham 2005, Table 2.3: backward error below 2^-53 up to
+/// 0.950).
+const PADE_7_REACH: f64 = 0.95;
 
 /// `b = a^-1 b` by Gaussian elimination with partial pivoting (`a` is
 /// overwritten). Pade's denominator is close to the identity's multiple,

@@ -30,7 +30,7 @@ use crate::engine::model::{Direction, HybridModel, Mode};
 use crate::engine::step::adaptive::{StepFailure, Tolerances};
 use crate::engine::step::locate::{Start, StepScan};
 use crate::numerics::first_crossing::{eval2, first_fall};
-use crate::numerics::polynomial::{eval, eval_compensated_rows, shift};
+use crate::numerics::polynomial::{eval_compensated_rows, eval_rows, shift};
 
 /// The tolerance `taylor` takes unless told: machine epsilon, as heyoka.
 pub const DEFAULT_TOLERANCE: f64 = f64::EPSILON;
@@ -273,9 +273,7 @@ impl Taylor {
     /// Horner, fused): what a linearisation of the step samples, which
     /// needs none of [`Taylor::eval`]'s compensation.
     pub fn sample(&self, tau: f64, x: &mut [f64]) {
-        for (xi, c) in x.iter_mut().zip(self.series.chunks_exact(self.order + 1)) {
-            *xi = eval(c, tau);
-        }
+        eval_rows(&self.series, self.order + 1, tau, x);
     }
 
     /// The last term kept, at the step's length.
