@@ -615,7 +615,7 @@ mod tests {
         // axis (the phase error of a periodic orbit): the parallelepiped
         // is kept.
         let shear = [1.0, 1.0, 0.0, 1.0];
-        assert!(dropped_for::<2>(&shear, 5000, Carried::Box).is_some());
+        assert!(dropped_for::<2>(&shear, 40_000, Carried::Box).is_some());
     }
 
     #[test]
