@@ -23,7 +23,9 @@
 //!   over 2000 time units).
 //! - An ellipsoid (`ellipsoid.rs`) takes every map exactly, but adding a
 //!   round local error to a long thin set swells its thin axes (the
-//!   mechanism's phase error after 43,000 impacts: 1e3 times looser).
+//!   mechanism's phase error after 43,000 impacts: 1e3 times looser); it
+//!   is held as two, the recent errors apart from the old, which tempers
+//!   that.
 //!
 //! Where one enclosure has grown a hundred times the other (the
 //! parallelepiped wrapped on Henon-Heiles, the ellipsoid swollen on the
