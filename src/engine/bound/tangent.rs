@@ -555,11 +555,11 @@ fn commutator<const N: usize>(a: &Square<N>, b: &Square<N>) -> Square<N> {
     combine(&product(a, b), &product(b, a), |x, y| x - y)
 }
 
-/// `out = exp(a)` for a row-major `n x n` matrix: Pade's (7, 7)
-/// approximant on `a / 2^s` with `|a / 2^s| <= 0.95`, then `s` squarings
-/// (scaling and squaring as Higham 2005, with the one degree a
-/// linearisation's pieces need: four products and a solve, and no
-/// squaring up to a piece's largest spread).
+/// `out = exp(a)` for a row-major `n x n` matrix: the Taylor polynomial
+/// of degree 19 on `a / 2^s` with `|a / 2^s| <= 1.2`, then `s` squarings
+/// (scaling and squaring, with the one degree a linearisation's pieces
+/// need: seven products, and no squaring up to a piece's largest
+/// spread).
 fn exp(n: usize, a: &[f64], out: &mut [f64]) {
     if n == 2 {
         return exp2(a, out);
@@ -651,18 +651,6 @@ fn square<const N: usize>(a: &[f64], scale: f64) -> Square<N> {
     out
 }
 
-/// `b6 x6 + b4 x4 + b2 x2 + b0 I`, with `b = [b6, b4, b2, b0]`.
-fn even<const N: usize>(x6: &Square<N>, x4: &Square<N>, x2: &Square<N>, b: [f64; 4]) -> Square<N> {
-    let mut out = [[0.0; N]; N];
-    for (i, row) in out.iter_mut().enumerate() {
-        for (j, x) in row.iter_mut().enumerate() {
-            let sum = b[0] * x6[i][j] + b[1] * x4[i][j] + b[2] * x2[i][j];
-            *x = if i == j { sum + b[3] } else { sum };
-        }
-    }
-    out
-}
-
 fn exp_sized<const N: usize>(a: &[f64], out: &mut [f64]) {
     let norm = row_norm(N, a);
     if !norm.is_finite() {
@@ -670,40 +658,44 @@ fn exp_sized<const N: usize>(a: &[f64], out: &mut [f64]) {
         out.fill(f64::NAN);
         return;
     }
-    // Scaled to |a / 2^s| <= PADE_7_REACH, where Pade's (7, 7) approximant
-    // is exact to round-off: a piece's generator (its spread at most
-    // PIECE_SPREAD) mostly needs no squaring. The halvings are exact.
+    // Scaled to |a / 2^s| <= TAYLOR_19_REACH, where the Taylor polynomial
+    // of degree 19 is exact to round-off: a piece's generator (its spread
+    // at most PIECE_SPREAD) mostly needs no squaring. The halvings are
+    // exact.
     let (mut squarings, mut scale) = (0, 1.0);
-    while norm * scale > PADE_7_REACH {
+    while norm * scale > TAYLOR_19_REACH {
         (squarings, scale) = (squarings + 1, 0.5 * scale);
     }
-    // exp(x) ~ (V(x) - U(x))^-1 (V(x) + U(x)), U odd, V even.
-    const B: [f64; 8] = [
-        17_297_280.0,
-        8_648_640.0,
-        1_995_840.0,
-        277_200.0,
-        25_200.0,
-        1_512.0,
-        56.0,
-        1.0,
-    ];
+    // Paterson and Stockmeyer: with y = x^4, the sum over j of
+    // B_j(x) y^j, B_j = c_4j I + c_4j+1 x + c_4j+2 x^2 + c_4j+3 x^3, by
+    // Horner's rule in y: seven products, and no solve (a Pade
+    // approximant's solve is a chain of divisions that took half the
+    // time).
     let x = square::<N>(a, scale);
     let x2 = product(&x, &x);
-    let x4 = product(&x2, &x2);
-    let x6 = product(&x4, &x2);
-    // U = x (B7 x^6 + B5 x^4 + B3 x^2 + B1 I), V = B6 x^6 + B4 x^4 + B2 x^2 + B0 I.
-    let term = even(&x6, &x4, &x2, [B[7], B[5], B[3], B[1]]);
-    let next = even(&x6, &x4, &x2, [B[6], B[4], B[2], B[0]]);
-    let u = product(&x, &term);
-    let (mut denominator, mut e) = (next, next);
-    for ((d, e), u) in denominator.iter_mut().zip(&mut e).zip(&u) {
-        for ((d, e), u) in d.iter_mut().zip(e.iter_mut()).zip(u) {
-            *d -= u;
-            *e += u;
+    let x3 = product(&x2, &x);
+    let y = product(&x2, &x2);
+    let block = |j: usize| {
+        let c = |k: usize| INVERSE_FACTORIALS[4 * j + k];
+        let mut b = [[0.0; N]; N];
+        for (i, row) in b.iter_mut().enumerate() {
+            for (l, v) in row.iter_mut().enumerate() {
+                let sum = c(1) * x[i][l] + c(2) * x2[i][l] + c(3) * x3[i][l];
+                *v = if i == l { sum + c(0) } else { sum };
+            }
+        }
+        b
+    };
+    let mut e = block(4);
+    for j in (0..4).rev() {
+        e = product(&e, &y);
+        let b = block(j);
+        for (row, b) in e.iter_mut().zip(&b) {
+            for (v, b) in row.iter_mut().zip(b) {
+                *v += b;
+            }
         }
     }
-    solve_in_place(&mut denominator, &mut e);
     for _ in 0..squarings {
         e = product(&e, &e);
     }
@@ -712,60 +704,21 @@ fn exp_sized<const N: usize>(a: &[f64], out: &mut [f64]) {
     }
 }
 
-/// The norm up to which Pade's (7, 7) approximant of `exp` is exact to
-/// round-off (Higham 2005, Table 2.3: backward error below 2^-53 up to
-/// 0.950).
-const PADE_7_REACH: f64 = 0.95;
+/// The norm up to which the Taylor polynomial of degree 19 gives `exp` to
+/// round-off: its first term left out, `|x|^20 / 20!`, is 2.4e-17 at 1.2.
+const TAYLOR_19_REACH: f64 = 1.2;
 
-/// `b = a^-1 b` by Gaussian elimination with partial pivoting (`a` is
-/// overwritten). Pade's denominator is close to the identity's multiple,
-/// so pivots never vanish for the norms it is asked at.
-fn solve_in_place<const N: usize>(a: &mut Square<N>, b: &mut Square<N>) {
-    // Whole rows at a time, so that each update is a few vector
-    // instructions; every entry sees the same operations in the same order
-    // as entry by entry.
-    for col in 0..N {
-        // The largest pivot, the last of equals.
-        let mut pivot = col;
-        for row in col + 1..N {
-            if a[row][col].abs().total_cmp(&a[pivot][col].abs()).is_ge() {
-                pivot = row;
-            }
-        }
-        if pivot != col {
-            a.swap(col, pivot);
-            b.swap(col, pivot);
-        }
-        let p = a[col][col];
-        let (above, below) = a.split_at_mut(col + 1);
-        let (b_above, b_below) = b.split_at_mut(col + 1);
-        for (a_row, b_row) in below.iter_mut().zip(b_below.iter_mut()) {
-            let f = a_row[col] / p;
-            // The entries left of `col` are never read again: updating
-            // them too keeps the row whole.
-            for (x, y) in a_row.iter_mut().zip(&above[col]) {
-                *x -= f * y;
-            }
-            for (x, y) in b_row.iter_mut().zip(&b_above[col]) {
-                *x -= f * y;
-            }
-        }
+/// `1 / k!` for `k` from 0 to 19, each rounded once (`k!` is exact in
+/// `f64` up to 22!).
+const INVERSE_FACTORIALS: [f64; 20] = {
+    let (mut c, mut factorial, mut k) = ([1.0; 20], 1.0, 1);
+    while k < 20 {
+        factorial *= k as f64;
+        c[k] = 1.0 / factorial;
+        k += 1;
     }
-    for col in (0..N).rev() {
-        let p = a[col][col];
-        let mut v = b[col];
-        for j in col + 1..N {
-            let f = a[col][j];
-            for (x, y) in v.iter_mut().zip(&b[j]) {
-                *x -= f * y;
-            }
-        }
-        for x in &mut v {
-            *x /= p;
-        }
-        b[col] = v;
-    }
-}
+    c
+};
 
 /// `a b`, each entry summed over `l` in increasing order.
 fn product<const N: usize>(a: &Square<N>, b: &Square<N>) -> Square<N> {
