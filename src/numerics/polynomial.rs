@@ -213,31 +213,45 @@ mod tests {
         assert_eq!(eval_compensated(&[], 3.0), 0.0);
     }
 
-    #[test]
-    fn rows_in_lockstep_are_each_row_alone() {
-        // One to nine rows (groups of four, of two, and one left over) of a
-        // width with cancelling terms: each must equal its own compensated
-        // Horner, bit for bit.
-        let width = 7;
-        let rows: Vec<f64> = (0..9 * width)
-            .map(|k| ((k * 37 % 11) as f64 - 5.0) * 1.3f64.powi((k % width) as i32))
-            .collect();
+    /// Nine rows of 7 terms that cancel.
+    const WIDTH: usize = 7;
+    fn nine_rows() -> Vec<f64> {
+        (0..9 * WIDTH)
+            .map(|k| ((k * 37 % 11) as f64 - 5.0) * 1.3f64.powi((k % WIDTH) as i32))
+            .collect()
+    }
+
+    /// One to nine rows (groups of four, of two, and one left over), at
+    /// several points: `rows_at` must give each row's `alone`, bit for
+    /// bit, and zeros for rows of no terms.
+    fn each_row_alone(
+        rows_at: impl Fn(&[f64], usize, f64, &mut [f64]),
+        alone: impl Fn(&[f64], f64) -> f64,
+    ) {
+        let (width, rows) = (WIDTH, nine_rows());
         for count in 1..=9 {
             for s in [0.0, -0.7, 0.37, 1.9] {
                 let mut out = vec![f64::NAN; count];
-                eval_compensated_rows(&rows[..count * width], width, s, &mut out);
+                rows_at(&rows[..count * width], width, s, &mut out);
                 for (o, c) in out.iter().zip(rows.chunks_exact(width)) {
-                    assert_eq!(
-                        o.to_bits(),
-                        eval_compensated(c, s).to_bits(),
-                        "{count} at {s}"
-                    );
+                    assert_eq!(o.to_bits(), alone(c, s).to_bits(), "{count} at {s}");
                 }
             }
         }
         let mut out = [1.0; 3];
-        eval_compensated_rows(&[], 0, 0.5, &mut out);
+        rows_at(&[], 0, 0.5, &mut out);
         assert!(out.iter().all(|o| *o == 0.0));
+    }
+
+    #[test]
+    fn plain_rows_in_lockstep_are_each_row_alone() {
+        each_row_alone(eval_rows, eval);
+    }
+
+    #[test]
+    fn rows_in_lockstep_are_each_row_alone() {
+        each_row_alone(eval_compensated_rows, eval_compensated);
+        let (width, rows) = (WIDTH, nine_rows());
         // With an extra term per row: each row's own `plus`.
         let extra = |i: usize| 1e-17 * (i as f64 - 3.0);
         for count in 1..=9 {
@@ -248,28 +262,6 @@ mod tests {
                 assert_eq!(o.to_bits(), alone.to_bits(), "{count}, row {i}");
             }
         }
-    }
-
-    #[test]
-    fn plain_rows_in_lockstep_are_each_row_alone() {
-        // One to nine rows at several points: each must be its own fused
-        // Horner, bit for bit (an empty width gives zeros).
-        let width = 6;
-        let rows: Vec<f64> = (0..9 * width)
-            .map(|k| ((k * 29 % 13) as f64 - 6.0) * 0.7f64.powi((k % width) as i32))
-            .collect();
-        for count in 1..=9 {
-            for s in [0.0, -0.7, 0.37, 1.9] {
-                let mut out = vec![f64::NAN; count];
-                eval_rows(&rows[..count * width], width, s, &mut out);
-                for (o, c) in out.iter().zip(rows.chunks_exact(width)) {
-                    assert_eq!(o.to_bits(), eval(c, s).to_bits(), "{count} at {s}");
-                }
-            }
-        }
-        let mut out = [1.0; 3];
-        eval_rows(&[], 0, 0.5, &mut out);
-        assert!(out.iter().all(|o| *o == 0.0));
     }
 
     #[test]
