@@ -70,6 +70,22 @@ fn settles_at(x: f64, v: f64, t_end: f64) -> f64 {
     s[0].signum()
 }
 
+/// Basins of `grid` read at `section`, the other settings the CLI's
+/// defaults but a minute's wall time; tests change what they need.
+fn request(grid: [&str; 2], section: Option<&str>) -> BasinsRequest {
+    BasinsRequest {
+        grid: grid.map(String::from).to_vec(),
+        transient: None,
+        section: section.map(String::from),
+        record: 16,
+        tolerance: 1e-6,
+        forcing_period: None,
+        past_horizon: false,
+        shard: None,
+        wall: 60.0,
+    }
+}
+
 fn basins(
     scene: &str,
     grid: [&str; 2],
@@ -80,15 +96,9 @@ fn basins(
         .from_value(&read_json(std::path::Path::new(&automaton(scene))))
         .unwrap();
     let asked = BasinsRequest {
-        grid: grid.map(String::from).to_vec(),
-        transient: None,
-        section: section.map(String::from),
-        record: 16,
-        tolerance: 1e-6,
         forcing_period,
-        past_horizon: false,
-        shard: None,
         wall: 120.0,
+        ..request(grid, section)
     };
     asked.on(&scene).unwrap().run(None, &|| {})
 }
@@ -200,15 +210,8 @@ fn a_forced_orbit_is_left_unrefined_without_its_forcing_period() {
         ))))
         .unwrap();
     let asked = BasinsRequest {
-        grid: vec!["x=-1:1:3".into(), "v=-1:1:3".into()],
-        transient: None,
-        section: None,
-        record: 16,
-        tolerance: 1e-6,
         forcing_period: Some(1.0),
-        past_horizon: false,
-        shard: None,
-        wall: 60.0,
+        ..request(["x=-1:1:3", "v=-1:1:3"], None)
     };
     let refused = asked.on(&scene).err().expect("refused");
     assert!(refused.to_string().contains("forcing_period"), "{refused}");
@@ -235,15 +238,9 @@ fn a_quasi_periodic_orbit_is_not_called_chaotic() {
     });
     let scene = Registry::builtin().from_value(&scene).unwrap();
     let asked = BasinsRequest {
-        grid: vec!["x=0.5:1:2".into(), "y=0.3:0.37:2".into()],
-        transient: None,
-        section: Some("bounce".into()),
         record: 32,
-        tolerance: 1e-6,
-        forcing_period: None,
         past_horizon: true,
-        shard: None,
-        wall: 60.0,
+        ..request(["x=0.5:1:2", "y=0.3:0.37:2"], Some("bounce"))
     };
     let found = asked.on(&scene).unwrap().run(None, &|| {});
     assert_eq!(found.attractors.len(), 1, "{:?}", found.attractors);
@@ -319,15 +316,9 @@ fn the_stick_slip_cycle_is_refined_with_its_multipliers_from_every_start() {
         ))))
         .unwrap();
     let asked = BasinsRequest {
-        grid: vec!["x=-0.5:1:6".into(), "v=-1:1:6".into()],
         transient: Some(100.0),
-        section: Some("wall".into()),
         record: 6,
-        tolerance: 1e-6,
-        forcing_period: None,
-        past_horizon: false,
-        shard: None,
-        wall: 60.0,
+        ..request(["x=-0.5:1:6", "v=-1:1:6"], Some("wall"))
     };
     let found = asked.on(&scene).unwrap().run(None, &|| {});
     assert_eq!(found.attractors.len(), 1, "{:?}", found.attractors);
@@ -361,15 +352,9 @@ fn a_chaotic_attractor_is_named_by_its_positive_exponent_past_the_horizon() {
     scene["t_end"] = serde_json::json!(60.0);
     let scene = Registry::builtin().from_value(&scene).unwrap();
     let asked = |past_horizon| BasinsRequest {
-        grid: vec!["y=0.05:0.6:4".into(), "v=0:4:4".into()],
-        transient: None,
-        section: Some("impact".into()),
         record: 64,
-        tolerance: 1e-6,
-        forcing_period: None,
         past_horizon,
-        shard: None,
-        wall: 60.0,
+        ..request(["y=0.05:0.6:4", "v=0:4:4"], Some("impact"))
     };
     let found = asked(true).on(&scene).unwrap().run(None, &|| {});
     let chaotic: Vec<_> = found
