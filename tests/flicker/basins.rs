@@ -10,6 +10,7 @@ use std::f64::consts::PI;
 
 use serde_json::Value;
 
+use flicker::scene::Scene;
 use flicker::session::{AttractorKind, Basins, BasinsRequest, Registry};
 
 use crate::automata::automaton;
@@ -70,6 +71,13 @@ fn settles_at(x: f64, v: f64, t_end: f64) -> f64 {
     s[0].signum()
 }
 
+/// The bundled automaton `name` as a scene.
+fn bundled(name: &str) -> Scene {
+    Registry::builtin()
+        .from_value(&read_json(std::path::Path::new(&automaton(name))))
+        .unwrap()
+}
+
 /// Basins of `grid` read at `section`, the other settings the CLI's
 /// defaults but a minute's wall time; tests change what they need.
 fn request(grid: [&str; 2], section: Option<&str>) -> BasinsRequest {
@@ -92,9 +100,7 @@ fn basins(
     section: Option<&str>,
     forcing_period: Option<f64>,
 ) -> Basins {
-    let scene = Registry::builtin()
-        .from_value(&read_json(std::path::Path::new(&automaton(scene))))
-        .unwrap();
+    let scene = bundled(scene);
     let asked = BasinsRequest {
         forcing_period,
         wall: 120.0,
@@ -204,11 +210,7 @@ fn a_forced_orbit_is_left_unrefined_without_its_forcing_period() {
         .find(|a| a.kind == AttractorKind::Periodic);
     assert!(periodic.expect("periodic").orbit.is_none());
     // A forcing period for an autonomous model is refused, naming it.
-    let scene = Registry::builtin()
-        .from_value(&read_json(std::path::Path::new(&automaton(
-            "double_well_wall.json",
-        ))))
-        .unwrap();
+    let scene = bundled("double_well_wall.json");
     let asked = BasinsRequest {
         forcing_period: Some(1.0),
         ..request(["x=-1:1:3", "v=-1:1:3"], None)
@@ -310,11 +312,7 @@ fn the_stick_slip_cycle_is_refined_with_its_multipliers_from_every_start() {
     // belt's speed, each begun in its own region of the discontinuous
     // flow), it ends on the one stick-slip cycle. Right after the wall
     // the block is at the wall, moving away from it.
-    let scene = Registry::builtin()
-        .from_value(&read_json(std::path::Path::new(&automaton(
-            "stick_slip_belt.json",
-        ))))
-        .unwrap();
+    let scene = bundled("stick_slip_belt.json");
     let asked = BasinsRequest {
         transient: Some(100.0),
         record: 6,
